@@ -1,0 +1,69 @@
+//! The `DiscreteEvent` interface (thesis §3.1.3): very short-lived events
+//! (collisions) that integration with a finite step cannot resolve.
+//!
+//! After each trial step the world asks every event for its state:
+//! - [`EventState::None`]: nothing happened;
+//! - [`EventState::Occurring`]: it is happening now and can be handled
+//!   ([`DiscreteEvent::handle`] then changes the state);
+//! - [`EventState::Missed`]: it happened somewhere inside the step, too long
+//!   ago to handle: the world throws the trial away and retakes the step in
+//!   shorter pieces.
+//!
+//! New events plug in with [`World::add_event`](crate::World::add_event); no
+//! integrator knows about any particular event.
+
+use crate::particle::Properties;
+use glam::DVec3;
+
+/// What an event reports about a trial step. Ordered by severity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum EventState {
+    /// No event during the step.
+    #[default]
+    None,
+    /// An event is occurring now and can be handled.
+    Occurring,
+    /// An event occurred inside the step: backtrack.
+    Missed,
+}
+
+/// The trial state an event inspects.
+#[derive(Clone, Copy)]
+pub struct EventContext<'a> {
+    /// Simulated time at the end of the trial step, s.
+    pub t: f64,
+    /// Positions at the end of the trial step.
+    pub pos: &'a [DVec3],
+    /// Velocities at the end of the trial step.
+    pub vel: &'a [DVec3],
+    /// The particles' properties.
+    pub particles: &'a Properties,
+}
+
+/// A discrete event: detected after a trial step, handled by changing the state.
+pub trait DiscreteEvent: Send {
+    /// Inspects the trial state. May remember what it found for `handle`.
+    fn check(&mut self, ctx: &EventContext) -> EventState;
+
+    /// Handles the event found by the last `check` (called only after
+    /// `Occurring`, or after `Missed` once the step cannot be split further).
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties);
+
+    /// Called once at the start of each step, before any trial; events that
+    /// record what happened during a step clear their records here.
+    fn begin_step(&mut self) {}
+
+    /// True if handling the event never changes the total energy.
+    fn conserves_energy(&self) -> bool {
+        false
+    }
+
+    /// A short name for summaries.
+    fn name(&self) -> &str {
+        "event"
+    }
+
+    /// Lets a caller that knows the concrete type read its records back
+    /// (e.g. the floor's collisions of the last step).
+    fn as_any(&self) -> &dyn std::any::Any;
+}

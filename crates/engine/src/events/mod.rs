@@ -1,0 +1,3 @@
+//! The built-in discrete events, one per file.
+
+pub mod floor_collision;

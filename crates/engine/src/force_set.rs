@@ -1,0 +1,125 @@
+//! Every force of a world, in typed collections so each hot loop is tight,
+//! evaluated in a fixed order at each trial state.
+
+use crate::force::{Force, ForceContext, Stage};
+use crate::forces::{
+    angle_joint::AngleJoints, constant_force::ConstantForces, floor_contact::FloorContact,
+    fluid::FluidMedium, gravity::Gravity, nbody::NBodyGravity, spring::Springs,
+    torque_joint::TorqueJoints,
+};
+use crate::particle::Properties;
+use glam::DVec3;
+
+/// The forces of a world. Built-in kinds live in their own collections; user
+/// forces ([`Force`] trait objects) are kept in the order they were added.
+///
+/// Order of evaluation: gravity, springs, angle joints, torque joints,
+/// constant forces, fluids, n-body gravity, user body forces; then the
+/// contact stage (floor, user contact forces), which reads the net force.
+#[derive(Default)]
+pub struct Forces {
+    /// Uniform gravity, if any.
+    pub gravity: Option<Gravity>,
+    /// Damped springs.
+    pub springs: Springs,
+    /// Angle joints.
+    pub angle_joints: AngleJoints,
+    /// Torque joints (motors).
+    pub torque_joints: TorqueJoints,
+    /// Constant forces.
+    pub constant_forces: ConstantForces,
+    /// Fluid media (drag and buoyancy).
+    pub fluids: Vec<FluidMedium>,
+    /// Mutual gravitation groups.
+    pub nbody: Vec<NBodyGravity>,
+    /// The floor's normal reaction and friction, if there is a floor.
+    pub floor: Option<FloorContact>,
+    pub(crate) user_body: Vec<Box<dyn Force>>,
+    pub(crate) user_contact: Vec<Box<dyn Force>>,
+}
+
+impl Forces {
+    /// The world's gravitational acceleration (zero without gravity).
+    pub fn g(&self) -> DVec3 {
+        self.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g)
+    }
+
+    pub(crate) fn add_user(&mut self, force: Box<dyn Force>) -> usize {
+        match force.stage() {
+            Stage::Body => self.user_body.push(force),
+            Stage::Contact => self.user_contact.push(force),
+        }
+        self.user_body.len() + self.user_contact.len() - 1
+    }
+
+    /// Overwrites `out` with the net force on every particle at the given
+    /// trial state.
+    #[inline]
+    pub fn evaluate(
+        &mut self,
+        t: f64,
+        dt: f64,
+        pos: &[DVec3],
+        vel: &[DVec3],
+        particles: &Properties,
+        out: &mut [DVec3],
+    ) {
+        out.fill(DVec3::ZERO);
+        let ctx = ForceContext {
+            t,
+            dt,
+            pos,
+            vel,
+            particles,
+            gravity: self.g(),
+        };
+        if let Some(g) = &mut self.gravity {
+            g.apply(&ctx, out);
+        }
+        if !self.springs.is_empty() {
+            self.springs.apply(&ctx, out);
+        }
+        if !self.angle_joints.is_empty() {
+            self.angle_joints.apply(&ctx, out);
+        }
+        if !self.torque_joints.is_empty() {
+            self.torque_joints.apply(&ctx, out);
+        }
+        if !self.constant_forces.is_empty() {
+            self.constant_forces.apply(&ctx, out);
+        }
+        for f in &mut self.fluids {
+            f.apply(&ctx, out);
+        }
+        for f in &mut self.nbody {
+            f.apply(&ctx, out);
+        }
+        for f in &mut self.user_body {
+            f.apply(&ctx, out);
+        }
+        if let Some(f) = &mut self.floor {
+            f.apply(&ctx, out);
+        }
+        for f in &mut self.user_contact {
+            f.apply(&ctx, out);
+        }
+    }
+
+    /// Calls `visit` with every force, built-in collections first.
+    pub fn for_each(&self, mut visit: impl FnMut(&dyn Force)) {
+        if let Some(g) = &self.gravity {
+            visit(g);
+        }
+        visit(&self.springs);
+        visit(&self.angle_joints);
+        visit(&self.torque_joints);
+        visit(&self.constant_forces);
+        self.fluids.iter().for_each(|f| visit(f));
+        self.nbody.iter().for_each(|f| visit(f));
+        self.user_body.iter().for_each(|f| visit(f.as_ref()));
+        if let Some(f) = &self.floor {
+            visit(f);
+        }
+        self.user_contact.iter().for_each(|f| visit(f.as_ref()));
+    }
+}

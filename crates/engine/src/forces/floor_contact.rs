@@ -1,0 +1,118 @@
+//! The floor's forces (thesis §3.1.2.7): normal reaction and friction for
+//! particles resting on the plane y = 0. Collisions with the floor are a
+//! discrete event, in `events/floor_collision.rs`.
+//!
+//! A particle is in contact when (the thesis's three conditions) it touches the
+//! plane (its lowest point is within `contact_tolerance` of it), it is not
+//! moving towards or away from it (normal speed at most `rest_speed`), and it
+//! is forced towards it (the net force of every other force points down).
+//! Then the floor pushes back with `N = -F_y`, and
+//! - below `static_speed` of sliding, static friction cancels the tangential
+//!   force and the residual slip, up to `mu_s |N|`;
+//! - otherwise kinetic friction `mu_k |N|` opposes the sliding, capped so that
+//!   it never reverses the sliding velocity within one step.
+//!
+//! This force reads the accumulated net force, so it runs in the
+//! [`Stage::Contact`] stage, after every ordinary force.
+
+use crate::error::ModelError;
+use crate::force::{Force, ForceContext, Stage, Targets};
+use crate::particle::non_negative;
+use glam::DVec3;
+
+/// Normal reaction and friction of the plane y = 0.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloorContact {
+    /// Sliding slower than this (m/s) is held by static friction.
+    pub static_speed: f64,
+    /// A particle moving towards or away from the plane faster than this (m/s)
+    /// is not resting on it.
+    pub rest_speed: f64,
+    /// How close (m) the lowest point must be to the plane to touch it.
+    pub contact_tolerance: f64,
+    /// The particles the floor supports.
+    pub targets: Targets,
+}
+
+impl Default for FloorContact {
+    fn default() -> Self {
+        FloorContact {
+            static_speed: 0.01,
+            rest_speed: 0.05,
+            contact_tolerance: 1e-6,
+            targets: Targets::All,
+        }
+    }
+}
+
+impl FloorContact {
+    /// Checks the thresholds.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        non_negative("static_speed", self.static_speed)?;
+        non_negative("rest_speed", self.rest_speed)?;
+        non_negative("contact_tolerance", self.contact_tolerance)?;
+        Ok(())
+    }
+
+    #[inline]
+    fn contact(&self, ctx: &ForceContext, i: usize, f: &mut DVec3) {
+        let p = &ctx.particles;
+        if p.inv_mass[i] == 0.0 || ctx.pos[i].y - p.radius[i] > self.contact_tolerance {
+            return;
+        }
+        let v = ctx.vel[i];
+        if v.y.abs() > self.rest_speed || f.y >= 0.0 {
+            return;
+        }
+        let normal = -f.y;
+        f.y = 0.0;
+        let m = p.mass[i];
+        let vt = DVec3::new(v.x, 0.0, v.z);
+        let ft = DVec3::new(f.x, 0.0, f.z);
+        let speed = vt.length();
+        if speed < self.static_speed {
+            // Static friction: hold the particle still (cancel the applied
+            // tangential force and the residual slip) if it can.
+            let hold = -ft - vt * (m / ctx.dt);
+            if hold.length() <= p.mu_s[i] * normal {
+                *f += hold;
+                return;
+            }
+        }
+        // Kinetic friction against the sliding (or, from rest, against the
+        // applied force that breaks static friction).
+        let dir = if speed > 0.0 {
+            vt / speed
+        } else {
+            ft.normalize_or_zero()
+        };
+        let stop = m * speed / ctx.dt + ft.dot(dir); // friction that would just stop it
+        let kinetic = (p.mu_k[i] * normal).min(stop.max(0.0));
+        *f -= dir * kinetic;
+    }
+}
+
+impl Force for FloorContact {
+    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
+        match &self.targets {
+            Targets::All => {
+                for (i, f) in forces.iter_mut().enumerate() {
+                    self.contact(ctx, i, f);
+                }
+            }
+            Targets::Only(ids) => {
+                for id in ids {
+                    self.contact(ctx, id.index(), &mut forces[id.index()]);
+                }
+            }
+        }
+    }
+
+    fn stage(&self) -> Stage {
+        Stage::Contact
+    }
+
+    fn name(&self) -> &str {
+        "floor contact"
+    }
+}

@@ -1,0 +1,81 @@
+//! Fluid medium (thesis §3.1.2.8): turbulent drag on the velocity relative to
+//! the fluid (Eq. 14), `F = -½ C ρ A |v_r| v_r`, and Archimedes' buoyancy
+//! (Eq. 15), `F = -V ρ g`. `A` is the sphere's cross-section `π r²`, `V` its
+//! volume and `g` the world's gravity.
+
+use crate::error::ModelError;
+use crate::force::{Force, ForceContext, Targets};
+use crate::forces::current::Current;
+use crate::particle::non_negative;
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// Water, air, or any fluid the particles move through.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FluidMedium {
+    /// kg/m³.
+    pub density: f64,
+    /// Drag coefficient `C` (0.47 for a sphere).
+    pub drag_coefficient: f64,
+    /// The fluid's velocity field.
+    pub current: Current,
+    /// The particles immersed in it.
+    pub targets: Targets,
+}
+
+impl FluidMedium {
+    /// Fresh water at rest (1000 kg/m³, sphere drag 0.47) around every particle.
+    pub fn water() -> Self {
+        FluidMedium {
+            density: 1000.0,
+            drag_coefficient: 0.47,
+            current: Current::Still,
+            targets: Targets::All,
+        }
+    }
+
+    /// Still air at sea level (1.2 kg/m³) around every particle.
+    pub fn air() -> Self {
+        FluidMedium {
+            density: 1.2,
+            ..FluidMedium::water()
+        }
+    }
+
+    /// Checks density and drag coefficient.
+    pub fn validate(&self) -> Result<(), ModelError> {
+        non_negative("density", self.density)?;
+        non_negative("drag_coefficient", self.drag_coefficient)?;
+        Ok(())
+    }
+
+    #[inline]
+    fn force_on(&self, ctx: &ForceContext, i: usize) -> DVec3 {
+        let r = ctx.particles.radius[i];
+        let vr = ctx.vel[i] - self.current.velocity(ctx.pos[i], ctx.t);
+        let drag = vr * (-0.5 * self.drag_coefficient * self.density * PI * r * r * vr.length());
+        let buoyancy = ctx.gravity * (-ctx.particles.volume[i] * self.density);
+        drag + buoyancy
+    }
+}
+
+impl Force for FluidMedium {
+    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
+        match &self.targets {
+            Targets::All => {
+                for (i, f) in forces.iter_mut().enumerate() {
+                    *f += self.force_on(ctx, i);
+                }
+            }
+            Targets::Only(ids) => {
+                for id in ids {
+                    forces[id.index()] += self.force_on(ctx, id.index());
+                }
+            }
+        }
+    }
+
+    fn name(&self) -> &str {
+        "fluid"
+    }
+}

@@ -1,0 +1,12 @@
+//! The built-in forces, one per file. To write your own, copy the shape of
+//! `constant_force.rs` (the simplest) and implement [`Force`](crate::Force).
+
+pub mod angle_joint;
+pub mod constant_force;
+pub mod current;
+pub mod floor_contact;
+pub mod fluid;
+pub mod gravity;
+pub mod nbody;
+pub mod spring;
+pub mod torque_joint;

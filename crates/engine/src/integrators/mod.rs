@@ -1,0 +1,137 @@
+//! Integrators (thesis §3.1.4): each advances the state by one step `h`,
+//! re-evaluating every force at each of its trial states (the thesis's
+//! trial-integration structure). One file per method; [`IntegratorKind`]
+//! chooses one at run time.
+//!
+//! All of them read the state at the start of the step (`from`) and write the
+//! end of the step into a separate buffer (`to`), so a step that an event
+//! rejects is thrown away without copying anything back.
+
+pub mod euler;
+pub mod midpoint;
+pub mod rk4;
+pub mod symplectic;
+
+use crate::force_set::Forces;
+use crate::particle::{Properties, State};
+use glam::DVec3;
+use std::fmt;
+use std::str::FromStr;
+
+/// The integration methods.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum IntegratorKind {
+    /// Explicit (forward) Euler, first order.
+    Euler,
+    /// Explicit midpoint, second order.
+    Midpoint,
+    /// Classic fourth-order Runge–Kutta (the thesis's default).
+    #[default]
+    Rk4,
+    /// Semi-implicit (symplectic) Euler: velocity first, then position with
+    /// the new velocity. First order, but its energy error stays bounded.
+    Symplectic,
+}
+
+impl IntegratorKind {
+    /// Every kind, in order of the names.
+    pub const ALL: [IntegratorKind; 4] = [
+        IntegratorKind::Euler,
+        IntegratorKind::Midpoint,
+        IntegratorKind::Rk4,
+        IntegratorKind::Symplectic,
+    ];
+
+    /// The name used in scene files and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Euler => "euler",
+            IntegratorKind::Midpoint => "midpoint",
+            IntegratorKind::Rk4 => "rk4",
+            IntegratorKind::Symplectic => "symplectic",
+        }
+    }
+
+    /// Order of accuracy (global error ~ h^order).
+    pub fn order(self) -> u32 {
+        match self {
+            IntegratorKind::Euler | IntegratorKind::Symplectic => 1,
+            IntegratorKind::Midpoint => 2,
+            IntegratorKind::Rk4 => 4,
+        }
+    }
+
+    /// Force evaluations per step.
+    pub fn evaluations(self) -> u32 {
+        match self {
+            IntegratorKind::Euler | IntegratorKind::Symplectic => 1,
+            IntegratorKind::Midpoint => 2,
+            IntegratorKind::Rk4 => 4,
+        }
+    }
+}
+
+impl fmt::Display for IntegratorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for IntegratorKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        IntegratorKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| {
+                format!("unknown integrator `{s}` (expected euler, midpoint, rk4 or symplectic)")
+            })
+    }
+}
+
+/// What an integrator needs besides the state: the forces, the particles, and
+/// scratch buffers it may use freely.
+pub struct Dynamics<'a> {
+    /// The forces to evaluate.
+    pub forces: &'a mut Forces,
+    /// Particle properties (mass, inverse mass...).
+    pub particles: &'a Properties,
+    /// Scratch buffers, each as long as the state.
+    pub scratch: &'a mut Scratch,
+}
+
+/// Scratch buffers shared by the integrators.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// Net forces of the current trial state.
+    pub force: Vec<DVec3>,
+    /// Accumulated position increments (RK4).
+    pub dx: Vec<DVec3>,
+    /// Accumulated velocity increments (RK4).
+    pub dv: Vec<DVec3>,
+}
+
+impl Scratch {
+    pub(crate) fn resize(&mut self, n: usize) {
+        for v in [&mut self.force, &mut self.dx, &mut self.dv] {
+            v.resize(n, DVec3::ZERO);
+        }
+    }
+}
+
+/// Advances `from` by `h` into `to` with the method `kind`, starting at time `t`.
+pub fn integrate(
+    kind: IntegratorKind,
+    d: &mut Dynamics,
+    t: f64,
+    h: f64,
+    from: &State,
+    to: &mut State,
+) {
+    match kind {
+        IntegratorKind::Euler => euler::step(d, t, h, from, to),
+        IntegratorKind::Midpoint => midpoint::step(d, t, h, from, to),
+        IntegratorKind::Rk4 => rk4::step(d, t, h, from, to),
+        IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
+    }
+}

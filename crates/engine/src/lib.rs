@@ -1,0 +1,51 @@
+//! # animats-engine
+//!
+//! The particle dynamics engine of animats, after Kobus (2001), *Animats from
+//! the physics up*, §2.3 and §3.1: point masses (spheres), the forces that act
+//! on them, discrete events such as collisions with the floor, and
+//! integrators that advance them in time.
+//!
+//! - A [`World`] stores its particles as arrays (structure of arrays)
+//!   addressed by copyable [`ParticleId`] handles.
+//! - Forces implement [`Force`]; the built-in ones live in [`forces`], one
+//!   file each, and in typed collections so their loops are tight. Add your
+//!   own with [`World::add_force`] (see `examples/nbody.rs`).
+//! - Discrete events implement [`DiscreteEvent`]; a missed event makes the
+//!   world retake the step in shorter pieces ([`World::step`]).
+//! - Integrators ([`IntegratorKind`]): explicit Euler, midpoint, RK4 and
+//!   symplectic Euler, chosen at run time.
+//!
+//! No I/O, no threads, no global state: a world is a plain value, so many can
+//! run side by side (one per evolving individual).
+
+pub mod error;
+pub mod event;
+pub mod events;
+pub mod force;
+pub mod force_set;
+pub mod forces;
+pub mod integrators;
+pub mod particle;
+pub mod world;
+
+pub use error::{ModelError, SimError};
+pub use event::{DiscreteEvent, EventContext, EventState};
+pub use events::floor_collision::{Collision, FloorCollision};
+pub use force::{Force, ForceContext, Stage, Targets};
+pub use force_set::Forces;
+pub use forces::{
+    angle_joint::{AngleJoint, AngleJointDef, AngleJointId},
+    constant_force::{ConstantForce, ConstantForceId},
+    current::{Current, ReefWater},
+    floor_contact::FloorContact,
+    fluid::FluidMedium,
+    gravity::Gravity,
+    nbody::NBodyGravity,
+    spring::{Spring, SpringDef, SpringId},
+    torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},
+};
+pub use integrators::IntegratorKind;
+pub use particle::{ParticleDef, ParticleId, Properties, State};
+pub use world::{Energy, FloorDef, Stats, StepReport, World};
+
+pub use glam::DVec3;

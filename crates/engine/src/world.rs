@@ -1,0 +1,575 @@
+//! The world: particles, the forces and events acting on them, a clock, and
+//! the step that advances them (thesis §3.1.4, `advance()`).
+
+use crate::error::{ModelError, SimError};
+use crate::event::{DiscreteEvent, EventContext, EventState};
+use crate::events::floor_collision::FloorCollision;
+use crate::force::{Force, ForceContext, Targets};
+use crate::force_set::Forces;
+use crate::forces::{
+    angle_joint::{AngleJointDef, AngleJointId},
+    constant_force::ConstantForceId,
+    floor_contact::FloorContact,
+    fluid::FluidMedium,
+    gravity::Gravity,
+    nbody::NBodyGravity,
+    spring::{SpringDef, SpringId},
+    torque_joint::{TorqueJointDef, TorqueJointId},
+};
+use crate::integrators::{integrate, Dynamics, IntegratorKind, Scratch};
+use crate::particle::{ParticleDef, ParticleId, Properties, State};
+use glam::DVec3;
+
+/// How many times a step may be halved when an event is missed: pieces are
+/// never shorter than `dt / 2^10`.
+pub const MAX_BACKTRACK_DEPTH: u32 = 10;
+
+/// What happened during one call of [`World::step`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StepReport {
+    /// Trial steps thrown away because an event was missed.
+    pub backtracks: u32,
+    /// Pieces the step was finally taken in (1 without backtracking).
+    pub pieces: u32,
+    /// Pieces accepted with an event still missed because the piece could not
+    /// be split further (the event was then handled as if occurring).
+    pub unresolved: u32,
+}
+
+/// Totals since the world was created.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Completed steps.
+    pub steps: u64,
+    /// Trial steps thrown away (see [`StepReport::backtracks`]).
+    pub backtracks: u64,
+    /// Missed events handled at the finest piece.
+    pub unresolved: u64,
+}
+
+/// Kinetic and potential energy of a world, J.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    /// Σ ½ m v² over the moving particles.
+    pub kinetic: f64,
+    /// Sum of every conservative force's potential energy.
+    pub potential: f64,
+}
+
+impl Energy {
+    /// Kinetic plus potential.
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.potential
+    }
+}
+
+/// Description of a floor (the plane y = 0): its collision event and its
+/// contact force, sharing their targets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloorDef {
+    /// Penetration beyond which a collision counts as missed, m.
+    pub envelope: f64,
+    /// Sliding slower than this is held by static friction, m/s.
+    pub static_speed: f64,
+    /// Impacts slower than this do not bounce, and normal speeds below it count
+    /// as resting, m/s.
+    pub rest_speed: f64,
+    /// How close to the plane a sphere must be to rest on it, m.
+    pub contact_tolerance: f64,
+    /// Whether the floor pushes back and rubs (normal reaction and friction).
+    /// Without it the floor only collides.
+    pub contact: bool,
+    /// The particles the floor acts on.
+    pub targets: Targets,
+}
+
+impl Default for FloorDef {
+    fn default() -> Self {
+        FloorDef {
+            envelope: 0.01,
+            static_speed: 0.01,
+            rest_speed: 0.05,
+            contact_tolerance: 1e-6,
+            contact: true,
+            targets: Targets::All,
+        }
+    }
+}
+
+/// A world of particles and the forces and events that act on them.
+///
+/// ```
+/// use animats_engine::{World, ParticleDef, SpringDef, IntegratorKind};
+/// use glam::DVec3;
+///
+/// let mut world = World::new();
+/// world.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+/// let anchor = world.add_particle(ParticleDef::new(1.0).at(DVec3::Y).fixed())?;
+/// let bob = world.add_particle(ParticleDef::new(0.5).at(DVec3::new(0.3, 1.0, 0.0)))?;
+/// world.add_spring(SpringDef::new(anchor, bob, 50.0, 0.1))?;
+/// world.set_integrator(IntegratorKind::Rk4);
+/// for _ in 0..1000 {
+///     world.step(0.001)?;
+/// }
+/// assert!(world.position(bob).y < 1.0); // it swung down
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub struct World {
+    state: State,
+    next: State,
+    particles: Properties,
+    forces: Forces,
+    events: Vec<Box<dyn DiscreteEvent>>,
+    event_states: Vec<EventState>,
+    integrator: IntegratorKind,
+    scratch: Scratch,
+    time: f64,
+    time_carry: f64,
+    stats: Stats,
+    last: StepReport,
+}
+
+impl Default for World {
+    fn default() -> Self {
+        World::new()
+    }
+}
+
+impl World {
+    /// An empty world: no gravity, no floor, RK4.
+    pub fn new() -> Self {
+        World {
+            state: State::default(),
+            next: State::default(),
+            particles: Properties::default(),
+            forces: Forces::default(),
+            events: Vec::new(),
+            event_states: Vec::new(),
+            integrator: IntegratorKind::default(),
+            scratch: Scratch::default(),
+            time: 0.0,
+            time_carry: 0.0,
+            stats: Stats::default(),
+            last: StepReport::default(),
+        }
+    }
+
+    // ----- particles -------------------------------------------------------
+
+    /// Adds a particle; fixed particles have their velocity set to zero.
+    pub fn add_particle(&mut self, def: ParticleDef) -> Result<ParticleId, ModelError> {
+        def.validate()?;
+        if self.len() >= u32::MAX as usize {
+            return Err(ModelError::new("particle", "too many particles"));
+        }
+        self.particles.push(&def);
+        self.state.pos.push(def.position);
+        self.state
+            .vel
+            .push(if def.fixed { DVec3::ZERO } else { def.velocity });
+        Ok(ParticleId(self.len() as u32 - 1))
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.state.len()
+    }
+
+    /// True when the world has no particles.
+    pub fn is_empty(&self) -> bool {
+        self.state.is_empty()
+    }
+
+    /// Handles of every particle, in order.
+    pub fn particle_ids(&self) -> impl Iterator<Item = ParticleId> {
+        (0..self.len() as u32).map(ParticleId)
+    }
+
+    /// Position of `p`, m.
+    pub fn position(&self, p: ParticleId) -> DVec3 {
+        self.state.pos[p.index()]
+    }
+
+    /// Velocity of `p`, m/s.
+    pub fn velocity(&self, p: ParticleId) -> DVec3 {
+        self.state.vel[p.index()]
+    }
+
+    /// Moves `p` (a fixed particle too: nails can be moved by hand).
+    pub fn set_position(&mut self, p: ParticleId, x: DVec3) {
+        self.state.pos[p.index()] = x;
+    }
+
+    /// Sets the velocity of `p` (ignored for a fixed particle, which never moves).
+    pub fn set_velocity(&mut self, p: ParticleId, v: DVec3) {
+        if !self.particles.fixed[p.index()] {
+            self.state.vel[p.index()] = v;
+        }
+    }
+
+    /// Changes the volume of `p`; its radius follows (a sphere).
+    pub fn set_volume(&mut self, p: ParticleId, volume: f64) {
+        self.particles.volume[p.index()] = volume;
+        self.particles.radius[p.index()] = crate::particle::sphere_radius(volume);
+    }
+
+    /// The current positions and velocities of every particle.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// Every particle's properties.
+    pub fn particles(&self) -> &Properties {
+        &self.particles
+    }
+
+    fn check_ids(&self, field: &'static str, ids: &[ParticleId]) -> Result<(), ModelError> {
+        match ids.iter().find(|id| id.index() >= self.len()) {
+            Some(id) => Err(ModelError::new(
+                field,
+                format!("particle #{} does not exist in this world", id.index()),
+            )),
+            None => Ok(()),
+        }
+    }
+
+    fn check_targets(&self, targets: &Targets) -> Result<(), ModelError> {
+        match targets.max_index() {
+            Some(i) if i >= self.len() => Err(ModelError::new(
+                "particles",
+                format!("particle #{i} does not exist in this world"),
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    // ----- forces ----------------------------------------------------------
+
+    /// Gravity `g` on every particle (replacing any earlier gravity).
+    pub fn set_gravity(&mut self, g: DVec3) {
+        self.forces.gravity = Some(Gravity::new(g));
+    }
+
+    /// Sets (or with `None` removes) the world's gravity force.
+    pub fn set_gravity_force(&mut self, gravity: Option<Gravity>) -> Result<(), ModelError> {
+        if let Some(g) = &gravity {
+            crate::particle::finite_vec("gravity", g.g)?;
+            self.check_targets(&g.targets)?;
+        }
+        self.forces.gravity = gravity;
+        Ok(())
+    }
+
+    /// Adds a damped spring.
+    pub fn add_spring(&mut self, def: SpringDef) -> Result<SpringId, ModelError> {
+        self.check_ids("a", &[def.a])?;
+        self.check_ids("b", &[def.b])?;
+        self.forces.springs.add(&def, &self.state.pos)
+    }
+
+    /// Adds an angle joint.
+    pub fn add_angle_joint(&mut self, def: AngleJointDef) -> Result<AngleJointId, ModelError> {
+        self.check_ids("a", &[def.a])?;
+        self.check_ids("joint", &[def.joint])?;
+        self.check_ids("b", &[def.b])?;
+        self.forces.angle_joints.add(&def, &self.state.pos)
+    }
+
+    /// Adds a torque joint.
+    pub fn add_torque_joint(&mut self, def: TorqueJointDef) -> Result<TorqueJointId, ModelError> {
+        self.check_ids("end", &[def.end])?;
+        self.check_ids("joint", &[def.joint])?;
+        self.forces.torque_joints.add(&def)
+    }
+
+    /// Adds a constant force `force` (N) on each of `particles`.
+    pub fn add_constant_force(
+        &mut self,
+        particles: Vec<ParticleId>,
+        force: DVec3,
+    ) -> Result<ConstantForceId, ModelError> {
+        self.check_ids("particles", &particles)?;
+        self.forces.constant_forces.add(particles, force)
+    }
+
+    /// Adds a fluid medium (drag and buoyancy).
+    pub fn add_fluid(&mut self, fluid: FluidMedium) -> Result<usize, ModelError> {
+        fluid.validate()?;
+        self.check_targets(&fluid.targets)?;
+        self.forces.fluids.push(fluid);
+        Ok(self.forces.fluids.len() - 1)
+    }
+
+    /// Adds mutual gravitation among a group of bodies.
+    pub fn add_nbody(&mut self, nbody: NBodyGravity) -> Result<usize, ModelError> {
+        nbody.validate()?;
+        self.check_targets(nbody.targets())?;
+        self.forces.nbody.push(nbody);
+        Ok(self.forces.nbody.len() - 1)
+    }
+
+    /// Adds the floor, the plane y = 0: its collision event and, unless
+    /// `def.contact` is false, its normal reaction and friction. A world has
+    /// at most one floor; adding another replaces the contact force and adds a
+    /// second collision event.
+    pub fn add_floor(&mut self, def: FloorDef) -> Result<(), ModelError> {
+        self.check_targets(&def.targets)?;
+        let collision = FloorCollision::new(def.envelope, def.rest_speed, def.targets.clone());
+        collision.validate()?;
+        if def.contact {
+            let contact = FloorContact {
+                static_speed: def.static_speed,
+                rest_speed: def.rest_speed,
+                contact_tolerance: def.contact_tolerance,
+                targets: def.targets,
+            };
+            contact.validate()?;
+            self.forces.floor = Some(contact);
+        }
+        self.add_event(Box::new(collision));
+        Ok(())
+    }
+
+    /// Adds a user-defined force; it is evaluated at every trial state, in
+    /// its [`Stage`](crate::Stage), after the built-in forces of that stage.
+    pub fn add_force(&mut self, force: Box<dyn Force>) -> usize {
+        self.forces.add_user(force)
+    }
+
+    /// Adds a discrete event, checked after every trial step.
+    pub fn add_event(&mut self, event: Box<dyn DiscreteEvent>) -> usize {
+        self.events.push(event);
+        self.event_states.push(EventState::None);
+        self.events.len() - 1
+    }
+
+    /// The forces, to read or change their parameters (actuators do this).
+    pub fn forces(&self) -> &Forces {
+        &self.forces
+    }
+
+    /// The forces, mutably.
+    pub fn forces_mut(&mut self) -> &mut Forces {
+        &mut self.forces
+    }
+
+    /// The events, in the order they were added.
+    pub fn events(&self) -> &[Box<dyn DiscreteEvent>] {
+        &self.events
+    }
+
+    /// The first event of type `E`, if any (e.g. the floor's collisions).
+    pub fn event<E: DiscreteEvent + 'static>(&self) -> Option<&E> {
+        self.events
+            .iter()
+            .find_map(|e| e.as_any().downcast_ref::<E>())
+    }
+
+    // ----- stepping --------------------------------------------------------
+
+    /// The integration method used by [`step`](World::step).
+    pub fn integrator(&self) -> IntegratorKind {
+        self.integrator
+    }
+
+    /// Chooses the integration method.
+    pub fn set_integrator(&mut self, kind: IntegratorKind) {
+        self.integrator = kind;
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Totals since the world was created.
+    pub fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    /// What happened during the last step.
+    pub fn last_step(&self) -> StepReport {
+        self.last
+    }
+
+    /// Advances the world by `dt` seconds.
+    ///
+    /// The integrator takes a trial step; every event then inspects it. If one
+    /// was missed, the trial is thrown away and the step is retaken in halves
+    /// (recursively, down to `dt / 2^MAX_BACKTRACK_DEPTH`); occurring events
+    /// are handled. If any particle ends non-finite the world stays at its
+    /// last good state and an error names the particle.
+    pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(SimError::BadStep(dt));
+        }
+        let n = self.len();
+        self.next.resize(n);
+        self.scratch.resize(n);
+        for e in &mut self.events {
+            e.begin_step();
+        }
+        let total = 1u32 << MAX_BACKTRACK_DEPTH;
+        let (mut done, mut piece) = (0u32, total);
+        let mut report = StepReport::default();
+        let t0 = self.time;
+        while done < total {
+            let t = t0 + dt * (done as f64 / total as f64);
+            let h = dt * (piece as f64 / total as f64);
+            let mut dynamics = Dynamics {
+                forces: &mut self.forces,
+                particles: &self.particles,
+                scratch: &mut self.scratch,
+            };
+            integrate(
+                self.integrator,
+                &mut dynamics,
+                t,
+                h,
+                &self.state,
+                &mut self.next,
+            );
+
+            let mut worst = EventState::None;
+            if !self.events.is_empty() {
+                let ctx = EventContext {
+                    t: t + h,
+                    pos: &self.next.pos,
+                    vel: &self.next.vel,
+                    particles: &self.particles,
+                };
+                for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
+                    *s = e.check(&ctx);
+                    worst = worst.max(*s);
+                }
+            }
+            if worst == EventState::Missed {
+                if piece > 1 {
+                    piece /= 2;
+                    report.backtracks += 1;
+                    continue;
+                }
+                report.unresolved += 1;
+            }
+            if worst != EventState::None {
+                for (e, s) in self.events.iter_mut().zip(&self.event_states) {
+                    if *s != EventState::None {
+                        e.handle(
+                            t + h,
+                            &mut self.next.pos,
+                            &mut self.next.vel,
+                            &self.particles,
+                        );
+                    }
+                }
+            }
+            if let Some(i) = first_non_finite(&self.next) {
+                self.last = report;
+                return Err(SimError::NonFinite {
+                    particle: ParticleId(i as u32),
+                    time: t + h,
+                });
+            }
+            std::mem::swap(&mut self.state, &mut self.next);
+            done += piece;
+            report.pieces += 1;
+            // After a backtrack, grow the pieces back once they line up again.
+            if piece < total && done % (2 * piece) == 0 {
+                piece *= 2;
+            }
+        }
+        self.advance_clock(dt);
+        self.stats.steps += 1;
+        self.stats.backtracks += report.backtracks as u64;
+        self.stats.unresolved += report.unresolved as u64;
+        self.last = report;
+        Ok(report)
+    }
+
+    /// Kahan-compensated `time += dt`, so a million steps of 1 ms end at 1000 s.
+    fn advance_clock(&mut self, dt: f64) {
+        let y = dt - self.time_carry;
+        let t = self.time + y;
+        self.time_carry = (t - self.time) - y;
+        self.time = t;
+    }
+
+    /// Sets the simulated time (and forgets the clock's rounding carry).
+    pub fn set_time(&mut self, t: f64) {
+        self.time = t;
+        self.time_carry = 0.0;
+    }
+
+    // ----- diagnostics -----------------------------------------------------
+
+    /// Kinetic and potential energy of the current state.
+    pub fn energy(&self) -> Energy {
+        let p = &self.particles;
+        let kinetic = (0..self.len())
+            .filter(|&i| !p.fixed[i])
+            .map(|i| 0.5 * p.mass[i] * self.state.vel[i].length_squared())
+            .sum();
+        let ctx = ForceContext {
+            t: self.time,
+            dt: 0.0,
+            pos: &self.state.pos,
+            vel: &self.state.vel,
+            particles: p,
+            gravity: self.forces.g(),
+        };
+        let mut potential = 0.0;
+        self.forces
+            .for_each(|f| potential += f.potential_energy(&ctx));
+        Energy { kinetic, potential }
+    }
+
+    /// True when every force is conservative and there are no events, so the
+    /// total energy should stay constant (up to integration error).
+    pub fn is_conservative(&self) -> bool {
+        let mut conservative = self.events.iter().all(|e| e.conserves_energy());
+        self.forces
+            .for_each(|f| conservative &= f.is_conservative());
+        conservative
+    }
+
+    /// Total linear momentum of the moving particles, kg m/s.
+    pub fn momentum(&self) -> DVec3 {
+        let p = &self.particles;
+        (0..self.len())
+            .filter(|&i| !p.fixed[i])
+            .map(|i| p.mass[i] * self.state.vel[i])
+            .sum()
+    }
+
+    /// Centre of mass of every particle, m.
+    pub fn centre_of_mass(&self) -> DVec3 {
+        let p = &self.particles;
+        let m: f64 = p.mass.iter().sum();
+        let s: DVec3 = (0..self.len()).map(|i| p.mass[i] * self.state.pos[i]).sum();
+        s / m
+    }
+}
+
+/// The index of the first particle with a non-finite position or velocity.
+fn first_non_finite(s: &State) -> Option<usize> {
+    // `x - x` is 0 for a finite x and NaN otherwise; summing in independent
+    // lanes keeps this pass branch-free and cheap next to the force loops.
+    let mut lanes = [DVec3::ZERO; 4];
+    let (pc, vc) = (s.pos.chunks_exact(4), s.vel.chunks_exact(4));
+    let (pr, vr) = (pc.remainder(), vc.remainder());
+    for (p, v) in pc.zip(vc) {
+        for k in 0..4 {
+            lanes[k] += (p[k] - p[k]) + (v[k] - v[k]);
+        }
+    }
+    for (p, v) in pr.iter().zip(vr) {
+        lanes[0] += (*p - *p) + (*v - *v);
+    }
+    if lanes.iter().all(|l| *l == DVec3::ZERO) {
+        return None;
+    }
+    s.pos
+        .iter()
+        .zip(&s.vel)
+        .position(|(p, v)| !(p.is_finite() && v.is_finite()))
+}
