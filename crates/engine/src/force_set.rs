@@ -1,7 +1,7 @@
 //! Every force of a world, in typed collections so each hot loop is tight,
 //! evaluated in a fixed order at each trial state.
 
-use crate::force::{Force, ForceContext, Stage};
+use crate::force::{Force, ForceContext, Stage, Targets};
 use crate::forces::{
     angle_joint::AngleJoints, constant_force::ConstantForces, floor_contact::FloorContact,
     fluid::FluidMedium, gravity::Gravity, nbody::NBodyGravity, spring::Springs,
@@ -64,7 +64,6 @@ impl Forces {
         particles: &Properties,
         out: &mut [DVec3],
     ) {
-        out.fill(DVec3::ZERO);
         let ctx = ForceContext {
             t,
             dt,
@@ -73,8 +72,19 @@ impl Forces {
             particles,
             gravity: self.g(),
         };
-        if let Some(g) = &mut self.gravity {
-            g.apply(&ctx, out);
+        // Gravity on every particle starts the accumulator (m g) instead of
+        // adding to zeros: one pass over the particles instead of two.
+        match &mut self.gravity {
+            Some(g) if g.targets == Targets::All => {
+                for (f, &m) in out.iter_mut().zip(&particles.mass) {
+                    *f = m * g.g;
+                }
+            }
+            Some(g) => {
+                out.fill(DVec3::ZERO);
+                g.apply(&ctx, out);
+            }
+            None => out.fill(DVec3::ZERO),
         }
         if !self.springs.is_empty() {
             self.springs.apply(&ctx, out);

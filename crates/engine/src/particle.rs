@@ -217,9 +217,12 @@ impl State {
     pub fn is_empty(&self) -> bool {
         self.pos.is_empty()
     }
+    #[inline]
     pub(crate) fn resize(&mut self, n: usize) {
-        self.pos.resize(n, DVec3::ZERO);
-        self.vel.resize(n, DVec3::ZERO);
+        if self.pos.len() != n || self.vel.len() != n {
+            self.pos.resize(n, DVec3::ZERO);
+            self.vel.resize(n, DVec3::ZERO);
+        }
     }
 }
 

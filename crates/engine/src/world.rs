@@ -409,80 +409,116 @@ impl World {
         for e in &mut self.events {
             e.begin_step();
         }
-        let total = 1u32 << MAX_BACKTRACK_DEPTH;
-        let (mut done, mut piece) = (0u32, total);
-        let mut report = StepReport::default();
         let t0 = self.time;
+        // The whole step first; pieces only after a missed event.
+        let events = self.trial(t0, dt);
+        let report = if events == EventState::Missed {
+            self.backtrack(t0, dt)?
+        } else {
+            self.accept(events, t0 + dt)?;
+            StepReport {
+                backtracks: 0,
+                pieces: 1,
+                unresolved: 0,
+            }
+        };
+        self.advance_clock(dt);
+        self.stats.steps += 1;
+        self.stats.backtracks += report.backtracks as u64;
+        self.stats.unresolved += report.unresolved as u64;
+        self.last = report;
+        Ok(report)
+    }
+
+    /// Integrates from the current state over `[t, t + h]` into the trial
+    /// buffer and asks every event about the result; returns the worst state.
+    #[inline]
+    fn trial(&mut self, t: f64, h: f64) -> EventState {
+        let mut dynamics = Dynamics {
+            forces: &mut self.forces,
+            particles: &self.particles,
+            scratch: &mut self.scratch,
+        };
+        integrate(
+            self.integrator,
+            &mut dynamics,
+            t,
+            h,
+            &self.state,
+            &mut self.next,
+        );
+        let mut worst = EventState::None;
+        if !self.events.is_empty() {
+            let ctx = EventContext {
+                t: t + h,
+                pos: &self.next.pos,
+                vel: &self.next.vel,
+                particles: &self.particles,
+            };
+            for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
+                *s = e.check(&ctx);
+                worst = worst.max(*s);
+            }
+        }
+        worst
+    }
+
+    /// Handles the events of the trial ending at `t`, checks it is finite and
+    /// makes it the current state.
+    #[inline]
+    fn accept(&mut self, worst: EventState, t: f64) -> Result<(), SimError> {
+        if worst != EventState::None {
+            for (e, s) in self.events.iter_mut().zip(&self.event_states) {
+                if *s != EventState::None {
+                    e.handle(t, &mut self.next.pos, &mut self.next.vel, &self.particles);
+                }
+            }
+        }
+        if let Some(i) = first_non_finite(&self.next) {
+            // The world stays at its last finite state.
+            return Err(SimError::NonFinite {
+                particle: ParticleId(i as u32),
+                time: t,
+            });
+        }
+        std::mem::swap(&mut self.state, &mut self.next);
+        Ok(())
+    }
+
+    /// Takes the step `[t0, t0 + dt]` in pieces: halve a piece whenever an
+    /// event is missed in it, and grow the pieces back once they line up.
+    #[cold]
+    fn backtrack(&mut self, t0: f64, dt: f64) -> Result<StepReport, SimError> {
+        let total = 1u32 << MAX_BACKTRACK_DEPTH;
+        let (mut done, mut piece) = (0u32, total / 2);
+        let mut report = StepReport {
+            backtracks: 1,
+            ..StepReport::default()
+        };
         while done < total {
             let t = t0 + dt * (done as f64 / total as f64);
             let h = dt * (piece as f64 / total as f64);
-            let mut dynamics = Dynamics {
-                forces: &mut self.forces,
-                particles: &self.particles,
-                scratch: &mut self.scratch,
-            };
-            integrate(
-                self.integrator,
-                &mut dynamics,
-                t,
-                h,
-                &self.state,
-                &mut self.next,
-            );
-
-            let mut worst = EventState::None;
-            if !self.events.is_empty() {
-                let ctx = EventContext {
-                    t: t + h,
-                    pos: &self.next.pos,
-                    vel: &self.next.vel,
-                    particles: &self.particles,
-                };
-                for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
-                    *s = e.check(&ctx);
-                    worst = worst.max(*s);
-                }
-            }
+            let mut worst = self.trial(t, h);
             if worst == EventState::Missed {
                 if piece > 1 {
                     piece /= 2;
                     report.backtracks += 1;
                     continue;
                 }
+                // Cannot split further: handle it as if occurring.
                 report.unresolved += 1;
+                worst = EventState::Occurring;
             }
-            if worst != EventState::None {
-                for (e, s) in self.events.iter_mut().zip(&self.event_states) {
-                    if *s != EventState::None {
-                        e.handle(
-                            t + h,
-                            &mut self.next.pos,
-                            &mut self.next.vel,
-                            &self.particles,
-                        );
-                    }
-                }
-            }
-            if let Some(i) = first_non_finite(&self.next) {
+            if let Err(e) = self.accept(worst, t + h) {
                 self.last = report;
-                return Err(SimError::NonFinite {
-                    particle: ParticleId(i as u32),
-                    time: t + h,
-                });
+                return Err(e);
             }
-            std::mem::swap(&mut self.state, &mut self.next);
             done += piece;
             report.pieces += 1;
-            // After a backtrack, grow the pieces back once they line up again.
             if piece < total && done % (2 * piece) == 0 {
                 piece *= 2;
             }
         }
-        self.advance_clock(dt);
-        self.stats.steps += 1;
-        self.stats.backtracks += report.backtracks as u64;
-        self.stats.unresolved += report.unresolved as u64;
-        self.last = report;
         Ok(report)
     }
 
@@ -552,24 +588,30 @@ impl World {
 
 /// The index of the first particle with a non-finite position or velocity.
 fn first_non_finite(s: &State) -> Option<usize> {
-    // `x - x` is 0 for a finite x and NaN otherwise; summing in independent
-    // lanes keeps this pass branch-free and cheap next to the force loops.
-    let mut lanes = [DVec3::ZERO; 4];
-    let (pc, vc) = (s.pos.chunks_exact(4), s.vel.chunks_exact(4));
+    // A sum of finite numbers is finite (unless it overflows, which the
+    // confirming scan below tells apart) and any inf or NaN makes it
+    // non-finite. Four independent lanes keep the pass short next to the
+    // force loops.
+    let n = s.pos.len().min(s.vel.len());
+    let (pos, vel) = (&s.pos[..n], &s.vel[..n]);
+    let sum = |p: &DVec3, v: &DVec3| ((p.x + p.y) + (p.z + v.x)) + (v.y + v.z);
+    let (mut a, mut b, mut c, mut d) = (0.0, 0.0, 0.0, 0.0);
+    let (pc, vc) = (pos.chunks_exact(4), vel.chunks_exact(4));
     let (pr, vr) = (pc.remainder(), vc.remainder());
     for (p, v) in pc.zip(vc) {
-        for k in 0..4 {
-            lanes[k] += (p[k] - p[k]) + (v[k] - v[k]);
-        }
+        a += sum(&p[0], &v[0]);
+        b += sum(&p[1], &v[1]);
+        c += sum(&p[2], &v[2]);
+        d += sum(&p[3], &v[3]);
     }
     for (p, v) in pr.iter().zip(vr) {
-        lanes[0] += (*p - *p) + (*v - *v);
+        a += sum(p, v);
     }
-    if lanes.iter().all(|l| *l == DVec3::ZERO) {
+    let lanes = [a, b, c, d];
+    if lanes.iter().all(|l| l.is_finite()) {
         return None;
     }
-    s.pos
-        .iter()
-        .zip(&s.vel)
+    pos.iter()
+        .zip(vel)
         .position(|(p, v)| !(p.is_finite() && v.is_finite()))
 }

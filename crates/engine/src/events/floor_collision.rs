@@ -79,24 +79,41 @@ impl FloorCollision {
 impl DiscreteEvent for FloorCollision {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.hits.clear();
-        let mut state = EventState::None;
         let (pos, p) = (ctx.pos, ctx.particles);
-        let mut check = |i: usize| {
-            let gap = pos[i].y - p.radius[i];
-            if gap < 0.0 && p.inv_mass[i] != 0.0 {
+        // The deepest penetration among the spheres below the plane.
+        let mut deepest = 0.0f64;
+        let mut hit = |i: usize, gap: f64| {
+            if p.inv_mass[i] != 0.0 {
                 self.hits.push(i as u32);
-                state = state.max(if gap < -self.envelope {
-                    EventState::Missed
-                } else {
-                    EventState::Occurring
-                });
+                deepest = deepest.min(gap);
             }
         };
         match &self.targets {
-            Targets::All => (0..pos.len()).for_each(&mut check),
-            Targets::Only(ids) => ids.iter().for_each(|id| check(id.index())),
+            Targets::All => {
+                for (i, (x, r)) in pos.iter().zip(&p.radius).enumerate() {
+                    let gap = x.y - r;
+                    if gap < 0.0 {
+                        hit(i, gap);
+                    }
+                }
+            }
+            Targets::Only(ids) => {
+                for id in ids {
+                    let i = id.index();
+                    let gap = pos[i].y - p.radius[i];
+                    if gap < 0.0 {
+                        hit(i, gap);
+                    }
+                }
+            }
         }
-        state
+        if self.hits.is_empty() {
+            EventState::None
+        } else if deepest < -self.envelope {
+            EventState::Missed
+        } else {
+            EventState::Occurring
+        }
     }
 
     fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {

@@ -10,8 +10,10 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
     let w = &d.particles.inv_mass;
-    for i in 0..from.pos.len() {
-        to.pos[i] = from.pos[i] + h * from.vel[i];
-        to.vel[i] = from.vel[i] + (h * w[i]) * f[i];
+    let new = to.pos.iter_mut().zip(to.vel.iter_mut());
+    let old = from.pos.iter().zip(&from.vel).zip(w.iter().zip(f.iter()));
+    for ((x1, v1), ((x0, v0), (w, f))) in new.zip(old) {
+        *x1 = *x0 + h * *v0;
+        *v1 = *v0 + (h * w) * *f;
     }
 }

@@ -112,9 +112,12 @@ pub struct Scratch {
 }
 
 impl Scratch {
+    #[inline]
     pub(crate) fn resize(&mut self, n: usize) {
-        for v in [&mut self.force, &mut self.dx, &mut self.dv] {
-            v.resize(n, DVec3::ZERO);
+        if self.force.len() != n {
+            for v in [&mut self.force, &mut self.dx, &mut self.dv] {
+                v.resize(n, DVec3::ZERO);
+            }
         }
     }
 }

@@ -11,9 +11,11 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
     let w = &d.particles.inv_mass;
-    for i in 0..from.pos.len() {
-        let v = from.vel[i] + (h * w[i]) * f[i];
-        to.vel[i] = v;
-        to.pos[i] = from.pos[i] + h * v;
+    let new = to.pos.iter_mut().zip(to.vel.iter_mut());
+    let old = from.pos.iter().zip(&from.vel).zip(w.iter().zip(f.iter()));
+    for ((x1, v1), ((x0, v0), (w, f))) in new.zip(old) {
+        let v = *v0 + (h * w) * *f;
+        *v1 = v;
+        *x1 = *x0 + h * v;
     }
 }

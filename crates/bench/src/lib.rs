@@ -1,0 +1,424 @@
+//! # animats-bench
+//!
+//! The standard benchmark workloads (`shared/bench/WORKLOADS.md`), run through
+//! the engine's public API — the code users get — side by side with plain
+//! hand-written loops for the same work, so every row carries its ratio.
+//!
+//! Timing protocol: one warm-up run of each, then `runs` timed runs of each,
+//! engine and baseline alternating (so a noisy neighbour hurts both alike);
+//! each run starts from a freshly built initial state and only the step loop
+//! is timed. Correctness checks are computed after the timed region.
+
+pub mod allpairs;
+pub mod mass_spring;
+pub mod nbody5;
+
+use animats_engine::{DVec3, IntegratorKind};
+use std::time::Instant;
+
+/// The workloads, in the order they are run by default.
+pub const WORKLOADS: [&str; 5] = [
+    "chain-64",
+    "cloth-32",
+    "cloth-128",
+    "nbody5",
+    "allpairs-1000",
+];
+
+/// Options of a benchmark run.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    /// Shorter runs where the workload defines a quick mode (nbody5, allpairs-1000).
+    pub quick: bool,
+    /// Timed runs after the warm-up (at least 5).
+    pub runs: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            quick: false,
+            runs: 5,
+        }
+    }
+}
+
+/// Median, minimum and maximum of a set of timed runs, s.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timing {
+    /// Median, s.
+    pub median: f64,
+    /// Fastest run, s.
+    pub min: f64,
+    /// Slowest run, s.
+    pub max: f64,
+    /// Number of runs.
+    pub runs: usize,
+}
+
+impl Timing {
+    /// Summarises run times (s).
+    pub fn from_runs(mut times: Vec<f64>) -> Timing {
+        times.sort_by(f64::total_cmp);
+        let n = times.len();
+        let median = if n % 2 == 1 {
+            times[n / 2]
+        } else {
+            0.5 * (times[n / 2 - 1] + times[n / 2])
+        };
+        Timing {
+            median,
+            min: times[0],
+            max: times[n - 1],
+            runs: n,
+        }
+    }
+}
+
+/// One correctness check of a workload's final state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Check {
+    /// What is checked, e.g. `com_y`.
+    pub name: String,
+    /// The value we got.
+    pub value: f64,
+    /// What it should be, where known.
+    pub expected: Option<f64>,
+    /// Largest acceptable |value - expected|.
+    pub tolerance: f64,
+}
+
+impl Check {
+    /// A check against an expected value.
+    pub fn new(name: &str, value: f64, expected: f64, tolerance: f64) -> Check {
+        Check {
+            name: name.into(),
+            value,
+            expected: Some(expected),
+            tolerance,
+        }
+    }
+    /// A value reported without a reference.
+    pub fn info(name: &str, value: f64) -> Check {
+        Check {
+            name: name.into(),
+            value,
+            expected: None,
+            tolerance: 0.0,
+        }
+    }
+    /// Whether it passed (`None` when there is nothing to compare with).
+    pub fn passed(&self) -> Option<bool> {
+        self.expected
+            .map(|e| (self.value - e).abs() <= self.tolerance && self.value.is_finite())
+    }
+}
+
+/// One line of the benchmark table.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Workload name.
+    pub workload: String,
+    /// Integrator (and thread note).
+    pub variant: String,
+    /// Particles (bodies).
+    pub particles: usize,
+    /// Springs (0 for the n-body workloads).
+    pub springs: usize,
+    /// Steps per run.
+    pub steps: usize,
+    /// Step, s.
+    pub dt: f64,
+    /// Force evaluations per step.
+    pub evaluations: u32,
+    /// Pair interactions per step (n-body workloads).
+    pub pairs: usize,
+    /// Engine timings.
+    pub engine: Timing,
+    /// Name and timings of the hand-written baseline.
+    pub baseline: Option<(String, Timing)>,
+    /// Checks of the final state.
+    pub checks: Vec<Check>,
+}
+
+impl Row {
+    /// Particle-steps per second (median).
+    pub fn particle_steps_per_s(&self) -> f64 {
+        (self.particles * self.steps) as f64 / self.engine.median
+    }
+    /// Spring evaluations per second (median).
+    pub fn spring_evals_per_s(&self) -> f64 {
+        (self.springs * self.steps) as f64 * self.evaluations as f64 / self.engine.median
+    }
+    /// Pair interactions per second (median).
+    pub fn pairs_per_s(&self) -> f64 {
+        (self.pairs * self.steps) as f64 / self.engine.median
+    }
+    /// Simulated seconds per wall-clock second (median).
+    pub fn sim_per_wall(&self) -> f64 {
+        self.steps as f64 * self.dt / self.engine.median
+    }
+    /// Engine median over baseline median.
+    pub fn ratio(&self) -> Option<f64> {
+        self.baseline
+            .as_ref()
+            .map(|(_, b)| self.engine.median / b.median)
+    }
+}
+
+/// Times `runs` runs of `a` and of `b`, alternating, after one warm-up of
+/// each. `setup` builds a fresh state (untimed); `run` is the timed loop.
+/// Returns the timings and the last states.
+pub fn measure_pair<SA, SB>(
+    runs: usize,
+    mut setup_a: impl FnMut() -> SA,
+    mut run_a: impl FnMut(&mut SA),
+    mut setup_b: impl FnMut() -> SB,
+    mut run_b: impl FnMut(&mut SB),
+) -> (Timing, Timing, SA, SB) {
+    let mut once_a = || {
+        let mut s = setup_a();
+        let t = Instant::now();
+        run_a(&mut s);
+        (t.elapsed().as_secs_f64(), s)
+    };
+    let mut once_b = || {
+        let mut s = setup_b();
+        let t = Instant::now();
+        run_b(&mut s);
+        (t.elapsed().as_secs_f64(), s)
+    };
+    let (_, mut last_a) = once_a();
+    let (_, mut last_b) = once_b();
+    let (mut ta, mut tb) = (Vec::new(), Vec::new());
+    for _ in 0..runs {
+        let (t, s) = once_a();
+        ta.push(t);
+        last_a = s;
+        let (t, s) = once_b();
+        tb.push(t);
+        last_b = s;
+    }
+    (Timing::from_runs(ta), Timing::from_runs(tb), last_a, last_b)
+}
+
+/// Runs one named workload; each mass-spring workload gives a row per integrator.
+pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
+    let runs = opts.runs.max(5);
+    match name {
+        "chain-64" | "cloth-32" | "cloth-128" => Ok(run_mass_spring(name, runs)),
+        "nbody5" => Ok(vec![run_nbody5(opts.quick, runs)]),
+        "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
+        _ => Err(format!(
+            "unknown workload `{name}` (expected one of: {})",
+            WORKLOADS.join(", ")
+        )),
+    }
+}
+
+fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
+    use mass_spring::*;
+    let spec = match name {
+        "chain-64" => chain64(),
+        "cloth-32" => cloth(32),
+        _ => cloth(128),
+    };
+    let mut rows = Vec::new();
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let (engine, baseline, world, base) = measure_pair(
+            runs,
+            || engine_world(&spec, kind),
+            |w| {
+                for _ in 0..STEPS {
+                    w.step(DT).expect("workload stays finite");
+                }
+            },
+            || Baseline::new(&spec),
+            |b| {
+                for _ in 0..STEPS {
+                    match kind {
+                        IntegratorKind::Rk4 => b.step_rk4(),
+                        _ => b.step_symplectic(),
+                    }
+                }
+            },
+        );
+        let s = summarise(&world.state().pos, &world.state().vel, &spec.pinned);
+        let (bx, bv) = base.state();
+        let sb = summarise(bx, bv, &spec.pinned);
+        let mut checks = Vec::new();
+        if let Some((cx, cy, ke)) = reference(name, kind) {
+            checks.push(Check::new("com_x", s.com.x, cx, 1e-6));
+            checks.push(Check::new("com_y", s.com.y, cy, 1e-6));
+            checks.push(Check::new(
+                "kinetic",
+                s.kinetic,
+                ke,
+                1e-6 * ke.abs().max(1e-6),
+            ));
+        }
+        checks.push(Check::new("com_y vs baseline", s.com.y, sb.com.y, 1e-6));
+        checks.push(Check::new("min_y >= 0", s.min_y.min(0.0), 0.0, 0.0));
+        checks.push(Check::new(
+            "finite",
+            if s.finite { 1.0 } else { 0.0 },
+            1.0,
+            0.0,
+        ));
+        rows.push(Row {
+            workload: name.into(),
+            variant: kind.name().into(),
+            particles: spec.positions.len(),
+            springs: spec.edges.len(),
+            steps: STEPS,
+            dt: DT,
+            evaluations: kind.evaluations(),
+            pairs: 0,
+            engine,
+            baseline: Some(("hand-written SoA loop".into(), baseline)),
+            checks,
+        });
+    }
+    rows
+}
+
+fn run_nbody5(quick: bool, runs: usize) -> Row {
+    use nbody5::*;
+    let steps = if quick { 5_000_000 } else { 50_000_000 };
+    let (engine, baseline, world, reference) = measure_pair(
+        runs,
+        engine_world,
+        |w| {
+            for _ in 0..steps {
+                w.step(DT).expect("n-body stays finite");
+            }
+        },
+        Reference::new,
+        |r| {
+            for _ in 0..steps {
+                r.advance(DT);
+            }
+        },
+    );
+    let mut short = engine_world();
+    let e0 = world_energy(&short);
+    for _ in 0..1000 {
+        short.step(DT).expect("n-body stays finite");
+    }
+    let mut checks = vec![
+        Check::new("E(0)", e0, E0, 5e-10),
+        Check::new("E(1000)", world_energy(&short), E1000, 5e-10),
+    ];
+    let e_end = world_energy(&world);
+    if steps == 50_000_000 {
+        checks.push(Check::new("E(50M)", e_end, E50M, 5e-10));
+    } else {
+        checks.push(Check::new(
+            "E(5M) vs reference algorithm",
+            e_end,
+            reference.energy(),
+            5e-10,
+        ));
+    }
+    Row {
+        workload: "nbody5".into(),
+        variant: "symplectic, user force".into(),
+        particles: 5,
+        springs: 0,
+        steps,
+        dt: DT,
+        evaluations: 1,
+        pairs: 10,
+        engine,
+        baseline: Some(("reference scalar advance".into(), baseline)),
+        checks,
+    }
+}
+
+fn allpairs_checks(x: &[DVec3], v: &[DVec3], steps: usize) -> Vec<Check> {
+    use allpairs::*;
+    let (e0_ref, e100_ref, drift_ref, com_ref, rms_ref) = REFERENCE;
+    let e0 = energy(&positions(), &vec![DVec3::ZERO; N]);
+    let e = energy(x, v);
+    let (com, rms) = shape(x);
+    let mut checks = vec![Check::new("E(0)", e0, e0_ref, 1e-12)];
+    if steps == STEPS {
+        checks.push(Check::new("E(100)", e, e100_ref, 1e-12));
+        checks.push(Check::new("drift", (e - e0) / e0.abs(), drift_ref, 5e-8));
+        checks.push(Check::new("com_x", com, com_ref, 5e-7));
+        checks.push(Check::new("rms radius", rms, rms_ref, 1e-10));
+    } else {
+        checks.push(Check::info("drift", (e - e0) / e0.abs()));
+    }
+    checks
+}
+
+fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
+    use allpairs::*;
+    let steps = if quick { 20 } else { STEPS };
+    let one = |w: &mut animats_engine::World| {
+        for _ in 0..steps {
+            w.step(DT).expect("all-pairs stays finite");
+        }
+    };
+    let (engine, baseline, world, base) =
+        measure_pair(runs, engine_world, one, Baseline::new, |b| {
+            for _ in 0..steps {
+                b.step();
+            }
+        });
+    let mut checks = allpairs_checks(&world.state().pos, &world.state().vel, steps);
+    checks.push(Check::new(
+        "E vs baseline",
+        energy(&world.state().pos, &world.state().vel),
+        energy(&base.x, &base.v),
+        1e-12,
+    ));
+    let row = |variant: &str, engine: Timing, baseline, pairs, checks| Row {
+        workload: "allpairs-1000".into(),
+        variant: variant.into(),
+        particles: N,
+        springs: 0,
+        steps,
+        dt: DT,
+        evaluations: 1,
+        pairs,
+        engine,
+        baseline,
+        checks,
+    };
+    let single = row(
+        "symplectic, 1 thread",
+        engine,
+        Some(("hand-written loop (all i, j)".into(), baseline)),
+        N * N,
+        checks,
+    );
+    // Two threads: two independent copies, one per thread (the throughput an
+    // evolution loop sees); the work of both counts.
+    let (two, two_base, _, _) = measure_pair(
+        runs,
+        || (engine_world(), engine_world()),
+        |(a, b)| {
+            std::thread::scope(|s| {
+                s.spawn(|| one(a));
+                s.spawn(|| one(b));
+            })
+        },
+        || (Baseline::new(), Baseline::new()),
+        |(a, b)| {
+            std::thread::scope(|s| {
+                s.spawn(|| (0..steps).for_each(|_| a.step()));
+                s.spawn(|| (0..steps).for_each(|_| b.step()));
+            })
+        },
+    );
+    let double = row(
+        "symplectic, 2 threads x 1 copy each",
+        two,
+        Some(("hand-written loop, 2 threads".into(), two_base)),
+        2 * N * N,
+        vec![],
+    );
+    vec![single, double]
+}

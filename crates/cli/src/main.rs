@@ -1,0 +1,72 @@
+//! `animats`: the command line. A thin layer over the libraries: it parses
+//! arguments, loads files, calls the library, and reports.
+//!
+//! Exit status: 0 success, 2 bad input (arguments, scene or parameter files,
+//! unwritable outputs), 3 the simulation blew up, 1 anything else.
+
+mod bench;
+mod output;
+mod simulate;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Build creatures from the physics up: simulate scenes of point masses,
+/// springs and joints, and benchmark the engine.
+#[derive(Parser)]
+#[command(name = "animats", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene file headless; write its trajectory or print a summary.
+    Simulate(simulate::Args),
+    /// Run the standard benchmark workloads beside hand-written baselines.
+    Bench(bench::Args),
+}
+
+/// A failed command, with the exit status it maps to.
+pub enum Failure {
+    /// Bad input: exit 2.
+    Input(String),
+    /// The simulation went non-finite: exit 3.
+    Blowup(String),
+    /// Anything else: exit 1.
+    Other(String),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Simulate(args) => simulate::run(args),
+        Command::Bench(args) => bench::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(m)) => {
+            eprintln!("error: {m}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Blowup(m)) => {
+            eprintln!("error: {m}");
+            ExitCode::from(3)
+        }
+        Err(Failure::Other(m)) => {
+            eprintln!("error: {m}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Parses a positive, finite number (for steps and durations).
+pub fn positive_f64(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("must be a positive finite number, got {s}"))
+    }
+}

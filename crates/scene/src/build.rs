@@ -1,0 +1,332 @@
+//! From a parsed scene description to a world: every entry validated, every
+//! particle name resolved, every mistake reported with its entry and field.
+
+use crate::def::*;
+use crate::error::SceneError;
+use crate::source::Source;
+use crate::Scene;
+use animats_engine::DVec3;
+use animats_engine::{
+    AngleJointDef, Current, FloorDef, FluidMedium, Gravity, ModelError, NBodyGravity, ParticleDef,
+    ParticleId, ReefWater, SpringDef, Targets, TorqueJointDef, World,
+};
+use std::collections::HashMap;
+use toml::Spanned;
+
+/// Where an entry came from, for error messages.
+struct At<'s> {
+    src: &'s Source<'s>,
+    entry: String,
+    line: usize,
+}
+
+impl At<'_> {
+    fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
+        SceneError {
+            file: self.src.file.to_string(),
+            line: Some(self.line),
+            entry: Some(self.entry.clone()),
+            field: (!field.is_empty()).then(|| field.to_string()),
+            message: message.into(),
+        }
+    }
+
+    fn model(&self, e: ModelError) -> SceneError {
+        self.err(&e.field, e.reason)
+    }
+
+    fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be a finite number, got {x}")))
+        }
+    }
+
+    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        self.finite(field, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, format!("must be > 0, got {x}")))
+        }
+    }
+
+    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<DVec3, SceneError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(DVec3::from_array(v))
+        } else {
+            Err(self.err(field, format!("must be finite, got {v:?}")))
+        }
+    }
+}
+
+fn at<'s, T>(src: &'s Source<'s>, entry: impl Into<String>, spanned: &Spanned<T>) -> At<'s> {
+    At {
+        src,
+        entry: entry.into(),
+        line: src.line_of(spanned.span().start),
+    }
+}
+
+/// Resolves particle names to handles.
+struct Names {
+    ids: HashMap<String, ParticleId>,
+}
+
+impl Names {
+    fn one(&self, at: &At, field: &str, name: &str) -> Result<ParticleId, SceneError> {
+        self.ids
+            .get(name)
+            .copied()
+            .ok_or_else(|| at.err(field, format!("unknown particle `{name}`")))
+    }
+
+    fn targets(&self, at: &At, names: &Option<Vec<String>>) -> Result<Targets, SceneError> {
+        match names {
+            None => Ok(Targets::All),
+            Some(list) => Ok(Targets::Only(
+                list.iter()
+                    .map(|n| self.one(at, "particles", n))
+                    .collect::<Result<_, _>>()?,
+            )),
+        }
+    }
+}
+
+/// A particle name: non-empty, and safe to write unquoted in CSV and JSON.
+fn check_name(at: &At, name: &str) -> Result<(), SceneError> {
+    let ok = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.' | ':' | '#' | '/'));
+    if ok {
+        Ok(())
+    } else {
+        Err(at.err(
+            "name",
+            format!("`{name}` is not a valid name: use letters, digits and _ - . : # /"),
+        ))
+    }
+}
+
+/// Builds the world a scene describes.
+pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
+    let mut world = World::new();
+
+    // [world]
+    let wd = def
+        .world
+        .as_ref()
+        .map(|w| w.get_ref().clone())
+        .unwrap_or_default();
+    let wat = match &def.world {
+        Some(w) => at(src, "world", w),
+        None => At {
+            src,
+            entry: "world".into(),
+            line: 1,
+        },
+    };
+    let gravity = wat.vec3("gravity", wd.gravity)?;
+    let dt = wat.positive("dt", wd.dt)?;
+    let duration = wat.positive("duration", wd.duration)?;
+    world.set_integrator(wd.integrator.into());
+    if gravity != DVec3::ZERO {
+        world
+            .set_gravity_force(Some(Gravity::new(gravity)))
+            .map_err(|e| wat.model(e))?;
+    }
+
+    // [[particle]]
+    let mut names = Names {
+        ids: HashMap::new(),
+    };
+    let mut name_list = Vec::with_capacity(def.particle.len());
+    for (k, entry) in def.particle.iter().enumerate() {
+        let p = entry.get_ref();
+        let at = at(src, format!("particle[{k}]"), entry);
+        check_name(&at, &p.name)?;
+        if names.ids.contains_key(&p.name) {
+            return Err(at.err("name", format!("duplicate particle name `{}`", p.name)));
+        }
+        if p.radius.is_none() && p.volume.is_none() {
+            return Err(at.err(
+                "radius",
+                "give the particle a `radius` or a `volume` (or both)",
+            ));
+        }
+        let pdef = ParticleDef {
+            mass: p.mass,
+            position: DVec3::from_array(p.position),
+            velocity: DVec3::from_array(p.velocity),
+            radius: p.radius,
+            volume: p.volume,
+            mu_s: p.mu_s,
+            mu_k: p.mu_k,
+            restitution: p.restitution,
+            fixed: p.fixed,
+        };
+        let id = world.add_particle(pdef).map_err(|e| at.model(e))?;
+        names.ids.insert(p.name.clone(), id);
+        name_list.push(p.name.clone());
+    }
+
+    // [floor]
+    if let Some(entry) = &def.floor {
+        let f = entry.get_ref();
+        let at = at(src, "floor", entry);
+        let targets = names.targets(&at, &f.particles)?;
+        world
+            .add_floor(FloorDef {
+                envelope: f.envelope,
+                static_speed: f.static_speed,
+                rest_speed: f.rest_speed,
+                targets,
+                ..FloorDef::default()
+            })
+            .map_err(|e| at.model(e))?;
+    }
+
+    // [fluid]
+    if let Some(entry) = &def.fluid {
+        let f = entry.get_ref();
+        let at = at(src, "fluid", entry);
+        let current = current(&at, &f.current, gravity.length())?;
+        let targets = names.targets(&at, &f.particles)?;
+        let fluid = FluidMedium {
+            density: f.density,
+            drag_coefficient: f.drag_coefficient,
+            current,
+            targets,
+        };
+        world.add_fluid(fluid).map_err(|e| at.model(e))?;
+    }
+
+    // [[spring]]
+    for (k, entry) in def.spring.iter().enumerate() {
+        let s = entry.get_ref();
+        let at = at(src, format!("spring[{k}]"), entry);
+        let sdef = SpringDef {
+            a: names.one(&at, "a", &s.a)?,
+            b: names.one(&at, "b", &s.b)?,
+            stiffness: s.stiffness,
+            damping: s.damping,
+            rest_length: s.rest_length,
+        };
+        world.add_spring(sdef).map_err(|e| at.model(e))?;
+    }
+
+    // [[angle_joint]]
+    for (k, entry) in def.angle_joint.iter().enumerate() {
+        let j = entry.get_ref();
+        let at = at(src, format!("angle_joint[{k}]"), entry);
+        let jdef = AngleJointDef {
+            a: names.one(&at, "a", &j.a)?,
+            joint: names.one(&at, "joint", &j.joint)?,
+            b: names.one(&at, "b", &j.b)?,
+            stiffness: j.stiffness,
+            damping: j.damping,
+            rest_angle: j.rest_angle,
+        };
+        world.add_angle_joint(jdef).map_err(|e| at.model(e))?;
+    }
+
+    // [[torque_joint]]
+    for (k, entry) in def.torque_joint.iter().enumerate() {
+        let j = entry.get_ref();
+        let at = at(src, format!("torque_joint[{k}]"), entry);
+        let jdef = TorqueJointDef {
+            end: names.one(&at, "end", &j.end)?,
+            joint: names.one(&at, "joint", &j.joint)?,
+            axis: DVec3::from_array(j.axis),
+            torque: j.torque,
+        };
+        world.add_torque_joint(jdef).map_err(|e| at.model(e))?;
+    }
+
+    // [[constant_force]]
+    for (k, entry) in def.constant_force.iter().enumerate() {
+        let c = entry.get_ref();
+        let at = at(src, format!("constant_force[{k}]"), entry);
+        let ids = match names.targets(&at, &c.particles)? {
+            Targets::All => world.particle_ids().collect(),
+            Targets::Only(ids) => ids,
+        };
+        let force = at.vec3("force", c.force)?;
+        world
+            .add_constant_force(ids, force)
+            .map_err(|e| at.model(e))?;
+    }
+
+    // [[nbody]]
+    for (k, entry) in def.nbody.iter().enumerate() {
+        let n = entry.get_ref();
+        let at = at(src, format!("nbody[{k}]"), entry);
+        let targets = names.targets(&at, &n.particles)?;
+        world
+            .add_nbody(NBodyGravity::new(n.g, n.softening, targets))
+            .map_err(|e| at.model(e))?;
+    }
+
+    Ok(Scene {
+        world,
+        names: name_list,
+        dt,
+        duration,
+    })
+}
+
+fn current(at: &At, c: &CurrentEntry, g: f64) -> Result<Current, SceneError> {
+    Ok(match c {
+        CurrentEntry::Still => Current::Still,
+        CurrentEntry::Uniform { velocity } => {
+            Current::Uniform(at.vec3("current.velocity", *velocity)?)
+        }
+        CurrentEntry::Reef {
+            surface,
+            amplitude,
+            wavelength,
+            period,
+            direction,
+            drift,
+        } => {
+            let d = ReefWater::default();
+            let wavelength =
+                at.positive("current.wavelength", wavelength.unwrap_or(d.wavelength))?;
+            let period = match period {
+                Some(p) => at.positive("current.period", *p)?,
+                None if g > 0.0 => ReefWater::deep_water_period(wavelength, g),
+                None => d.period,
+            };
+            let direction = match direction {
+                Some(v) => at.vec3("current.direction", *v)?,
+                None => d.direction,
+            };
+            if DVec3::new(direction.x, 0.0, direction.z).length() == 0.0 {
+                return Err(at.err(
+                    "current.direction",
+                    "must have a horizontal (x or z) component",
+                ));
+            }
+            let amplitude = at.finite("current.amplitude", amplitude.unwrap_or(d.amplitude))?;
+            if amplitude < 0.0 {
+                return Err(at.err(
+                    "current.amplitude",
+                    format!("must be >= 0, got {amplitude}"),
+                ));
+            }
+            Current::Reef(ReefWater {
+                surface: at.finite("current.surface", surface.unwrap_or(d.surface))?,
+                amplitude,
+                wavelength,
+                period,
+                direction,
+                drift: match drift {
+                    Some(v) => at.vec3("current.drift", *v)?,
+                    None => d.drift,
+                },
+            })
+        }
+    })
+}

@@ -1,0 +1,312 @@
+//! The scene file contract, as serde structures: one struct per table, every
+//! default written once, unknown keys refused.
+//!
+//! SI units, y up, the floor is the plane y = 0. See `docs/SCENES.md` for the
+//! whole format with an example of every entry.
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A whole scene file.
+#[derive(Clone, Debug, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDef {
+    /// `[world]`: gravity, step, integrator, duration.
+    #[serde(default)]
+    pub world: Option<Spanned<WorldDef>>,
+    /// `[[particle]]` entries.
+    #[serde(default)]
+    pub particle: Vec<Spanned<ParticleEntry>>,
+    /// `[floor]`: the plane y = 0.
+    #[serde(default)]
+    pub floor: Option<Spanned<FloorEntry>>,
+    /// `[fluid]`: drag and buoyancy.
+    #[serde(default)]
+    pub fluid: Option<Spanned<FluidEntry>>,
+    /// `[[spring]]` entries.
+    #[serde(default)]
+    pub spring: Vec<Spanned<SpringEntry>>,
+    /// `[[angle_joint]]` entries.
+    #[serde(default)]
+    pub angle_joint: Vec<Spanned<AngleJointEntry>>,
+    /// `[[torque_joint]]` entries.
+    #[serde(default)]
+    pub torque_joint: Vec<Spanned<TorqueJointEntry>>,
+    /// `[[constant_force]]` entries.
+    #[serde(default)]
+    pub constant_force: Vec<Spanned<ConstantForceEntry>>,
+    /// `[[nbody]]` entries.
+    #[serde(default)]
+    pub nbody: Vec<Spanned<NBodyEntry>>,
+}
+
+/// Integration method names as written in files.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum IntegratorName {
+    /// Explicit Euler.
+    Euler,
+    /// Explicit midpoint.
+    Midpoint,
+    /// Classic RK4.
+    #[default]
+    Rk4,
+    /// Semi-implicit Euler.
+    Symplectic,
+}
+
+impl From<IntegratorName> for animats_engine::IntegratorKind {
+    fn from(n: IntegratorName) -> Self {
+        use animats_engine::IntegratorKind as K;
+        match n {
+            IntegratorName::Euler => K::Euler,
+            IntegratorName::Midpoint => K::Midpoint,
+            IntegratorName::Rk4 => K::Rk4,
+            IntegratorName::Symplectic => K::Symplectic,
+        }
+    }
+}
+
+/// `[world]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WorldDef {
+    /// m/s², default `[0, -9.8, 0]`.
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    /// Step, s, > 0; default 0.001.
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// Integration method; default RK4.
+    #[serde(default)]
+    pub integrator: IntegratorName,
+    /// Simulated seconds, > 0; default 5.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+}
+
+impl Default for WorldDef {
+    fn default() -> Self {
+        WorldDef {
+            gravity: default_gravity(),
+            dt: default_dt(),
+            integrator: IntegratorName::default(),
+            duration: default_duration(),
+        }
+    }
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, -9.8, 0.0]
+}
+fn default_dt() -> f64 {
+    0.001
+}
+fn default_duration() -> f64 {
+    5.0
+}
+
+/// `[[particle]]`: a sphere.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleEntry {
+    /// Unique; forces refer to particles by name.
+    pub name: String,
+    /// kg, > 0.
+    pub mass: f64,
+    /// m.
+    pub position: [f64; 3],
+    /// m/s, default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// m; or `volume`; at least one.
+    pub radius: Option<f64>,
+    /// m³; or `radius`; at least one.
+    pub volume: Option<f64>,
+    /// Default 0.5.
+    #[serde(default = "default_mu_s")]
+    pub mu_s: f64,
+    /// Default 0.3.
+    #[serde(default = "default_mu_k")]
+    pub mu_k: f64,
+    /// 0..=1, default 0.5.
+    #[serde(default = "default_restitution")]
+    pub restitution: f64,
+    /// Nailed in place; default false.
+    #[serde(default)]
+    pub fixed: bool,
+}
+
+fn default_mu_s() -> f64 {
+    0.5
+}
+fn default_mu_k() -> f64 {
+    0.3
+}
+fn default_restitution() -> f64 {
+    0.5
+}
+
+/// `[floor]`: the plane y = 0.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FloorEntry {
+    /// m: deeper than this below the plane = missed; default 0.01.
+    #[serde(default = "default_envelope")]
+    pub envelope: f64,
+    /// m/s: below this, static friction; default 0.01.
+    #[serde(default = "default_static_speed")]
+    pub static_speed: f64,
+    /// m/s: impacts slower than this do not bounce; default 0.05.
+    #[serde(default = "default_rest_speed")]
+    pub rest_speed: f64,
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+}
+
+fn default_envelope() -> f64 {
+    0.01
+}
+fn default_static_speed() -> f64 {
+    0.01
+}
+fn default_rest_speed() -> f64 {
+    0.05
+}
+
+/// `[fluid]`: drag and buoyancy.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidEntry {
+    /// kg/m³, default 1000 (water).
+    #[serde(default = "default_density")]
+    pub density: f64,
+    /// Default 0.47 (a sphere).
+    #[serde(default = "default_drag")]
+    pub drag_coefficient: f64,
+    /// The fluid's velocity field; default still.
+    #[serde(default)]
+    pub current: CurrentEntry,
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+}
+
+fn default_density() -> f64 {
+    1000.0
+}
+fn default_drag() -> f64 {
+    0.47
+}
+
+/// `current = { kind = "..." ... }`.
+#[derive(Clone, Debug, Deserialize, Default)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum CurrentEntry {
+    /// At rest.
+    #[default]
+    Still,
+    /// The same velocity everywhere.
+    Uniform {
+        /// m/s.
+        velocity: [f64; 3],
+    },
+    /// Swaying currents under passing waves (see `ReefWater`).
+    Reef {
+        /// Height of the mean water surface, m; default 1.5.
+        surface: Option<f64>,
+        /// Wave amplitude at the surface, m; default 0.08.
+        amplitude: Option<f64>,
+        /// m; default 1.5.
+        wavelength: Option<f64>,
+        /// s; default: deep-water waves of that wavelength.
+        period: Option<f64>,
+        /// Horizontal direction of travel; default `[1, 0, 0]`.
+        direction: Option<[f64; 3]>,
+        /// Steady current added everywhere, m/s; default 0.
+        drift: Option<[f64; 3]>,
+    },
+}
+
+/// `[[spring]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringEntry {
+    /// One end (a particle name).
+    pub a: String,
+    /// The other end.
+    pub b: String,
+    /// N/m, >= 0.
+    pub stiffness: f64,
+    /// N s/m, >= 0, default 0.
+    #[serde(default)]
+    pub damping: f64,
+    /// m, > 0; default the initial distance.
+    pub rest_length: Option<f64>,
+}
+
+/// `[[angle_joint]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AngleJointEntry {
+    /// End of the first arm.
+    pub a: String,
+    /// Where the arms meet.
+    pub joint: String,
+    /// End of the second arm.
+    pub b: String,
+    /// N m/rad, >= 0.
+    pub stiffness: f64,
+    /// N m s/rad, >= 0, default 0.
+    #[serde(default)]
+    pub damping: f64,
+    /// rad in [0, π]; default the initial angle.
+    pub rest_angle: Option<f64>,
+}
+
+/// `[[torque_joint]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TorqueJointEntry {
+    /// The mass turned.
+    pub end: String,
+    /// The mass it turns about.
+    pub joint: String,
+    /// Default `[0, 0, 1]`.
+    #[serde(default = "default_axis")]
+    pub axis: [f64; 3],
+    /// N m, default 0.
+    #[serde(default)]
+    pub torque: f64,
+}
+
+fn default_axis() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+/// `[[constant_force]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantForceEntry {
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+    /// N, on each.
+    pub force: [f64; 3],
+}
+
+/// `[[nbody]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NBodyEntry {
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+    /// Gravitational constant; default 6.674e-11.
+    #[serde(rename = "G", default = "default_big_g")]
+    pub g: f64,
+    /// m, default 0.
+    #[serde(default)]
+    pub softening: f64,
+}
+
+fn default_big_g() -> f64 {
+    6.674e-11
+}
