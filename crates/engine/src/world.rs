@@ -474,7 +474,7 @@ impl World {
                 }
             }
         }
-        if let Some(i) = first_non_finite(&self.next) {
+        if let Some(i) = first_non_finite(&self.next, &self.particles.fixed) {
             // The world stays at its last finite state.
             return Err(SimError::NonFinite {
                 particle: ParticleId(i as u32),
@@ -586,8 +586,10 @@ impl World {
     }
 }
 
-/// The index of the first particle with a non-finite position or velocity.
-fn first_non_finite(s: &State) -> Option<usize> {
+/// The index of the first particle with a non-finite position or velocity,
+/// preferring a moving one: a nail next to an overflowing spring goes NaN
+/// only because 0 × ∞ is NaN, and is not the one to blame.
+fn first_non_finite(s: &State, fixed: &[bool]) -> Option<usize> {
     // A sum of finite numbers is finite (unless it overflows, which the
     // confirming scan below tells apart) and any inf or NaN makes it
     // non-finite. Four independent lanes keep the pass short next to the
@@ -611,7 +613,9 @@ fn first_non_finite(s: &State) -> Option<usize> {
     if lanes.iter().all(|l| l.is_finite()) {
         return None;
     }
-    pos.iter()
-        .zip(vel)
-        .position(|(p, v)| !(p.is_finite() && v.is_finite()))
+    let bad = |i: &usize| !(pos[*i].is_finite() && vel[*i].is_finite());
+    (0..n)
+        .filter(|&i| !fixed[i])
+        .find(bad)
+        .or_else(|| (0..n).find(bad))
 }

@@ -341,3 +341,37 @@ fn user_forces_are_evaluated_at_every_trial_state() {
     );
     assert!((w.position(p).x - 3.0f64.cos()).abs() < 1e-10);
 }
+
+#[test]
+fn a_blow_up_is_an_error_and_the_world_keeps_its_last_finite_state() {
+    // ωh ≈ 300 under explicit Euler: the oscillation grows ~300× per step.
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Euler);
+    let anchor = w.add_particle(ParticleDef::new(1.0).fixed()).unwrap();
+    let bob = w
+        .add_particle(ParticleDef::new(1e-3).at(DVec3::new(1.1, 0.0, 0.0)))
+        .unwrap();
+    w.add_spring(SpringDef::new(anchor, bob, 1e6, 0.0).with_rest_length(1.0))
+        .unwrap();
+    let mut steps = 0;
+    let err = loop {
+        match w.step(0.01) {
+            Ok(_) => steps += 1,
+            Err(e) => break e,
+        }
+        assert!(steps < 1000, "never blew up");
+    };
+    match err {
+        animats_engine::SimError::NonFinite { particle, time } => {
+            assert_eq!(particle, bob, "the moving particle is blamed, not the nail");
+            assert!((time - 0.01 * (steps + 1) as f64).abs() < 1e-9);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    assert!(w.position(bob).is_finite() && w.velocity(bob).is_finite());
+    assert!(
+        (w.time() - 0.01 * steps as f64).abs() < 1e-9,
+        "the clock did not advance past the last good step"
+    );
+    assert_eq!(w.step(-1.0), Err(animats_engine::SimError::BadStep(-1.0)));
+}

@@ -1,0 +1,337 @@
+//! `animats simulate`: the output contracts and every bad-input case of the
+//! scene format, run through the real binary.
+
+mod common;
+use common::*;
+
+const TWO_BALLS: &str = r#"
+[world]
+dt = 0.001
+duration = 0.01
+
+[floor]
+
+[[particle]]
+name = "a"
+mass = 1.0
+position = [0.0, 1.0, 0.0]
+velocity = [0.3, 0.0, 0.1]
+radius = 0.1
+
+[[particle]]
+name = "b"
+mass = 2.0
+position = [1.0, 1.0, 0.0]
+radius = 0.1
+
+[[spring]]
+a = "a"
+b = "b"
+stiffness = 10.0
+damping = 0.1
+"#;
+
+#[test]
+fn summary_reports_steps_backtracks_speed_and_energy() {
+    let o = animats(&["simulate", "scenes/oscillator.toml", "--duration", "10"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(out.contains("1000 steps to t = 10 s"), "{out}");
+    assert!(out.contains("backtracks: 0"), "{out}");
+    assert!(out.contains("simulated s per wall s"), "{out}");
+    assert!(
+        out.contains("drift"),
+        "a conservative scene reports its energy drift: {out}"
+    );
+}
+
+#[test]
+fn csv_has_the_header_one_row_per_particle_per_recorded_step_and_full_precision() {
+    let dir = scratch("csv");
+    let scene = write(&dir, "two.toml", TWO_BALLS);
+    let out = dir.join("run.csv");
+    let o = animats(&[
+        "simulate",
+        &scene,
+        "--every",
+        "3",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("t,particle,x,y,z,vx,vy,vz"));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // 10 steps, every 3rd recorded, plus t = 0 and the last: steps 0, 3, 6, 9, 10.
+    assert_eq!(rows.len(), 5 * 2);
+    let times: Vec<f64> = rows
+        .iter()
+        .step_by(2)
+        .map(|r| r[0].parse().unwrap())
+        .collect();
+    let expected = [0.0, 0.003, 0.006, 0.009, 0.01];
+    for (t, e) in times.iter().zip(expected) {
+        assert!((t - e).abs() < 1e-15, "times {times:?}");
+    }
+    assert_eq!(rows[0][1], "a");
+    assert_eq!(rows[1][1], "b");
+
+    // The numbers read back to exactly the f64s the library computes.
+    let mut scene = animats_scene::parse(TWO_BALLS, "two.toml").unwrap();
+    for _ in 0..10 {
+        scene.step(0.001).unwrap();
+    }
+    let last = &rows[rows.len() - 2];
+    let a = scene.particle("a").unwrap();
+    let (p, v) = (scene.world.position(a), scene.world.velocity(a));
+    let got: Vec<f64> = last[2..].iter().map(|x| x.parse().unwrap()).collect();
+    assert_eq!(got, vec![p.x, p.y, p.z, v.x, v.y, v.z]);
+}
+
+#[test]
+fn jsonl_has_one_object_per_recorded_step() {
+    let dir = scratch("jsonl");
+    let scene = write(&dir, "two.toml", TWO_BALLS);
+    let out = dir.join("run.jsonl");
+    let o = animats(&[
+        "simulate",
+        &scene,
+        "--every",
+        "5",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let lines: Vec<serde_json::Value> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("each line is JSON"))
+        .collect();
+    assert_eq!(lines.len(), 3); // steps 0, 5, 10
+    assert_eq!(lines[2]["step"], 10);
+    assert_eq!(lines[0]["particles"][1]["name"], "b");
+    assert_eq!(lines[0]["particles"][0]["velocity"][0], 0.3);
+    assert_eq!(
+        lines[0]["particles"][0]["position"]
+            .as_array()
+            .unwrap()
+            .len(),
+        3
+    );
+}
+
+#[test]
+fn command_line_overrides_the_world_table_and_steps_are_rounded() {
+    let dir = scratch("override");
+    let scene = write(&dir, "two.toml", TWO_BALLS);
+    let out = dir.join("o.csv");
+    // 0.0104 / 0.002 = 5.2 → 5 steps, ending at 0.01 s, not one step past.
+    let o = animats(&[
+        "simulate",
+        &scene,
+        "--dt",
+        "0.002",
+        "--duration",
+        "0.0104",
+        "--integrator",
+        "midpoint",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        stdout.contains("integrator midpoint, dt 0.002 s, 5 steps"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 6 * 2);
+    let last_t: f64 = csv
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((last_t - 0.01).abs() < 1e-15);
+}
+
+fn refused(scene_text: &str, expect: &[&str]) {
+    let dir = scratch(&format!("bad-{:x}", scene_text.len() * 31 + expect.len()));
+    let scene = write(&dir, "bad.toml", scene_text);
+    let o = animats(&["simulate", &scene]);
+    let (_, err) = text(&o);
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "expected exit 2 for {expect:?}, stderr: {err}"
+    );
+    assert!(
+        err.contains("bad.toml"),
+        "message should name the file: {err}"
+    );
+    for e in expect {
+        assert!(err.contains(e), "message should mention `{e}`: {err}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn every_bad_scene_is_refused_with_file_entry_and_field() {
+    let ok = TWO_BALLS;
+    refused(
+        &ok.replace("damping = 0.1", "damping = 0.1\nstifness = 3"),
+        &["spring[0]", "stifness", "unknown field"],
+    );
+    refused(
+        &ok.replace("b = \"b\"", "b = \"c\""),
+        &["spring[0].b", "unknown particle `c`"],
+    );
+    refused(
+        &ok.replace("name = \"b\"", "name = \"a\""),
+        &["particle[1].name", "duplicate"],
+    );
+    refused(
+        &ok.replace("mass = 2.0", "mass = -2.0"),
+        &["particle[1].mass", "> 0"],
+    );
+    refused(
+        &ok.replace("mass = 2.0", "mass = 0"),
+        &["particle[1].mass", "> 0"],
+    );
+    refused(&ok.replace("dt = 0.001", "dt = 0.0"), &["world.dt", "> 0"]);
+    refused(&ok.replace("dt = 0.001", "dt = -1e-3"), &["world.dt"]);
+    refused(
+        &ok.replace("mass = 1.0", "mass = nan"),
+        &["particle[0].mass", "finite"],
+    );
+    refused(
+        &ok.replace("velocity = [0.3, 0.0, 0.1]", "velocity = [0.3, inf, 0.1]"),
+        &["particle[0].velocity", "finite"],
+    );
+    refused(
+        &ok.replace("stiffness = 10.0", "stiffness = inf"),
+        &["spring[0].stiffness", "finite"],
+    );
+    refused(
+        &ok.replace(
+            "radius = 0.1\n\n[[particle]]",
+            "radius = 0.1\nrestitution = 1.2\n\n[[particle]]",
+        ),
+        &["particle[0].restitution", "between 0 and 1"],
+    );
+    refused(
+        &ok.replace("position = [1.0, 1.0, 0.0]", "position = [0.0, 1.0, 0.0]"),
+        &["spring[0]", "zero length"],
+    );
+    refused(
+        &ok.replace("damping = 0.1", "damping = 0.1\nrest_length = 0.0"),
+        &["spring[0].rest_length", "> 0"],
+    );
+    refused(
+        &ok.replace("[floor]", "[floor]\nparticles = [\"zz\"]"),
+        &["floor.particles", "unknown particle `zz`"],
+    );
+    refused(
+        &ok.replace("integrator", "x")
+            .replace("duration = 0.01", "duration = 0.01\nintegrator = \"rk5\""),
+        &["world.integrator", "rk5"],
+    );
+    refused(
+        &ok.replace("radius = 0.1\n\n[[particle]]", "\n[[particle]]"),
+        &["particle[0].radius", "volume"],
+    );
+    refused("[world\n", &["bad.toml:1"]);
+    refused("this is not toml", &["bad.toml:1"]);
+}
+
+#[test]
+fn missing_files_bad_options_and_unwritable_outputs_exit_2() {
+    let o = animats(&["simulate", "no/such/scene.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("no/such/scene.toml"));
+    for args in [
+        vec!["simulate", "scenes/oscillator.toml", "--dt", "0"],
+        vec!["simulate", "scenes/oscillator.toml", "--dt", "nan"],
+        vec!["simulate", "scenes/oscillator.toml", "--duration", "-1"],
+        vec![
+            "simulate",
+            "scenes/oscillator.toml",
+            "--integrator",
+            "verlet",
+        ],
+        vec!["simulate", "scenes/oscillator.toml", "--every", "0"],
+        vec![
+            "simulate",
+            "scenes/oscillator.toml",
+            "--output",
+            "/no/such/dir/out.csv",
+        ],
+        vec!["simulate", "scenes/oscillator.toml", "--output", "out.txt"],
+        vec!["simulate", "scenes/oscillator.toml", "--duration", "0.001"],
+    ] {
+        let o = animats(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o).1);
+        assert!(!text(&o).1.contains("panicked"));
+    }
+}
+
+#[test]
+fn a_blow_up_exits_3_naming_time_and_particle_and_leaves_no_complete_output() {
+    // A stiff spring and a huge step under explicit Euler: the amplitude
+    // grows by about ωh ≈ 300 per step and overflows within a few hundred steps.
+    let dir = scratch("blowup");
+    let scene = write(
+        &dir,
+        "stiff.toml",
+        r#"
+[world]
+gravity = [0.0, 0.0, 0.0]
+dt = 0.01
+integrator = "euler"
+duration = 100.0
+
+[[particle]]
+name = "anchor"
+mass = 1.0
+position = [0.0, 0.0, 0.0]
+radius = 0.01
+fixed = true
+
+[[particle]]
+name = "wobbly"
+mass = 0.001
+position = [1.1, 0.0, 0.0]
+radius = 0.01
+
+[[spring]]
+a = "anchor"
+b = "wobbly"
+stiffness = 1e6
+rest_length = 1.0
+"#,
+    );
+    let out = dir.join("traj.csv");
+    let o = animats(&["simulate", &scene, "--output", out.to_str().unwrap()]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("non-finite at t = "), "{err}");
+    assert!(err.contains("`wobbly`"), "{err}");
+    assert!(
+        !out.exists(),
+        "a failed run must not leave a file under the requested name"
+    );
+    assert!(
+        dir.join("traj.csv.partial").exists(),
+        "what was computed is kept as .partial"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp-"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}

@@ -1,0 +1,62 @@
+//! Every scene shipped in `scenes/` loads, validates and runs.
+
+use std::path::Path;
+
+#[test]
+fn every_shipped_scene_builds_and_runs_a_second() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut count = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+            continue;
+        }
+        let mut scene = animats_scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!scene.names.is_empty(), "{}: empty scene", path.display());
+        let steps = (1.0 / scene.dt).round() as usize;
+        for _ in 0..steps {
+            scene
+                .step(scene.dt)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        }
+        count += 1;
+    }
+    assert!(count >= 5, "only {count} scenes found in {}", dir.display());
+}
+
+#[test]
+fn errors_name_the_line_of_the_entry() {
+    let text = "[world]\ndt = 0.01\n\n[[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0, 0, 0]\nradius = 0.1\n\n[[particle]]\nname = \"b\"\nmass = -1.0\nposition = [1, 0, 0]\nradius = 0.1\n";
+    let e = animats_scene::parse(text, "x.toml").err().unwrap();
+    assert_eq!(e.line, Some(10));
+    assert_eq!(e.entry.as_deref(), Some("particle[1]"));
+    assert_eq!(e.field.as_deref(), Some("mass"));
+    assert_eq!(
+        e.to_string(),
+        "x.toml:10: particle[1].mass: must be > 0, got -1"
+    );
+}
+
+#[test]
+fn defaults_are_those_of_the_contract() {
+    let s = animats_scene::parse(
+        "[[particle]]\nname = \"p\"\nmass = 2\nposition = [0, 1, 0]\nvolume = 0.001\n",
+        "d.toml",
+    )
+    .unwrap();
+    let p = s.world.particles();
+    assert_eq!(
+        (p.mu_s[0], p.mu_k[0], p.restitution[0], p.fixed[0]),
+        (0.5, 0.3, 0.5, false)
+    );
+    // radius follows from volume for a sphere
+    let r = (3.0 * 0.001 / (4.0 * std::f64::consts::PI)).cbrt();
+    assert!((p.radius[0] - r).abs() < 1e-15);
+    assert_eq!(s.dt, 0.001);
+    assert_eq!(s.duration, 5.0);
+    assert_eq!(s.world.integrator(), animats_engine::IntegratorKind::Rk4);
+    assert_eq!(
+        s.world.forces().g(),
+        animats_engine::DVec3::new(0.0, -9.8, 0.0)
+    );
+}
