@@ -84,6 +84,31 @@ impl Baseline {
             }
             self.a[i] = a;
         }
+        self.kick_drift();
+    }
+
+    /// One kick-drift step summing each pair once (i < j) and applying it to
+    /// both bodies: half the square roots of [`step`](Baseline::step).
+    pub fn step_pairs(&mut self) {
+        let m = 1.0 / N as f64;
+        let eps2 = SOFTENING * SOFTENING;
+        self.a.fill(DVec3::ZERO);
+        for i in 0..N {
+            let xi = self.x[i];
+            let mut ai = DVec3::ZERO;
+            for j in i + 1..N {
+                let d = self.x[j] - xi;
+                let r2 = d.length_squared() + eps2;
+                let f = d * (m / (r2 * r2.sqrt()));
+                ai += f;
+                self.a[j] -= f;
+            }
+            self.a[i] += ai;
+        }
+        self.kick_drift();
+    }
+
+    fn kick_drift(&mut self) {
         for i in 0..N {
             self.v[i] += DT * self.a[i];
             self.x[i] += DT * self.v[i];
