@@ -10,6 +10,7 @@
 //! is timed. Correctness checks are computed after the timed region.
 
 pub mod allpairs;
+pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
 
@@ -17,12 +18,13 @@ use animats_engine::{DVec3, IntegratorKind};
 use std::time::Instant;
 
 /// The workloads, in the order they are run by default.
-pub const WORKLOADS: [&str; 5] = [
+pub const WORKLOADS: [&str; 6] = [
     "chain-64",
     "cloth-32",
     "cloth-128",
     "nbody5",
     "allpairs-1000",
+    "hopper",
 ];
 
 /// Options of a benchmark run.
@@ -75,27 +77,61 @@ impl Timing {
     }
 }
 
-/// One correctness check of a workload's final state.
+/// What a check compares its value with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bound {
+    /// Within `tolerance` of `expected`.
+    Near {
+        /// The reference value.
+        expected: f64,
+        /// Largest acceptable |value - expected|.
+        tolerance: f64,
+    },
+    /// At least this.
+    AtLeast(f64),
+    /// At most this.
+    AtMost(f64),
+    /// Reported only.
+    Info,
+}
+
+/// One correctness (or target) check of a workload's result.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Check {
     /// What is checked, e.g. `com_y`.
     pub name: String,
     /// The value we got.
     pub value: f64,
-    /// What it should be, where known.
-    pub expected: Option<f64>,
-    /// Largest acceptable |value - expected|.
-    pub tolerance: f64,
+    /// What it must satisfy.
+    pub bound: Bound,
 }
 
 impl Check {
-    /// A check against an expected value.
+    /// A check against a reference value.
     pub fn new(name: &str, value: f64, expected: f64, tolerance: f64) -> Check {
         Check {
             name: name.into(),
             value,
-            expected: Some(expected),
-            tolerance,
+            bound: Bound::Near {
+                expected,
+                tolerance,
+            },
+        }
+    }
+    /// A value that must be at least `min`.
+    pub fn at_least(name: &str, value: f64, min: f64) -> Check {
+        Check {
+            name: name.into(),
+            value,
+            bound: Bound::AtLeast(min),
+        }
+    }
+    /// A value that must be at most `max`.
+    pub fn at_most(name: &str, value: f64, max: f64) -> Check {
+        Check {
+            name: name.into(),
+            value,
+            bound: Bound::AtMost(max),
         }
     }
     /// A value reported without a reference.
@@ -103,14 +139,21 @@ impl Check {
         Check {
             name: name.into(),
             value,
-            expected: None,
-            tolerance: 0.0,
+            bound: Bound::Info,
         }
     }
     /// Whether it passed (`None` when there is nothing to compare with).
     pub fn passed(&self) -> Option<bool> {
-        self.expected
-            .map(|e| (self.value - e).abs() <= self.tolerance && self.value.is_finite())
+        let v = self.value;
+        match self.bound {
+            Bound::Near {
+                expected,
+                tolerance,
+            } => Some((v - expected).abs() <= tolerance && v.is_finite()),
+            Bound::AtLeast(min) => Some(v >= min),
+            Bound::AtMost(max) => Some(v <= max),
+            Bound::Info => None,
+        }
     }
 }
 
@@ -202,6 +245,29 @@ pub fn measure_pair<SA, SB>(
     (Timing::from_runs(ta), Timing::from_runs(tb), last_a, last_b)
 }
 
+/// Times `runs` runs of `run` after one warm-up; returns the timing and the
+/// last state.
+pub fn measure<S>(
+    runs: usize,
+    mut setup: impl FnMut() -> S,
+    mut run: impl FnMut(&mut S),
+) -> (Timing, S) {
+    let mut once = || {
+        let mut s = setup();
+        let t = Instant::now();
+        run(&mut s);
+        (t.elapsed().as_secs_f64(), s)
+    };
+    let (_, mut last) = once();
+    let mut times = Vec::new();
+    for _ in 0..runs {
+        let (t, s) = once();
+        times.push(t);
+        last = s;
+    }
+    (Timing::from_runs(times), last)
+}
+
 /// Runs one named workload; each mass-spring workload gives a row per integrator.
 pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
     let runs = opts.runs.max(5);
@@ -209,6 +275,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "chain-64" | "cloth-32" | "cloth-128" => Ok(run_mass_spring(name, runs)),
         "nbody5" => Ok(vec![run_nbody5(opts.quick, runs)]),
         "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
+        "hopper" => hopper::run(opts.quick, runs),
         _ => Err(format!(
             "unknown workload `{name}` (expected one of: {})",
             WORKLOADS.join(", ")

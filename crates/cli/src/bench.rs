@@ -68,13 +68,20 @@ fn print_row(r: &Row) {
             Some(false) => "MISMATCH".to_string(),
             None => "info".to_string(),
         };
-        match c.expected {
-            Some(e) => println!(
-                "    {:<30} {:>+.10e}  expected {:>+.10e} ± {:.1e}  {verdict}",
-                c.name, c.value, e, c.tolerance
-            ),
-            None => println!("    {:<30} {:>+.10e}  {verdict}", c.name, c.value),
-        }
+        use animats_bench::Bound;
+        let against = match c.bound {
+            Bound::Near {
+                expected,
+                tolerance,
+            } => format!("expected {expected:>+.10e} ± {tolerance:.1e}"),
+            Bound::AtLeast(min) => format!("at least {min}"),
+            Bound::AtMost(max) => format!("at most {max}"),
+            Bound::Info => String::new(),
+        };
+        println!(
+            "    {:<30} {:>+.10e}  {against}  {verdict}",
+            c.name, c.value
+        );
     }
 }
 

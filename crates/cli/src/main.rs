@@ -2,9 +2,12 @@
 //! arguments, loads files, calls the library, and reports.
 //!
 //! Exit status: 0 success, 2 bad input (arguments, scene or parameter files,
-//! unwritable outputs), 3 the simulation blew up, 1 anything else.
+//! unwritable outputs, corrupt checkpoints), 3 the simulation blew up,
+//! 130 interrupted by Ctrl-C (after saving), 1 anything else.
 
 mod bench;
+mod evolve;
+mod hop;
 mod output;
 mod simulate;
 
@@ -12,7 +15,7 @@ use clap::{Parser, Subcommand};
 use std::process::ExitCode;
 
 /// Build creatures from the physics up: simulate scenes of point masses,
-/// springs and joints, and benchmark the engine.
+/// springs and joints, evolve hopping gaits, and benchmark the engine.
 #[derive(Parser)]
 #[command(name = "animats", version, about, long_about = None)]
 struct Cli {
@@ -24,6 +27,10 @@ struct Cli {
 enum Command {
     /// Run a scene file headless; write its trajectory or print a summary.
     Simulate(simulate::Args),
+    /// Simulate one hopping roobot with a parameter set and report its fitness.
+    Hop(hop::Args),
+    /// Evolve hopping gaits with the thesis's evolver, lanes in parallel.
+    Evolve(evolve::Args),
     /// Run the standard benchmark workloads beside hand-written baselines.
     Bench(bench::Args),
 }
@@ -34,6 +41,8 @@ pub enum Failure {
     Input(String),
     /// The simulation went non-finite: exit 3.
     Blowup(String),
+    /// Stopped by Ctrl-C after saving its work: exit 130.
+    Interrupted(String),
     /// Anything else: exit 1.
     Other(String),
 }
@@ -42,6 +51,8 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Simulate(args) => simulate::run(args),
+        Command::Hop(args) => hop::run(args),
+        Command::Evolve(args) => evolve::run(args),
         Command::Bench(args) => bench::run(args),
     };
     match result {
@@ -53,6 +64,10 @@ fn main() -> ExitCode {
         Err(Failure::Blowup(m)) => {
             eprintln!("error: {m}");
             ExitCode::from(3)
+        }
+        Err(Failure::Interrupted(m)) => {
+            eprintln!("{m}");
+            ExitCode::from(130)
         }
         Err(Failure::Other(m)) => {
             eprintln!("error: {m}");

@@ -31,6 +31,7 @@ pub mod world;
 pub use error::{ModelError, SimError};
 pub use event::{DiscreteEvent, EventContext, EventState};
 pub use events::floor_collision::{Collision, FloorCollision};
+pub use events::plane_constraint::PlaneConstraint;
 pub use force::{Force, ForceContext, Stage, Targets};
 pub use force_set::Forces;
 pub use forces::{

@@ -375,3 +375,42 @@ fn a_blow_up_is_an_error_and_the_world_keeps_its_last_finite_state() {
     );
     assert_eq!(w.step(-1.0), Err(animats_engine::SimError::BadStep(-1.0)));
 }
+
+#[test]
+fn a_plane_constraint_keeps_a_body_in_a_tilted_plane() {
+    use animats_engine::PlaneConstraint;
+    // A pendulum swinging in a vertical plane at 37° from the x axis. Its
+    // forces lie in the plane only up to rounding; the constraint keeps it in.
+    let a = 37f64.to_radians();
+    let along = DVec3::new(a.cos(), 0.0, -a.sin());
+    let normal = along.cross(DVec3::Y);
+    let mut w = World::new();
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    let pivot = w
+        .add_particle(ParticleDef::new(1.0).at(DVec3::new(0.3, 2.0, 0.7)).fixed())
+        .unwrap();
+    let bob = w
+        .add_particle(
+            ParticleDef::new(0.2)
+                .at(DVec3::new(0.3, 2.0, 0.7) + along * 0.5)
+                .with_velocity(normal * 0.01),
+        )
+        .unwrap();
+    w.add_spring(SpringDef::new(pivot, bob, 500.0, 0.0))
+        .unwrap();
+    w.add_event(Box::new(PlaneConstraint::new(
+        DVec3::new(0.3, 2.0, 0.7),
+        normal,
+        vec![pivot, bob],
+    )));
+    let mut lowest = f64::INFINITY;
+    for _ in 0..5000 {
+        w.step(1e-3).unwrap();
+        lowest = lowest.min(w.position(bob).y);
+        let off = (w.position(bob) - DVec3::new(0.3, 2.0, 0.7)).dot(normal);
+        assert!(off.abs() < 1e-15, "left the plane by {off}");
+        assert!(w.velocity(bob).dot(normal).abs() < 1e-15);
+    }
+    // It did swing, down through the bottom of its arc.
+    assert!(lowest < 2.0 - 0.45, "lowest point {lowest}");
+}

@@ -5,6 +5,8 @@ use crate::def::*;
 use crate::error::SceneError;
 use crate::source::Source;
 use crate::Scene;
+use animats_creatures::roobot::{BodyConstants, Roobot};
+use animats_creatures::Creature;
 use animats_engine::DVec3;
 use animats_engine::{
     AngleJointDef, Current, FloorDef, FluidMedium, Gravity, ModelError, NBodyGravity, ParticleDef,
@@ -269,11 +271,58 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .map_err(|e| at.model(e))?;
     }
 
+    // [[roobot]]
+    let mut creatures: Vec<Box<dyn Creature>> = Vec::new();
+    for (k, entry) in def.roobot.iter().enumerate() {
+        let r = entry.get_ref();
+        let at = at(src, format!("roobot[{k}]"), entry);
+        let name = r.name.clone().unwrap_or_else(|| format!("roobot{k}"));
+        check_name(&at, &name)?;
+        let position = at.vec3("position", r.position)?;
+        let heading = at.finite("heading", r.heading)?;
+        let params = match &r.params {
+            None => crate::params::load("evolved", None),
+            Some(ParamsEntry::Inline(v)) => crate::params::check(src.file, "params", v),
+            Some(ParamsEntry::Named(n)) if crate::params::BUILT_IN.contains(&n.as_str()) => {
+                crate::params::load(n, None)
+            }
+            Some(ParamsEntry::Named(path)) => {
+                let base = std::path::Path::new(src.file)
+                    .parent()
+                    .unwrap_or(std::path::Path::new(""));
+                crate::params::load(&base.join(path).to_string_lossy(), None)
+            }
+        }
+        .map_err(|e| at.err("params", e.to_string()))?;
+        let first = world.len();
+        let roobot = Roobot::build(
+            &mut world,
+            &name,
+            &BodyConstants::STANDARD,
+            position,
+            heading,
+            params,
+        )
+        .map_err(|e| at.model(e))?;
+        for (i, part) in ["hip", "foot", "head", "tail1", "tail2"].iter().enumerate() {
+            let full = format!("{name}.{part}");
+            if names.ids.contains_key(&full) {
+                return Err(at.err("name", format!("duplicate particle name `{full}`")));
+            }
+            names
+                .ids
+                .insert(full.clone(), ParticleId::from_index(first + i));
+            name_list.push(full);
+        }
+        creatures.push(Box::new(roobot));
+    }
+
     Ok(Scene {
         world,
         names: name_list,
         dt,
         duration,
+        creatures,
     })
 }
 

@@ -38,6 +38,9 @@ pub struct SceneDef {
     /// `[[nbody]]` entries.
     #[serde(default)]
     pub nbody: Vec<Spanned<NBodyEntry>>,
+    /// `[[roobot]]` entries: hopping monopods with their controllers.
+    #[serde(default)]
+    pub roobot: Vec<Spanned<RoobotEntry>>,
 }
 
 /// Integration method names as written in files.
@@ -309,4 +312,31 @@ pub struct NBodyEntry {
 
 fn default_big_g() -> f64 {
     6.674e-11
+}
+
+/// Where a creature's parameters come from: a built-in name or file path, or
+/// the numbers themselves.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ParamsEntry {
+    /// `"evolved"`, `"initial"`, or a parameter file (relative to the scene file).
+    Named(String),
+    /// The 14 numbers inline.
+    Inline(Vec<f64>),
+}
+
+/// `[[roobot]]`: a hopping monopod with its FSM controller.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoobotEntry {
+    /// Prefix of its particles' names (`NAME.hip`...); default `roobot{k}`.
+    pub name: Option<String>,
+    /// Where its foot stands, m (y is ignored: the foot rests on the floor).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Direction it faces, rad from +x, counter-clockwise seen from above.
+    #[serde(default)]
+    pub heading: f64,
+    /// Its hopping parameters; default `"evolved"`.
+    pub params: Option<ParamsEntry>,
 }

@@ -24,6 +24,7 @@
 pub mod build;
 pub mod def;
 pub mod error;
+pub mod params;
 pub mod source;
 
 pub use error::SceneError;
@@ -43,6 +44,8 @@ pub struct Scene {
     pub dt: f64,
     /// Simulated seconds to run.
     pub duration: f64,
+    /// The creatures in the world, each with its controller.
+    pub creatures: Vec<Box<dyn animats_creatures::Creature>>,
 }
 
 impl Scene {
@@ -59,8 +62,12 @@ impl Scene {
         &self.names[p.index()]
     }
 
-    /// Advances the scene by `dt`.
+    /// Advances the scene by `dt`: every creature's controller acts, then
+    /// the world steps.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        for c in &mut self.creatures {
+            c.control(&mut self.world, dt);
+        }
         self.world.step(dt)
     }
 }

@@ -89,7 +89,7 @@ pub struct AngleJoint {
 pub fn angle_at(a: DVec3, j: DVec3, b: DVec3) -> f64 {
     let (ra, rb) = (a - j, b - j);
     // atan2 of |a×b| and a·b is accurate at every angle, unlike acos near 0 and π.
-    ra.cross(rb).length().atan2(ra.dot(rb))
+    libm::atan2(ra.cross(rb).length(), ra.dot(rb))
 }
 
 impl AngleJoint {
@@ -194,22 +194,24 @@ impl Force for AngleJoints {
         for jt in &self.joints {
             let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
             let (ra, rb) = (pos[a] - pos[j], pos[b] - pos[j]);
-            let (la, lb) = (ra.length(), rb.length());
+            let (la2, lb2) = (ra.length_squared(), rb.length_squared());
             let normal = ra.cross(rb);
-            let nl = normal.length();
-            if nl <= 1e-12 * la * lb || la == 0.0 || lb == 0.0 {
+            let n2 = normal.length_squared();
+            if n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0 {
                 continue; // collinear or degenerate: no plane of bending
             }
-            let theta = nl.atan2(ra.dot(rb));
-            let jn = normal / nl;
-            // Unit directions in which each end moves to change the angle:
-            // `ta` turns a towards b (closing), `tb` turns b away from a (opening).
-            let ta = jn.cross(ra) / la;
-            let tb = jn.cross(rb) / lb;
-            let theta_dot = tb.dot(vel[b] - vel[j]) / lb - ta.dot(vel[a] - vel[j]) / la;
+            let nl = n2.sqrt();
+            let theta = libm::atan2(nl, ra.dot(rb));
+            // With ĵ = n/|n|: ĵ × â = (n × a)/(|n||a|), since n ⊥ a. The
+            // force on an end is T/|arm| along that unit vector, so
+            // F_a = (n × a) T / (|n| |a|²): one square root per joint.
+            // `pa` turns a towards b (closing), `pb` turns b away from a.
+            let (pa, pb) = (normal.cross(ra), normal.cross(rb));
+            let (wa, wb) = (1.0 / (nl * la2), 1.0 / (nl * lb2));
+            let theta_dot = pb.dot(vel[b] - vel[j]) * wb - pa.dot(vel[a] - vel[j]) * wa;
             let torque = jt.stiffness * (theta - jt.rest_angle) + jt.damping * theta_dot;
-            let fa = ta * (torque / la);
-            let fb = tb * (-torque / lb);
+            let fa = pa * (torque * wa);
+            let fb = pb * (-torque * wb);
             forces[a] += fa;
             forces[b] += fb;
             forces[j] -= fa + fb;

@@ -69,8 +69,9 @@ impl ReefWater {
         let omega = TAU / self.period;
         let dir = DVec3::new(self.direction.x, 0.0, self.direction.z).normalize_or_zero();
         let depth = (self.surface - p.y).max(0.0);
-        let speed = self.amplitude * omega * (-k * depth).exp();
-        let (s, c) = (k * dir.dot(p) - omega * t).sin_cos();
+        // libm: the same bits on every platform, for reproducible runs.
+        let speed = self.amplitude * omega * libm::exp(-k * depth);
+        let (s, c) = libm::sincos(k * dir.dot(p) - omega * t);
         dir * (speed * c) + DVec3::Y * (speed * s) + self.drift
     }
 }

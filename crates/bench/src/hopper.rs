@@ -1,0 +1,89 @@
+//! `hopper`: the roobot's evolution workload (issue 3). One 20 s fitness
+//! evaluation of the shipped evolved gait (RK4, 8 ms, 2500 steps), and the
+//! thesis's experiment: 6 lanes × 1000 generations from Appendix B's initial
+//! parameters (quick: 100 generations), on every core.
+
+use crate::{measure, Check, Row, Timing};
+use animats_creatures::roobot::evaluate::{evaluate, EvalSettings, Evaluation};
+use animats_evolve::{Config, State};
+
+/// Evaluations timed per run of the single-evaluation measurement.
+const EVALS_PER_RUN: usize = 20;
+
+/// Runs the workload: one row per measurement.
+pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
+    let params = animats_scene::params::load("evolved", None).map_err(|e| e.to_string())?;
+    let settings = EvalSettings::default();
+    let (timing, last): (Timing, Option<Evaluation>) = measure(
+        runs,
+        || None,
+        |out| {
+            for _ in 0..EVALS_PER_RUN {
+                *out = evaluate(params, &settings).ok();
+            }
+        },
+    );
+    let per_eval = Timing {
+        median: timing.median / EVALS_PER_RUN as f64,
+        min: timing.min / EVALS_PER_RUN as f64,
+        max: timing.max / EVALS_PER_RUN as f64,
+        runs: timing.runs,
+    };
+    let e = last.ok_or("the evolved gait could not be evaluated")?;
+    let steps = (settings.seconds / settings.dt).round() as usize;
+    let eval_row = Row {
+        workload: "hopper".into(),
+        variant: "1 evaluation, 20 s, rk4".into(),
+        particles: 5,
+        springs: 4,
+        steps,
+        dt: settings.dt,
+        evaluations: 4,
+        pairs: 0,
+        engine: per_eval,
+        baseline: None,
+        checks: vec![
+            Check::new("time upright", e.time_up, 20.0, 0.0),
+            Check::at_least("times real time", settings.seconds / per_eval.median, 1e4),
+        ],
+    };
+
+    let generations = if quick { 100 } else { 1000 };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    let (evo, state) = measure(
+        runs,
+        || State::new(Config::thesis(6, generations, 1)).expect("valid configuration"),
+        |s| {
+            while !s.done() {
+                pool.install(|| s.advance(10)).expect("evaluations succeed");
+            }
+        },
+    );
+    let stable = state
+        .lanes
+        .iter()
+        .filter(|l| l.best_time_up >= 20.0)
+        .count();
+    let mut checks = vec![Check::info("lanes hopping 20 s", stable as f64)];
+    if !quick {
+        checks.push(Check::at_most("wall time, s", evo.median, 15.0));
+    }
+    let evo_row = Row {
+        workload: "hopper".into(),
+        variant: format!("evolve 6 lanes x {generations} gens, {threads} thr"),
+        particles: 5,
+        springs: 4,
+        steps: 6 * generations as usize * steps,
+        dt: settings.dt,
+        evaluations: 4,
+        pairs: 0,
+        engine: evo,
+        baseline: None,
+        checks,
+    };
+    Ok(vec![eval_row, evo_row])
+}

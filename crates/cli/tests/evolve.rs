@@ -1,0 +1,318 @@
+//! `animats hop` and `animats evolve` through the real binary.
+
+mod common;
+use common::*;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+#[test]
+fn hop_reports_the_initial_and_evolved_gaits() {
+    let o = animats(&["hop", "initial"]);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    for key in [
+        "fitness:",
+        "upright:",
+        "distance:",
+        "hops:",
+        "speed:",
+        "ended:      fell",
+    ] {
+        assert!(out.contains(key), "missing `{key}` in:\n{out}");
+    }
+    let o = animats(&["hop"]); // evolved by default
+    let (out, _) = text(&o);
+    assert!(
+        out.contains("upright:    20.000 s") && out.contains("ended:      timeout"),
+        "{out}"
+    );
+}
+
+#[test]
+fn hop_writes_a_trajectory_like_simulate() {
+    let dir = scratch("hop-traj");
+    let out = dir.join("hop.csv");
+    let o = animats(&[
+        "hop",
+        "evolved",
+        "--seconds",
+        "1",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let csv = std::fs::read_to_string(&out).unwrap();
+    assert_eq!(csv.lines().next(), Some("t,particle,x,y,z,vx,vy,vz"));
+    assert_eq!(
+        csv.lines().count(),
+        1 + 5 * 126,
+        "t = 0 and 125 steps of 8 ms, five particles"
+    );
+    assert!(csv.lines().nth(1).unwrap().starts_with("0.0,roobot.hip,"));
+}
+
+#[test]
+fn bad_parameter_files_are_refused_naming_file_and_field() {
+    let dir = scratch("bad-params");
+    let ok = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../params/initial.toml"
+    ))
+    .unwrap();
+    let cases = [
+        (
+            "short.toml",
+            ok.replace("    4.0,", ""),
+            "params: expected 14 numbers, got 13",
+        ),
+        (
+            "nan.toml",
+            ok.replace("0.55,", "nan,"),
+            "params[1]: must be a finite number",
+        ),
+        (
+            "unknown.toml",
+            format!("{ok}\nspeed = 3\n"),
+            "unknown field `speed`",
+        ),
+        ("empty.toml", String::new(), "params: missing"),
+    ];
+    for (name, content, expect) in cases {
+        let path = write(&dir, name, &content);
+        let o = animats(&["hop", &path]);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(name) && err.contains(expect), "{name}: {err}");
+    }
+    let o = animats(&["hop", "fastest"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("built-in sets: initial, evolved"));
+    let o = animats(&["hop", "evolved", "--lane", "3"]);
+    assert_eq!(o.status.code(), Some(2), "the built-in set has no lanes");
+}
+
+fn evolve(args: &[&str]) -> std::process::Output {
+    let mut all = vec!["evolve"];
+    all.extend_from_slice(args);
+    animats(&all)
+}
+
+fn log(dir: &std::path::Path) -> String {
+    std::fs::read_to_string(dir.join("log.csv")).unwrap()
+}
+
+#[test]
+fn evolve_writes_its_outputs_and_is_identical_on_one_or_two_threads() {
+    let base = scratch("evolve-threads");
+    let (a, b) = (base.join("one"), base.join("two"));
+    for (dir, threads) in [(&a, "1"), (&b, "2")] {
+        let o = evolve(&[
+            "--generations",
+            "40",
+            "--lanes",
+            "4",
+            "--seed",
+            "5",
+            "--threads",
+            threads,
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o).1);
+    }
+    assert_eq!(log(&a), log(&b));
+    assert!(log(&a).starts_with("lane,generation,fitness,time_up,distance,p0,p1,"));
+    for file in ["best.toml", "fitness.png", "checkpoint.json"] {
+        assert!(a.join(file).exists(), "{file}");
+    }
+    let png = std::fs::read(a.join("fitness.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    // best.toml loads back into `animats hop`, and scores what the log says.
+    let o = animats(&["hop", a.join("best.toml").to_str().unwrap(), "--lane", "2"]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let best_of_lane_2 = log(&a)
+        .lines()
+        .rev()
+        .find(|l| l.starts_with("2,"))
+        .unwrap()
+        .split(',')
+        .nth(2)
+        .unwrap()
+        .to_string();
+    let fitness: f64 = best_of_lane_2.parse().unwrap();
+    assert!(
+        text(&o).0.contains(&format!("fitness:    {fitness:.4}")),
+        "{}",
+        text(&o).0
+    );
+}
+
+/// Waits until `dir/checkpoint.json` exists.
+fn wait_for_checkpoint(dir: &std::path::Path) {
+    let t = Instant::now();
+    while !dir.join("checkpoint.json").exists() {
+        assert!(
+            t.elapsed() < Duration::from_secs(60),
+            "no checkpoint appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+fn generation_in_checkpoint(dir: &std::path::Path) -> u64 {
+    let text = std::fs::read_to_string(dir.join("checkpoint.json")).unwrap();
+    let state: serde_json::Value = serde_json::from_str(text.lines().nth(1).unwrap()).unwrap();
+    state["lanes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["generation"].as_u64().unwrap())
+        .min()
+        .unwrap()
+}
+
+#[test]
+fn a_run_killed_part_way_and_resumed_logs_exactly_what_an_unstopped_run_does() {
+    let base = scratch("evolve-kill");
+    let (whole, killed) = (base.join("whole"), base.join("killed"));
+    let args = [
+        "--generations",
+        "400",
+        "--lanes",
+        "2",
+        "--seed",
+        "3",
+        "--checkpoint-every",
+        "0",
+    ];
+    let mut first: Vec<&str> = args.to_vec();
+    first.extend(["--out", whole.to_str().unwrap()]);
+    assert!(evolve(&first).status.success());
+
+    let mut child = Command::new(env!("CARGO_BIN_EXE_animats"))
+        .arg("evolve")
+        .args(args)
+        .args(["--out", killed.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    wait_for_checkpoint(&killed);
+    child.kill().unwrap(); // SIGKILL: no chance to clean up
+    child.wait().unwrap();
+    let at = generation_in_checkpoint(&killed);
+    assert!(
+        at < 400,
+        "the run finished before it could be killed (generation {at})"
+    );
+
+    let o = evolve(&["--resume", killed.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert_eq!(log(&killed), log(&whole), "resumed from generation {at}");
+}
+
+#[test]
+fn ctrl_c_stops_cleanly_with_a_checkpoint_and_the_run_resumes() {
+    let base = scratch("evolve-int");
+    let (whole, stopped) = (base.join("whole"), base.join("stopped"));
+    let args = [
+        "--generations",
+        "400",
+        "--lanes",
+        "2",
+        "--seed",
+        "4",
+        "--checkpoint-every",
+        "1000",
+    ];
+    let mut first: Vec<&str> = args.to_vec();
+    first.extend(["--out", whole.to_str().unwrap()]);
+    assert!(evolve(&first).status.success());
+
+    let child = Command::new(env!("CARGO_BIN_EXE_animats"))
+        .arg("evolve")
+        .args(args)
+        .args(["--out", stopped.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(150));
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(130) {
+        // Stopped early: it saved everything and says how to go on.
+        assert!(err.contains("--resume"), "{err}");
+        assert!(generation_in_checkpoint(&stopped) < 400);
+    } else {
+        assert!(out.status.success(), "{err}"); // finished before the signal
+    }
+    let o = evolve(&["--resume", stopped.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert_eq!(log(&stopped), log(&whole));
+}
+
+#[test]
+fn bad_outputs_and_checkpoints_are_refused_before_any_work() {
+    let base = scratch("evolve-bad");
+    // An --out inside a regular file cannot be created.
+    let file = base.join("file");
+    std::fs::write(&file, "x").unwrap();
+    let out = file.join("run");
+    let o = evolve(&["--generations", "5", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o).1);
+    assert!(text(&o).1.contains("cannot"), "{}", text(&o).1);
+
+    // A directory that already holds a run is not overwritten.
+    let run = base.join("run");
+    assert!(evolve(&[
+        "--generations",
+        "3",
+        "--lanes",
+        "1",
+        "--out",
+        run.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let before = log(&run);
+    let o = evolve(&["--generations", "5", "--out", run.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("--resume"));
+    assert_eq!(log(&run), before);
+
+    // A corrupt checkpoint is refused, never silently restarted.
+    let cp = run.join("checkpoint.json");
+    let mut bytes = std::fs::read(&cp).unwrap();
+    let n = bytes.len();
+    bytes[n - 10] ^= 0x01;
+    std::fs::write(&cp, &bytes).unwrap();
+    let o = evolve(&["--resume", run.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("corrupt"), "{}", text(&o).1);
+    std::fs::write(&cp, "{}\n").unwrap();
+    let o = evolve(&["--resume", run.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let o = evolve(&["--resume", base.join("nothing-here").to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("cannot read the checkpoint"));
+    // A resumed run keeps its seed.
+    let fresh = base.join("fresh");
+    assert!(evolve(&[
+        "--generations",
+        "2",
+        "--lanes",
+        "1",
+        "--out",
+        fresh.to_str().unwrap()
+    ])
+    .status
+    .success());
+    let o = evolve(&["--resume", fresh.to_str().unwrap(), "--seed", "99"]);
+    assert_eq!(o.status.code(), Some(2));
+}

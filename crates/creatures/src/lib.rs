@@ -1,0 +1,21 @@
+//! # animats-creatures
+//!
+//! The animat layer (thesis §2.3.2, §4.2) on top of the engine: sensors that
+//! report a level in [0, 1], actuators that map a level in [0, 1] onto a
+//! physical parameter, controllers that read the one and set the other once
+//! per step, and the thesis's creatures built from them.
+//!
+//! - [`sensor::Sensor`], one sensor per file in [`sensors`];
+//! - [`actuator::Actuator`] over an [`actuator::Actuated`] parameter, one per
+//!   file in [`actuators`];
+//! - [`controller::Controller`] and [`controller::Creature`];
+//! - [`roobot`]: the hopping monopod and its FSM.
+
+pub mod actuator;
+pub mod actuators;
+pub mod controller;
+pub mod roobot;
+pub mod sensor;
+pub mod sensors;
+
+pub use controller::{Controller, Creature, Status};

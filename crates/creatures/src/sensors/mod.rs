@@ -1,0 +1,11 @@
+//! The sensors, one per file.
+
+pub mod height;
+pub mod speed;
+pub mod tilt;
+pub mod touchdown;
+
+pub use height::HeightSensor;
+pub use speed::SpeedSensor;
+pub use tilt::TiltSensor;
+pub use touchdown::TouchdownSensor;

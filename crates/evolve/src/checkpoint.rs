@@ -1,0 +1,98 @@
+//! Checkpoints: the whole [`State`] of a run, written atomically (a temporary
+//! file, synced, then renamed over the old one) so that a crash at any moment
+//! leaves either the previous checkpoint or the new one, never half of one.
+//!
+//! The file is two lines: a header with the format name, version and an
+//! FNV-1a checksum of the second line, then the state as JSON. A file that is
+//! truncated, edited or from another program is refused with a message.
+
+use crate::run::State;
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::Path;
+
+const FORMAT: &str = "animats-evolve-checkpoint";
+const VERSION: u32 = 1;
+
+#[derive(Serialize, Deserialize)]
+struct Header {
+    format: String,
+    version: u32,
+    checksum: String,
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+/// Writes `state` to `path` atomically.
+pub fn save(path: &Path, state: &State) -> Result<(), String> {
+    let body =
+        serde_json::to_string(state).map_err(|e| format!("cannot encode the checkpoint: {e}"))?;
+    let header = Header {
+        format: FORMAT.into(),
+        version: VERSION,
+        checksum: format!("{:016x}", fnv1a(body.as_bytes())),
+    };
+    let header = serde_json::to_string(&header).map_err(|e| e.to_string())?;
+    write_atomically(path, format!("{header}\n{body}\n").as_bytes())
+}
+
+/// Writes `bytes` to `path` through a temporary file in the same directory.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    result.map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        format!("{}: cannot write: {e}", path.display())
+    })
+}
+
+/// Reads a checkpoint, refusing anything that is not an intact one.
+pub fn load(path: &Path) -> Result<State, String> {
+    let shown = path.display();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{shown}: cannot read the checkpoint: {e}"))?;
+    let (header, body) = text
+        .split_once('\n')
+        .ok_or_else(|| format!("{shown}: not a checkpoint (no header line)"))?;
+    let header: Header = serde_json::from_str(header)
+        .map_err(|e| format!("{shown}: not an animats checkpoint (bad header: {e})"))?;
+    if header.format != FORMAT {
+        return Err(format!(
+            "{shown}: not an animats evolution checkpoint (format `{}`)",
+            header.format
+        ));
+    }
+    if header.version != VERSION {
+        return Err(format!(
+            "{shown}: checkpoint version {} is not supported (expected {VERSION})",
+            header.version
+        ));
+    }
+    let body = body.strip_suffix('\n').unwrap_or(body);
+    let sum = format!("{:016x}", fnv1a(body.as_bytes()));
+    if sum != header.checksum {
+        return Err(format!(
+            "{shown}: the checkpoint is corrupt (checksum {sum}, expected {}); refusing to resume from it",
+            header.checksum
+        ));
+    }
+    let state: State = serde_json::from_str(body)
+        .map_err(|e| format!("{shown}: the checkpoint is corrupt: {e}"))?;
+    state
+        .validate()
+        .map_err(|e| format!("{shown}: the checkpoint is inconsistent: {e}"))?;
+    Ok(state)
+}
