@@ -163,14 +163,29 @@ fn the_evolved_gait_hops_whichever_way_it_faces() {
     use animats_engine::{DVec3, FloorDef, FluidMedium, World};
     // The planar body is held in its plane, so a heading only rotates the
     // same hop (up to rounding, which this chaotic gait shrugs off).
-    let straight = evaluate(evolved(), &EvalSettings::default()).unwrap().distance;
+    let straight = evaluate(evolved(), &EvalSettings::default())
+        .unwrap()
+        .distance;
     for heading in [0.3, std::f64::consts::FRAC_PI_2, 3.0, -2.0] {
         let mut w = World::new();
         w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
         let base = DVec3::new(1.0, 0.0, -2.0);
-        let mut r = Roobot::build(&mut w, "r", &BodyConstants::STANDARD, base, heading, evolved()).unwrap();
+        let mut r = Roobot::build(
+            &mut w,
+            "r",
+            &BodyConstants::STANDARD,
+            base,
+            heading,
+            evolved(),
+        )
+        .unwrap();
         w.add_fluid(FluidMedium::air()).unwrap();
-        w.add_floor(FloorDef { envelope: 0.01, static_speed: 0.2, ..FloorDef::default() }).unwrap();
+        w.add_floor(FloorDef {
+            envelope: 0.01,
+            static_speed: 0.2,
+            ..FloorDef::default()
+        })
+        .unwrap();
         let x0 = w.position(r.body.hip);
         for _ in 0..2500 {
             assert!(!r.fallen(&w), "heading {heading}: fell at {} s", w.time());
@@ -181,8 +196,14 @@ fn the_evolved_gait_hops_whichever_way_it_faces() {
         let along = moved.dot(r.body.forward);
         // The gait is chaotic: rounding moves each landing a little, so the
         // distance varies by a few per cent from one start to another.
-        assert!((along - straight).abs() < 0.1 * straight, "heading {heading}: {along} m vs {straight} m");
+        assert!(
+            (along - straight).abs() < 0.1 * straight,
+            "heading {heading}: {along} m vs {straight} m"
+        );
         let sideways = moved.dot(r.body.forward.cross(DVec3::Y));
-        assert!(sideways.abs() < 1e-9 * along, "heading {heading}: drifted {sideways} m sideways");
+        assert!(
+            sideways.abs() < 1e-9 * along,
+            "heading {heading}: drifted {sideways} m sideways"
+        );
     }
 }
