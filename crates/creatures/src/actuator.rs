@@ -77,6 +77,17 @@ impl<T: Actuated> Actuator<T> {
         &self.target
     }
 
+    /// The driven parameter, to change how it is driven (a force's axis);
+    /// the new setting takes effect at the next `set_level` or `reapply`.
+    pub fn target_mut(&mut self) -> &mut T {
+        &mut self.target
+    }
+
+    /// Drives the parameter again at the current level (after `target_mut`).
+    pub fn reapply(&mut self, world: &mut World) {
+        self.target.set(world, self.value());
+    }
+
     /// The range [min, max].
     pub fn range(&self) -> (f64, f64) {
         (self.min, self.max)

@@ -1,9 +1,11 @@
-//! Controllers and creatures (thesis §2.3.2.4, §4.2.3).
+//! Controllers and actors (thesis §2.3.2.4, §4.2.3).
 //!
-//! A controller is the creature's brain: once per step, before the world
-//! advances, it reads its sensors and sets its actuators. A creature is a body
-//! built into a world plus its controller; scenes hold creatures and call
-//! `control` on each before every step.
+//! A controller is a creature's brain: once per step, before the world
+//! advances, it reads its sensors and sets its actuators. An actor is anything
+//! in a scene that acts once per step that way: a creature (a body and its
+//! controller) or an environment process, such as a bubble column spawning
+//! and recycling its bubbles. Scenes call `act` on every actor before every
+//! step.
 
 use animats_engine::World;
 
@@ -23,12 +25,17 @@ pub struct Status {
     pub state: &'static str,
     /// Internal energy in [0, 1], for creatures that have one.
     pub energy: Option<f64>,
+    /// Phase of a periodic motion, rad in [0, 2π) (the jellyfish's pulse).
+    pub phase: Option<f64>,
 }
 
-/// A body in a world with a brain.
-pub trait Creature: Send {
-    /// Decides and acts for the next step (see [`Controller::control`]).
-    fn control(&mut self, world: &mut World, dt: f64);
-    /// Its state now.
-    fn status(&self) -> Status;
+/// Something in a world that acts once per step: a creature's brain, or an
+/// environment process.
+pub trait Actor: Send {
+    /// Acts for the next step (see [`Controller::control`]).
+    fn act(&mut self, world: &mut World, dt: f64);
+    /// A creature's state now; `None` for things that are not creatures.
+    fn status(&self) -> Option<Status> {
+        None
+    }
 }

@@ -8,14 +8,16 @@
 //! - [`sensor::Sensor`], one sensor per file in [`sensors`];
 //! - [`actuator::Actuator`] over an [`actuator::Actuated`] parameter, one per
 //!   file in [`actuators`];
-//! - [`controller::Controller`] and [`controller::Creature`];
+//! - [`controller::Controller`] and [`controller::Actor`];
 //! - [`roobot`]: the hopping monopod and its FSM.
 
 pub mod actuator;
 pub mod actuators;
 pub mod controller;
+pub mod jellyfish;
 pub mod roobot;
+pub mod seaworld;
 pub mod sensor;
 pub mod sensors;
 
-pub use controller::{Controller, Creature, Status};
+pub use controller::{Actor, Controller, Status};

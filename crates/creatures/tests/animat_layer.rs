@@ -127,18 +127,24 @@ fn actuators_map_levels_onto_their_range_and_reset_to_the_initial_level() {
     assert_eq!(w.forces().torque_joints.get(motor).torque, -2.0);
 
     let f = w.add_constant_force(vec![a], DVec3::ZERO).unwrap();
-    let mut push = Actuator::new(
-        ForceMagnitude {
-            force: f,
-            direction: DVec3::Y,
-        },
-        0.0,
-        4.0,
-        &w,
-    );
-    push.set_level(&mut w, 0.75);
+    let axis = DVec3::Y;
+    let mut push = Actuator::new(ForceMagnitude { force: f, axis }, -4.0, 4.0, &w);
+    assert_eq!(push.level(), 0.5, "a zero force is the middle of [-4, 4]");
+    push.set_level(&mut w, 0.875);
     assert_eq!(
         w.forces().constant_forces.get(f).force,
         DVec3::new(0.0, 3.0, 0.0)
+    );
+    // Negative magnitudes point against the axis; turning the axis keeps the level.
+    push.set_level(&mut w, 0.25);
+    assert_eq!(
+        w.forces().constant_forces.get(f).force,
+        DVec3::new(0.0, -2.0, 0.0)
+    );
+    push.target_mut().axis = DVec3::X;
+    push.reapply(&mut w);
+    assert_eq!(
+        w.forces().constant_forces.get(f).force,
+        DVec3::new(-2.0, 0.0, 0.0)
     );
 }

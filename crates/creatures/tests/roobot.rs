@@ -159,7 +159,7 @@ fn hip_motor_acts_only_in_flight_and_ankle_only_in_stance() {
 #[test]
 fn the_evolved_gait_hops_whichever_way_it_faces() {
     use animats_creatures::roobot::{BodyConstants, Roobot};
-    use animats_creatures::Creature;
+    use animats_creatures::Actor;
     use animats_engine::{DVec3, FloorDef, FluidMedium, World};
     // The planar body is held in its plane, so a heading only rotates the
     // same hop (up to rounding, which this chaotic gait shrugs off).
@@ -189,7 +189,7 @@ fn the_evolved_gait_hops_whichever_way_it_faces() {
         let x0 = w.position(r.body.hip);
         for _ in 0..2500 {
             assert!(!r.fallen(&w), "heading {heading}: fell at {} s", w.time());
-            r.control(&mut w, 0.008);
+            r.act(&mut w, 0.008);
             w.step(0.008).unwrap();
         }
         let moved = w.position(r.body.hip) - x0;

@@ -207,6 +207,15 @@ impl World {
         }
     }
 
+    /// Changes the mass of `p` (kg, > 0; a fixed particle stays fixed).
+    pub fn set_mass(&mut self, p: ParticleId, mass: f64) {
+        let i = p.index();
+        self.particles.mass[i] = mass;
+        if !self.particles.fixed[i] {
+            self.particles.inv_mass[i] = 1.0 / mass;
+        }
+    }
+
     /// Changes the volume of `p`; its radius follows (a sphere).
     pub fn set_volume(&mut self, p: ParticleId, volume: f64) {
         self.particles.volume[p.index()] = volume;

@@ -5,8 +5,12 @@ use crate::def::*;
 use crate::error::SceneError;
 use crate::source::Source;
 use crate::Scene;
+use animats_creatures::jellyfish::{Jellyfish, JellyfishConstants};
 use animats_creatures::roobot::{BodyConstants, Roobot};
-use animats_creatures::Creature;
+use animats_creatures::seaworld::{
+    rocks, seaweed, BubbleColumn, BubbleConstants, Random, RocksConstants, SeaweedConstants,
+};
+use animats_creatures::Actor;
 use animats_engine::DVec3;
 use animats_engine::{
     AngleJointDef, Current, FloorDef, FluidMedium, Gravity, ModelError, NBodyGravity, ParticleDef,
@@ -174,6 +178,33 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         name_list.push(p.name.clone());
     }
 
+    // [[food]]: before the creatures that smell it.
+    for (k, entry) in def.food.iter().enumerate() {
+        let f = entry.get_ref();
+        let at = at(src, format!("food[{k}]"), entry);
+        check_name(&at, &f.name)?;
+        if names.ids.contains_key(&f.name) {
+            return Err(at.err("name", format!("duplicate particle name `{}`", f.name)));
+        }
+        let position = at.vec3("position", f.position)?;
+        let radius = match f.radius {
+            Some(r) => at.positive("radius", r)?,
+            None => animats_engine::particle::sphere_radius(1e-3),
+        };
+        // Appendix B's food is 1 kg in a litre; it is nailed in place (the
+        // thesis never simulates it) and moved by hand.
+        let id = world
+            .add_particle(
+                ParticleDef::new(1.0)
+                    .with_radius(radius)
+                    .at(position)
+                    .fixed(),
+            )
+            .map_err(|e| at.model(e))?;
+        names.ids.insert(f.name.clone(), id);
+        name_list.push(f.name.clone());
+    }
+
     // [floor]
     if let Some(entry) = &def.floor {
         let f = entry.get_ref();
@@ -272,7 +303,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     }
 
     // [[roobot]]
-    let mut creatures: Vec<Box<dyn Creature>> = Vec::new();
+    let mut actors: Vec<Box<dyn Actor>> = Vec::new();
     for (k, entry) in def.roobot.iter().enumerate() {
         let r = entry.get_ref();
         let at = at(src, format!("roobot[{k}]"), entry);
@@ -314,16 +345,155 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
                 .insert(full.clone(), ParticleId::from_index(first + i));
             name_list.push(full);
         }
-        creatures.push(Box::new(roobot));
+        actors.push(Box::new(roobot));
     }
 
+    let mut namer = Namer {
+        names: &mut names,
+        list: &mut name_list,
+    };
+    let seed = wd.seed;
+
+    // [[jellyfish]]
+    for (k, entry) in def.jellyfish.iter().enumerate() {
+        let j = entry.get_ref();
+        let at = at(src, format!("jellyfish[{k}]"), entry);
+        let name = j.name.clone().unwrap_or_else(|| format!("jellyfish{k}"));
+        check_name(&at, &name)?;
+        let food = namer.names.ids.get(&j.food).copied().ok_or_else(|| {
+            at.err(
+                "food",
+                format!(
+                    "no particle `{}` to track: add a [[food]] entry named so",
+                    j.food
+                ),
+            )
+        })?;
+        let position = at.vec3("position", j.position)?;
+        let mut constants = JellyfishConstants::new(j.dome_mass, j.tentacle_mass);
+        if let Some(f) = j.pulse_force {
+            constants.pulse_force = at.positive("pulse_force", f)?;
+        }
+        if let Some(f) = j.steer_force {
+            constants.steer_force = at.finite("steer_force", f)?.abs();
+        }
+        if let Some(c) = j.ceiling {
+            constants.ceiling = at.positive("ceiling", c)?;
+        }
+        let first = world.len();
+        let jelly = Jellyfish::build(&mut world, &name, &constants, position, food)
+            .map_err(|e| at.model(e))?;
+        let mut parts: Vec<String> = (0..constants.tentacles)
+            .map(|i| format!("{name}.dome{i}"))
+            .collect();
+        for i in 0..constants.tentacles {
+            parts.extend((0..constants.segments).map(|s| format!("{name}.tentacle{i}.{s}")));
+        }
+        namer.add(&at, first, &parts)?;
+        actors.push(Box::new(jelly));
+    }
+
+    // [[seaweed]]
+    for (k, entry) in def.seaweed.iter().enumerate() {
+        let w = entry.get_ref();
+        let at = at(src, format!("seaweed[{k}]"), entry);
+        let name = w.name.clone().unwrap_or_else(|| format!("seaweed{k}"));
+        check_name(&at, &name)?;
+        let d = SeaweedConstants::default();
+        let c = SeaweedConstants {
+            segments: w.segments.unwrap_or(d.segments),
+            segment_length: w.segment_length.unwrap_or(d.segment_length),
+            mass: w.mass.unwrap_or(d.mass),
+            density: w.density.unwrap_or(d.density),
+            stiffness: w.stiffness.unwrap_or(d.stiffness),
+            damping: w.damping.unwrap_or(d.damping),
+        };
+        let position = at.vec3("position", w.position)?;
+        let first = world.len();
+        seaweed::build(&mut world, &c, position).map_err(|e| at.model(e))?;
+        let parts: Vec<String> = (0..=c.segments).map(|i| format!("{name}.{i}")).collect();
+        namer.add(&at, first, &parts)?;
+    }
+
+    // [[bubble_column]]
+    for (k, entry) in def.bubble_column.iter().enumerate() {
+        let b = entry.get_ref();
+        let at = at(src, format!("bubble_column[{k}]"), entry);
+        let name = b.name.clone().unwrap_or_else(|| format!("bubbles{k}"));
+        check_name(&at, &name)?;
+        let d = BubbleConstants::default();
+        let c = BubbleConstants {
+            bubbles: b.bubbles.unwrap_or(d.bubbles),
+            interval: b.interval.map_or(d.interval, |[a, z]| (a, z)),
+            radius: b.radius.map_or(d.radius, |[a, z]| (a, z)),
+            density: b.density.unwrap_or(d.density),
+            surface: b.surface.unwrap_or(d.surface),
+            spread: d.spread,
+        };
+        let position = at.vec3("position", b.position)?;
+        let base = DVec3::new(position.x, 0.0, position.z);
+        let first = world.len();
+        let column = BubbleColumn::build(&mut world, &c, base, Random::new(seed, 1000 + k as u64))
+            .map_err(|e| at.model(e))?;
+        let parts: Vec<String> = (0..c.bubbles).map(|i| format!("{name}.{i}")).collect();
+        namer.add(&at, first, &parts)?;
+        actors.push(Box::new(column));
+    }
+
+    // [[rocks]]
+    for (k, entry) in def.rocks.iter().enumerate() {
+        let r = entry.get_ref();
+        let at = at(src, format!("rocks[{k}]"), entry);
+        let name = r.name.clone().unwrap_or_else(|| "rock".into());
+        check_name(&at, &name)?;
+        let d = RocksConstants::default();
+        let c = RocksConstants {
+            count: r.count.unwrap_or(d.count),
+            mass: r.mass.map_or(d.mass, |[a, z]| (a, z)),
+            density: r.density.unwrap_or(d.density),
+            from: r.from.map_or(Ok(d.from), |v| at.vec3("from", v))?,
+            to: r.to.map_or(Ok(d.to), |v| at.vec3("to", v))?,
+        };
+        let first = world.len();
+        rocks::scatter(&mut world, &c, &mut Random::new(seed, 2000 + k as u64))
+            .map_err(|e| at.model(e))?;
+        let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
+        namer.add(&at, first, &parts)?;
+    }
+
+    let max_dt = match wd.max_dt {
+        Some(m) => wat.positive("max_dt", m)?,
+        None => dt,
+    };
     Ok(Scene {
         world,
         names: name_list,
         dt,
+        max_dt,
         duration,
-        creatures,
+        actors,
     })
+}
+
+/// Gives names to the particles a builder just added.
+struct Namer<'a> {
+    names: &'a mut Names,
+    list: &'a mut Vec<String>,
+}
+
+impl Namer<'_> {
+    fn add(&mut self, at: &At, first: usize, parts: &[String]) -> Result<(), SceneError> {
+        for (i, full) in parts.iter().enumerate() {
+            if self.names.ids.contains_key(full) {
+                return Err(at.err("name", format!("duplicate particle name `{full}`")));
+            }
+            self.names
+                .ids
+                .insert(full.clone(), ParticleId::from_index(first + i));
+            self.list.push(full.clone());
+        }
+        Ok(())
+    }
 }
 
 fn current(at: &At, c: &CurrentEntry, g: f64) -> Result<Current, SceneError> {

@@ -41,6 +41,21 @@ pub struct SceneDef {
     /// `[[roobot]]` entries: hopping monopods with their controllers.
     #[serde(default)]
     pub roobot: Vec<Spanned<RoobotEntry>>,
+    /// `[[food]]` entries: fixed particles that jellyfish smell.
+    #[serde(default)]
+    pub food: Vec<Spanned<FoodEntry>>,
+    /// `[[jellyfish]]` entries.
+    #[serde(default)]
+    pub jellyfish: Vec<Spanned<JellyfishEntry>>,
+    /// `[[seaweed]]` entries: fronds.
+    #[serde(default)]
+    pub seaweed: Vec<Spanned<SeaweedEntry>>,
+    /// `[[bubble_column]]` entries.
+    #[serde(default)]
+    pub bubble_column: Vec<Spanned<BubbleColumnEntry>>,
+    /// `[[rocks]]` entries: scattered sinking stones.
+    #[serde(default)]
+    pub rocks: Vec<Spanned<RocksEntry>>,
 }
 
 /// Integration method names as written in files.
@@ -86,6 +101,11 @@ pub struct WorldDef {
     /// Simulated seconds, > 0; default 5.
     #[serde(default = "default_duration")]
     pub duration: f64,
+    /// Largest stable step, s: real-time mode never steps longer; default `dt`.
+    pub max_dt: Option<f64>,
+    /// Seed of every random placement and spawn; default 1.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
 }
 
 impl Default for WorldDef {
@@ -95,8 +115,14 @@ impl Default for WorldDef {
             dt: default_dt(),
             integrator: IntegratorName::default(),
             duration: default_duration(),
+            max_dt: None,
+            seed: default_seed(),
         }
     }
+}
+
+fn default_seed() -> u64 {
+    1
 }
 
 fn default_gravity() -> [f64; 3] {
@@ -217,9 +243,9 @@ pub enum CurrentEntry {
     Reef {
         /// Height of the mean water surface, m; default 1.5.
         surface: Option<f64>,
-        /// Wave amplitude at the surface, m; default 0.08.
+        /// Wave amplitude at the surface, m; default 0.1.
         amplitude: Option<f64>,
-        /// m; default 1.5.
+        /// m; default 3.
         wavelength: Option<f64>,
         /// s; default: deep-water waves of that wavelength.
         period: Option<f64>,
@@ -339,4 +365,115 @@ pub struct RoobotEntry {
     pub heading: f64,
     /// Its hopping parameters; default `"evolved"`.
     pub params: Option<ParamsEntry>,
+}
+
+/// `[[food]]`: a fixed particle that jellyfish track.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoodEntry {
+    /// Default `food`.
+    #[serde(default = "default_food")]
+    pub name: String,
+    /// m.
+    pub position: [f64; 3],
+    /// m; default 0.062 (Appendix B's volume of 1 litre).
+    pub radius: Option<f64>,
+}
+
+fn default_food() -> String {
+    "food".into()
+}
+
+/// `[[jellyfish]]`: Appendix B's jellyfish.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JellyfishEntry {
+    /// Prefix of its particles' names; default `jellyfish{k}`.
+    pub name: Option<String>,
+    /// Centre of its dome, m.
+    pub position: [f64; 3],
+    /// Mass of each dome mass, kg; default 0.2.
+    #[serde(default = "default_dome_mass")]
+    pub dome_mass: f64,
+    /// Mass of each tentacle segment, kg; default 0.02.
+    #[serde(default = "default_tentacle_mass")]
+    pub tentacle_mass: f64,
+    /// The particle it tracks; default `food`.
+    #[serde(default = "default_food")]
+    pub food: String,
+    /// Pulse force range per dome mass, N; default 4.5× the submerged weight
+    /// it carries (Appendix B: 5).
+    pub pulse_force: Option<f64>,
+    /// Steering force range per dome mass, N; default a tenth of the pulse's
+    /// (Appendix B: 0.5).
+    pub steer_force: Option<f64>,
+    /// Height its depth sense reads as "too high", m; default 1.
+    pub ceiling: Option<f64>,
+}
+
+fn default_dome_mass() -> f64 {
+    0.2
+}
+fn default_tentacle_mass() -> f64 {
+    0.02
+}
+
+/// `[[seaweed]]`: a frond nailed to the floor.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeaweedEntry {
+    /// Prefix of its particles' names; default `seaweed{k}`.
+    pub name: Option<String>,
+    /// Where its base is nailed, m (y is ignored: on the floor).
+    pub position: [f64; 3],
+    /// Default 12.
+    pub segments: Option<usize>,
+    /// m; default 0.06.
+    pub segment_length: Option<f64>,
+    /// kg per segment; default 0.004.
+    pub mass: Option<f64>,
+    /// kg/m³; default 980.
+    pub density: Option<f64>,
+    /// N/m; default 10.
+    pub stiffness: Option<f64>,
+    /// N s/m; default 0.02.
+    pub damping: Option<f64>,
+}
+
+/// `[[bubble_column]]`: a particle system of rising bubbles.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BubbleColumnEntry {
+    /// Prefix of its particles' names; default `bubbles{k}`.
+    pub name: Option<String>,
+    /// Base of the column, m (y is ignored: on the floor).
+    pub position: [f64; 3],
+    /// Bubbles in the pool; default 15.
+    pub bubbles: Option<usize>,
+    /// Time between spawns, s; default [0.1, 0.4].
+    pub interval: Option<[f64; 2]>,
+    /// Bubble radius range, m; default [0.002, 0.005].
+    pub radius: Option<[f64; 2]>,
+    /// Effective density with added mass, kg/m³; default 500.
+    pub density: Option<f64>,
+    /// Water surface height, m; default 1.5.
+    pub surface: Option<f64>,
+}
+
+/// `[[rocks]]`: stones scattered at random.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RocksEntry {
+    /// Prefix of their names; default `rock` (`rock0`, `rock1`...).
+    pub name: Option<String>,
+    /// How many; default 10.
+    pub count: Option<usize>,
+    /// Mass range, kg; default [0.05, 0.3].
+    pub mass: Option<[f64; 2]>,
+    /// kg/m³; default 2000.
+    pub density: Option<f64>,
+    /// Least corner of the drop box, m; default [-0.5, 0.2, -0.5].
+    pub from: Option<[f64; 3]>,
+    /// Greatest corner, m; default [0.5, 1.2, 0.5].
+    pub to: Option<[f64; 3]>,
 }

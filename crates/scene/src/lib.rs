@@ -42,10 +42,13 @@ pub struct Scene {
     pub names: Vec<String>,
     /// Step, s.
     pub dt: f64,
+    /// Largest stable step, s (real-time mode never exceeds it).
+    pub max_dt: f64,
     /// Simulated seconds to run.
     pub duration: f64,
-    /// The creatures in the world, each with its controller.
-    pub creatures: Vec<Box<dyn animats_creatures::Creature>>,
+    /// Everything that acts once per step: creatures with their controllers,
+    /// and environment processes (bubble columns).
+    pub actors: Vec<Box<dyn animats_creatures::Actor>>,
 }
 
 impl Scene {
@@ -62,11 +65,10 @@ impl Scene {
         &self.names[p.index()]
     }
 
-    /// Advances the scene by `dt`: every creature's controller acts, then
-    /// the world steps.
+    /// Advances the scene by `dt`: every actor acts, then the world steps.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
-        for c in &mut self.creatures {
-            c.control(&mut self.world, dt);
+        for a in &mut self.actors {
+            a.act(&mut self.world, dt);
         }
         self.world.step(dt)
     }

@@ -12,7 +12,7 @@ fn roobots_in_a_scene_hop_along_their_headings() {
         "[[roobot]]\nname = \"a\"\nheading = 0.0\n\n[[roobot]]\nname = \"b\"\nposition = [5.0, 0.0, 5.0]\nheading = 2.5\nparams = \"evolved\"\n",
     )
     .unwrap();
-    assert_eq!(s.creatures.len(), 2);
+    assert_eq!(s.actors.len(), 2);
     assert_eq!(
         s.names[..5],
         ["a.hip", "a.foot", "a.head", "a.tail1", "a.tail2"]
@@ -31,7 +31,7 @@ fn roobots_in_a_scene_hop_along_their_headings() {
     assert!(da > 2.0 && db > 2.0, "hopped {da} m and {db} m forward");
     // Both are upright and in flight or stance, not fallen.
     assert!(s.world.position(ha).y > 0.2 && s.world.position(hb).y > 0.2);
-    assert!(["stance", "leap", "launch", "flight"].contains(&s.creatures[1].status().state));
+    assert!(["stance", "leap", "launch", "flight"].contains(&s.actors[1].status().unwrap().state));
 }
 
 #[test]

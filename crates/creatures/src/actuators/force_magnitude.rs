@@ -1,17 +1,19 @@
-//! The magnitude of a constant force along a direction, as an actuated
-//! parameter (the jellyfish's pulse and steering forces).
+//! The signed magnitude of a constant force along an axis, as an actuated
+//! parameter (the jellyfish's pulse and steering forces, Appendix B's
+//! `ConstantForceActuator`). The controller may turn the axis each step
+//! (the jellyfish points it along its dome's normal); the magnitude may be
+//! negative (a force against the axis).
 
 use crate::actuator::Actuated;
 use animats_engine::{ConstantForceId, DVec3, World};
 
-/// The magnitude of a constant force; setting it keeps the force's current
-/// direction (or `direction` when the force is zero).
+/// `force = axis × magnitude` for one constant force.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ForceMagnitude {
     /// The force driven.
     pub force: ConstantForceId,
-    /// Direction used when the force is zero.
-    pub direction: DVec3,
+    /// Unit axis of the force.
+    pub axis: DVec3,
 }
 
 impl Actuated for ForceMagnitude {
@@ -21,14 +23,12 @@ impl Actuated for ForceMagnitude {
             .constant_forces
             .get(self.force)
             .force
-            .length()
+            .dot(self.axis)
     }
     fn set(&self, world: &mut World, value: f64) {
-        let current = world.forces().constant_forces.get(self.force).force;
-        let dir = current.try_normalize().unwrap_or(self.direction);
         world
             .forces_mut()
             .constant_forces
-            .set(self.force, dir * value);
+            .set(self.force, self.axis * value);
     }
 }

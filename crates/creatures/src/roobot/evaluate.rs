@@ -5,7 +5,7 @@
 //! `fitness = time upright + 50 × forward distance of the hip`.
 
 use super::{BodyConstants, HopParams, Roobot};
-use crate::controller::Creature;
+use crate::controller::Actor;
 use animats_engine::{DVec3, FloorDef, FluidMedium, IntegratorKind, ModelError, Targets, World};
 use std::fmt;
 
@@ -143,7 +143,7 @@ pub fn evaluate_with(
             ending = Ending::LegLimit;
             break;
         }
-        roobot.control(&mut world, settings.dt);
+        roobot.act(&mut world, settings.dt);
         if world.step(settings.dt).is_err() {
             ending = Ending::BlewUp;
             break;

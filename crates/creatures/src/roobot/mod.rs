@@ -16,7 +16,7 @@ pub mod params;
 
 use crate::actuator::Actuator;
 use crate::actuators::{JointTorque, SpringRestLength};
-use crate::controller::{Creature, Status};
+use crate::controller::{Actor, Status};
 use crate::sensor::Sensor;
 use crate::sensors::{HeightSensor, SpeedSensor, TiltSensor, TouchdownSensor};
 use animats_engine::{DVec3, ModelError, World};
@@ -157,8 +157,8 @@ fn apply<T: crate::actuator::Actuated>(a: &mut Actuator<T>, world: &mut World, c
     }
 }
 
-impl Creature for Roobot {
-    fn control(&mut self, world: &mut World, dt: f64) {
+impl Actor for Roobot {
+    fn act(&mut self, world: &mut World, dt: f64) {
         let senses = self.sensors.read(world);
         let orders = self.fsm.step(&senses, self.leg.level(), dt);
         apply(&mut self.leg, world, orders.leg);
@@ -181,11 +181,12 @@ impl Creature for Roobot {
         }
     }
 
-    fn status(&self) -> Status {
-        Status {
+    fn status(&self) -> Option<Status> {
+        Some(Status {
             name: self.name.clone(),
             state: self.fsm.state().name(),
             energy: None,
-        }
+            phase: None,
+        })
     }
 }

@@ -1,10 +1,14 @@
 //! The sensors, one per file.
 
+pub mod depth;
+pub mod food;
 pub mod height;
 pub mod speed;
 pub mod tilt;
 pub mod touchdown;
 
+pub use depth::DepthSensor;
+pub use food::FoodSensor;
 pub use height::HeightSensor;
 pub use speed::SpeedSensor;
 pub use tilt::TiltSensor;

@@ -77,14 +77,15 @@ impl ReefWater {
 }
 
 impl Default for ReefWater {
-    /// Waves 1.5 m long with 0.08 m amplitude over a surface at 1.5 m: near the
-    /// sea floor (1.5 m down) the water sways at about 5 cm/s.
+    /// Waves 3 m long with 0.1 m amplitude over a surface at 1.5 m (period
+    /// 1.39 s): the water sways at about 10 cm/s 0.75 m down and 2 cm/s at
+    /// the sea floor, 1.5 m down.
     fn default() -> Self {
         ReefWater {
             surface: 1.5,
-            amplitude: 0.08,
-            wavelength: 1.5,
-            period: ReefWater::deep_water_period(1.5, 9.8),
+            amplitude: 0.1,
+            wavelength: 3.0,
+            period: ReefWater::deep_water_period(3.0, 9.8),
             direction: DVec3::X,
             drift: DVec3::ZERO,
         }

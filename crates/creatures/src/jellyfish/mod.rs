@@ -1,0 +1,144 @@
+//! The jellyfish (thesis §3.2.2, Appendix B `Jellyfish`): a dome of three
+//! masses trailing three tentacles, swimming by pulses of a force along its
+//! dome's normal and steering by pushing one side harder, choosing between
+//! idling, tracking food and hovering by its internal energy.
+//!
+//! - `body.rs`: masses, springs and forces (Appendix B's constants);
+//! - `fsm.rs`: the energy-driven behaviour FSM.
+//!
+//! Sensors: a food sensor at each dome mass and a depth sensor. Actuators:
+//! the pulse force (±5 N per dome mass) and one steering force per dome mass
+//! (±0.5 N), all along the dome's normal, which is recomputed every step.
+
+pub mod body;
+pub mod fsm;
+
+use crate::actuator::Actuator;
+use crate::actuators::ForceMagnitude;
+use crate::controller::{Actor, Status};
+use crate::sensor::Sensor;
+use crate::sensors::{DepthSensor, FoodSensor};
+use animats_engine::{DVec3, ModelError, ParticleId, World};
+pub use body::{Body, JellyfishConstants};
+pub use fsm::{Behaviour, JellyfishFsm, Orders, Senses};
+
+/// A jellyfish in a world.
+#[derive(Clone, Debug)]
+pub struct Jellyfish {
+    /// A name for reports.
+    pub name: String,
+    /// Handles to its parts.
+    pub body: Body,
+    /// One food sensor per dome mass.
+    pub food: Vec<FoodSensor>,
+    /// Its depth sense (dome mass 0).
+    pub depth: DepthSensor,
+    /// The pulse force.
+    pub pulse: Actuator<ForceMagnitude>,
+    /// The steering forces.
+    pub steer: Vec<Actuator<ForceMagnitude>>,
+    /// Its controller.
+    pub fsm: JellyfishFsm,
+    body_radius: f64,
+}
+
+impl Jellyfish {
+    /// Builds a jellyfish with its dome centred at `at`, smelling `food`.
+    pub fn build(
+        world: &mut World,
+        name: &str,
+        constants: &JellyfishConstants,
+        at: DVec3,
+        food: ParticleId,
+    ) -> Result<Jellyfish, ModelError> {
+        let body = body::build(world, constants, at)?;
+        let axis = body.normal(world);
+        let pulse = Actuator::new(
+            ForceMagnitude {
+                force: body.pulse,
+                axis,
+            },
+            -constants.pulse_force,
+            constants.pulse_force,
+            world,
+        );
+        let steer = body
+            .steer
+            .iter()
+            .map(|f| {
+                Actuator::new(
+                    ForceMagnitude { force: *f, axis },
+                    -constants.steer_force,
+                    constants.steer_force,
+                    world,
+                )
+            })
+            .collect();
+        Ok(Jellyfish {
+            name: name.to_string(),
+            food: body
+                .dome
+                .iter()
+                .map(|d| FoodSensor { sensor: *d, food })
+                .collect(),
+            depth: DepthSensor {
+                particle: body.dome[0],
+                ceiling: constants.ceiling,
+            },
+            body,
+            pulse,
+            steer,
+            fsm: JellyfishFsm::new(constants.pulse_period),
+            body_radius: constants.dome_radius,
+        })
+    }
+
+    /// Mean horizontal distance from the dome masses to the food, m.
+    pub fn food_distance(&self, world: &World) -> f64 {
+        self.food.iter().map(|f| f.distance(world)).sum::<f64>() / self.food.len() as f64
+    }
+}
+
+impl Actor for Jellyfish {
+    fn act(&mut self, world: &mut World, dt: f64) {
+        // Every force acts along the dome's current normal.
+        let axis = self.body.normal(world);
+        self.pulse.target_mut().axis = axis;
+        for s in &mut self.steer {
+            s.target_mut().axis = axis;
+        }
+        let centre = self.body.centre(world);
+        let radius = self.body_radius;
+        let senses = Senses {
+            food: self.food.iter().map(|f| f.level(world)).collect(),
+            depth: self.depth.level(world),
+            time: world.time(),
+            lean: self
+                .body
+                .dome
+                .iter()
+                .map(|d| (world.position(*d).y - centre.y) / radius)
+                .collect(),
+        };
+        let orders = self.fsm.step(&senses, dt);
+        match orders.pulse {
+            Some(l) => self.pulse.set_level(world, l),
+            None => self.pulse.reset(world),
+        }
+        for (i, s) in self.steer.iter_mut().enumerate() {
+            match &orders.steer {
+                Some(levels) => s.set_level(world, levels[i]),
+                None => s.reset(world),
+            }
+        }
+    }
+
+    fn status(&self) -> Option<Status> {
+        Some(Status {
+            name: self.name.clone(),
+            state: self.fsm.behaviour().name(),
+            energy: Some(self.fsm.energy()),
+            phase: Some(self.fsm.phase()),
+        })
+    }
+}

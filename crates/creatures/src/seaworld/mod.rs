@@ -1,0 +1,13 @@
+//! The underwater world of the jellyfish (thesis §3.2.2.5, Appendix B
+//! `SeaWorld`): swaying seaweed, rising bubbles and sinking rocks, all moved by
+//! the same `ReefWater` currents (the engine's `Current::Reef`).
+
+pub mod bubble_column;
+pub mod random;
+pub mod rocks;
+pub mod seaweed;
+
+pub use bubble_column::{BubbleColumn, BubbleConstants};
+pub use random::Random;
+pub use rocks::RocksConstants;
+pub use seaweed::{Seaweed, SeaweedConstants};
