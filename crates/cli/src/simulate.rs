@@ -26,6 +26,13 @@ pub struct Args {
     /// Record every N-th step (t = 0 and the last step are always recorded).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..))]
     every: u64,
+    /// Pace the simulation to the wall clock, adapting the step each second
+    /// as the thesis's SeaWorld does (never above the scene's `max_dt`).
+    #[arg(long)]
+    realtime: bool,
+    /// Frames per second to aim for with --realtime.
+    #[arg(long, default_value_t = 60.0, value_parser = positive_f64)]
+    fps: f64,
 }
 
 fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
@@ -34,6 +41,9 @@ fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
+    if args.realtime {
+        return realtime(args);
+    }
     let mut scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     let dt = args.dt.unwrap_or(scene.dt);
     let duration = args.duration.unwrap_or(scene.duration);
@@ -127,5 +137,101 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let path = t.finish().map_err(write_err)?;
         println!("wrote {frames} recorded steps to {}", path.display());
     }
+    Ok(())
+}
+
+/// The thesis's SeaWorld loop (§5.3, Appendix B): frames at a steady rate;
+/// once a second the simulated time per frame is moved a quarter of the way
+/// towards the real time per frame, `new = (3 old + interval/frames)/4`, so
+/// the simulation tracks the wall clock. A frame is taken in equal steps no
+/// longer than the scene's `max_dt` (the thesis took one step per frame and
+/// capped it, falling behind real time when the cap bit).
+fn realtime(args: Args) -> Result<(), Failure> {
+    use std::time::Duration;
+    let mut scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    if let Some(kind) = args.integrator {
+        scene.world.set_integrator(kind);
+    }
+    let max_dt = args.dt.map_or(scene.max_dt, |d| d.min(scene.max_dt));
+    let duration = args.duration.unwrap_or(scene.duration);
+    let mut trajectory = match &args.output {
+        Some(path) => Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?),
+        None => None,
+    };
+    if let Some(t) = trajectory.as_mut() {
+        t.record(0.0, 0, scene.world.state())
+            .map_err(Failure::Other)?;
+    }
+    let frame_period = Duration::from_secs_f64(1.0 / args.fps);
+    let mut frame_dt = 1.0 / args.fps;
+    let start = Instant::now();
+    let mut next_frame = start;
+    let (mut second_start, mut frames, mut sim_at_second) = (start, 0u64, 0.0);
+    let mut steps = 0u64;
+    let mut busy = Duration::ZERO;
+    println!(
+        "{}: real time at {} frames/s, steps of at most {max_dt} s; Ctrl-C to stop",
+        args.scene.display(),
+        args.fps
+    );
+    while scene.world.time() < duration - 1e-12 {
+        let work = Instant::now();
+        let frame = frame_dt.min(duration - scene.world.time());
+        let n = (frame / max_dt).ceil().max(1.0);
+        let h = frame / n;
+        for _ in 0..n as u64 {
+            if let Err(e) = scene.step(h) {
+                let kept = trajectory.and_then(|t| t.abandon());
+                let note = kept.map_or(String::new(), |p| {
+                    format!(" (trajectory so far in {})", p.display())
+                });
+                return Err(Failure::Blowup(format!(
+                    "{}: {e}{note}",
+                    args.scene.display()
+                )));
+            }
+            steps += 1;
+            if let Some(t) = trajectory.as_mut() {
+                if steps % args.every == 0 {
+                    t.record(scene.world.time(), steps, scene.world.state())
+                        .map_err(Failure::Other)?;
+                }
+            }
+        }
+        busy += work.elapsed();
+        frames += 1;
+        next_frame += frame_period;
+        let now = Instant::now();
+        if next_frame > now {
+            std::thread::sleep(next_frame - now);
+        } else {
+            next_frame = now; // behind: do not try to catch up in a burst
+        }
+        let interval = second_start.elapsed().as_secs_f64();
+        if interval >= 1.0 {
+            let sim = scene.world.time() - sim_at_second;
+            println!(
+                "t = {:7.2} s  {:5.1} frames/s  simulated/real {:.3}  step {:.5} s  CPU {:.1}%",
+                scene.world.time(),
+                frames as f64 / interval,
+                sim / interval,
+                frame_dt / n,
+                100.0 * busy.as_secs_f64() / interval
+            );
+            frame_dt = (3.0 * frame_dt + interval / frames as f64) / 4.0;
+            (second_start, frames, sim_at_second, busy) =
+                (Instant::now(), 0, scene.world.time(), Duration::ZERO);
+        }
+    }
+    if let Some(t) = trajectory {
+        let written = t.frames();
+        let path = t.finish().map_err(Failure::Other)?;
+        println!("wrote {written} recorded steps to {}", path.display());
+    }
+    println!(
+        "{steps} steps to t = {:.3} s in {:.2} s of wall time",
+        scene.world.time(),
+        start.elapsed().as_secs_f64()
+    );
     Ok(())
 }

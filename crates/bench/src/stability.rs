@@ -1,0 +1,127 @@
+//! `stability`: the largest stable step (thesis §5.3: "the seaweed fronds
+//! become unstable when the timestep exceeds a certain threshold, which
+//! varies with the strength of the water current"). For one frond of the
+//! default seaweed in the default ReefWater current, and for the whole of
+//! SeaWorld, bisect the step: stable means 30 simulated seconds with every
+//! particle finite and none faster than a bound far above anything physical
+//! in it: 1 m/s for the frond (its segments move at about 10 cm/s), 5 m/s for
+//! SeaWorld (whose fastest things, sinking rocks, fall at about 1.4 m/s).
+//! An exploding mode (RK4, midpoint, symplectic Euler) crosses any such bound
+//! within a few steps; explicit Euler's energy grows slowly instead, so its
+//! limit depends on the bound and the duration.
+
+use crate::{Check, Row, Timing};
+use animats_creatures::seaworld::{seaweed, SeaweedConstants};
+use animats_engine::{Current, DVec3, FloorDef, FluidMedium, IntegratorKind, ReefWater, World};
+use std::time::Instant;
+
+/// One frond of 12 segments in the default reef current, over a floor.
+pub fn frond(kind: IntegratorKind) -> World {
+    let mut w = World::new();
+    w.set_integrator(kind);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    seaweed::build(&mut w, &SeaweedConstants::default(), DVec3::ZERO).expect("valid frond");
+    let mut water = FluidMedium::water();
+    water.current = Current::Reef(ReefWater::default());
+    w.add_fluid(water).expect("valid fluid");
+    w.add_floor(FloorDef::default()).expect("valid floor");
+    w
+}
+
+/// True if `step` advances the system `make` builds for `seconds` without
+/// blowing up.
+pub fn stable(
+    make: &mut dyn FnMut() -> Box<dyn FnMut(f64) -> Result<f64, ()>>,
+    step: f64,
+    seconds: f64,
+    bound: f64,
+) -> bool {
+    let mut advance = make();
+    let n = (seconds / step).ceil() as usize;
+    for _ in 0..n {
+        match advance(step) {
+            Ok(speed) if speed <= bound => {}
+            _ => return false,
+        }
+    }
+    true
+}
+
+/// Bisects the largest stable step in [lo, hi] to 1% (assumes lo is stable).
+pub fn largest_stable_step(
+    make: &mut dyn FnMut() -> Box<dyn FnMut(f64) -> Result<f64, ()>>,
+    seconds: f64,
+    bound: f64,
+) -> f64 {
+    let (mut lo, mut hi) = (1e-4, 0.2);
+    if stable(make, hi, seconds, bound) {
+        return hi;
+    }
+    while hi / lo > 1.01 {
+        let mid = (lo * hi).sqrt();
+        if stable(make, mid, seconds, bound) {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+fn fastest(w: &World) -> f64 {
+    w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max)
+}
+
+/// Runs the search for every integrator: the frond, and (RK4, midpoint) SeaWorld.
+pub fn run(seaworld: Option<&std::path::Path>) -> Vec<Row> {
+    let mut rows = Vec::new();
+    for kind in IntegratorKind::ALL {
+        let t = Instant::now();
+        let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
+            let mut w = frond(kind);
+            Box::new(move |h| {
+                w.step(h).map_err(|_| ())?;
+                Ok(fastest(&w))
+            })
+        };
+        let limit = largest_stable_step(&mut make, 30.0, 1.0);
+        rows.push(row("seaweed frond", kind, limit, t.elapsed().as_secs_f64()));
+    }
+    if let Some(path) = seaweed_scene(seaworld) {
+        for kind in IntegratorKind::ALL {
+            let t = Instant::now();
+            let p = path.clone();
+            let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
+                let mut s = animats_scene::load(&p).expect("SeaWorld loads");
+                s.world.set_integrator(kind);
+                Box::new(move |h| {
+                    s.step(h).map_err(|_| ())?;
+                    Ok(fastest(&s.world))
+                })
+            };
+            let limit = largest_stable_step(&mut make, 30.0, 5.0);
+            rows.push(row("seaworld", kind, limit, t.elapsed().as_secs_f64()));
+        }
+    }
+    rows
+}
+
+fn seaweed_scene(p: Option<&std::path::Path>) -> Option<std::path::PathBuf> {
+    p.filter(|p| p.exists()).map(|p| p.to_path_buf())
+}
+
+fn row(what: &str, kind: IntegratorKind, limit: f64, seconds: f64) -> Row {
+    Row {
+        workload: "stability".into(),
+        variant: format!("{what}, {}", kind.name()),
+        particles: 0,
+        springs: 0,
+        steps: 0,
+        dt: limit,
+        evaluations: kind.evaluations(),
+        pairs: 0,
+        engine: Timing::from_runs(vec![seconds]),
+        baseline: None,
+        checks: vec![Check::info("largest stable step, s", limit)],
+    }
+}
