@@ -13,19 +13,21 @@ pub mod allpairs;
 pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
+pub mod seaworld;
 pub mod stability;
 
 use animats_engine::{DVec3, IntegratorKind};
 use std::time::Instant;
 
 /// The workloads, in the order they are run by default.
-pub const WORKLOADS: [&str; 7] = [
+pub const WORKLOADS: [&str; 8] = [
     "chain-64",
     "cloth-32",
     "cloth-128",
     "nbody5",
     "allpairs-1000",
     "hopper",
+    "seaworld",
     "stability",
 ];
 
@@ -278,6 +280,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "nbody5" => Ok(vec![run_nbody5(opts.quick, runs)]),
         "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
         "hopper" => hopper::run(opts.quick, runs),
+        "seaworld" => seaworld::run(opts.quick, runs),
         "stability" => Ok(stability::run(Some(std::path::Path::new(
             "scenes/seaworld.toml",
         )))),

@@ -15,6 +15,7 @@ pub mod actuator;
 pub mod actuators;
 pub mod controller;
 pub mod jellyfish;
+pub mod quadruped;
 pub mod roobot;
 pub mod seaworld;
 pub mod sensor;

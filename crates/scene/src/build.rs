@@ -6,6 +6,7 @@ use crate::error::SceneError;
 use crate::source::Source;
 use crate::Scene;
 use animats_creatures::jellyfish::{Jellyfish, JellyfishConstants};
+use animats_creatures::quadruped::{Demo, Model, Quadruped, QuadrupedConstants};
 use animats_creatures::roobot::{BodyConstants, Roobot};
 use animats_creatures::seaworld::{
     rocks, seaweed, BubbleColumn, BubbleConstants, Random, RocksConstants, SeaweedConstants,
@@ -459,6 +460,39 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
         namer.add(&at, first, &parts)?;
+    }
+
+    // [[quadruped]]
+    for (k, entry) in def.quadruped.iter().enumerate() {
+        let q = entry.get_ref();
+        let at = at(src, format!("quadruped[{k}]"), entry);
+        let name = q.name.clone().unwrap_or_else(|| format!("quadruped{k}"));
+        check_name(&at, &name)?;
+        let model = Model::from_number(q.model)
+            .ok_or_else(|| at.err("model", format!("must be 1, 2 or 3, got {}", q.model)))?;
+        let position = at.vec3("position", q.position)?;
+        let heading = at.finite("heading", q.heading)?;
+        let demo_at = at.finite("demo_at", q.demo_at)?;
+        let first = world.len();
+        let mut quad = Quadruped::build(
+            &mut world,
+            &name,
+            model,
+            &QuadrupedConstants::default(),
+            position,
+            heading,
+        )
+        .map_err(|e| at.model(e))?;
+        quad.demo = (demo_at >= 0.0).then_some(Demo { at: demo_at });
+        let mut parts: Vec<String> = (0..4).map(|i| format!("{name}.corner{i}")).collect();
+        for i in 0..4 {
+            if model == Model::TwoSegment {
+                parts.push(format!("{name}.knee{i}"));
+            }
+            parts.push(format!("{name}.foot{i}"));
+        }
+        namer.add(&at, first, &parts)?;
+        actors.push(Box::new(quad));
     }
 
     let max_dt = match wd.max_dt {

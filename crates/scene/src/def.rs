@@ -56,6 +56,9 @@ pub struct SceneDef {
     /// `[[rocks]]` entries: scattered sinking stones.
     #[serde(default)]
     pub rocks: Vec<Spanned<RocksEntry>>,
+    /// `[[quadruped]]` entries: the thesis's three failed quadrupeds.
+    #[serde(default)]
+    pub quadruped: Vec<Spanned<QuadrupedEntry>>,
 }
 
 /// Integration method names as written in files.
@@ -476,4 +479,28 @@ pub struct RocksEntry {
     pub from: Option<[f64; 3]>,
     /// Greatest corner, m; default [0.5, 1.2, 0.5].
     pub to: Option<[f64; 3]>,
+}
+
+/// `[[quadruped]]`: one of the thesis's three quadruped models.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadrupedEntry {
+    /// Prefix of its particles' names; default `quadruped{k}`.
+    pub name: Option<String>,
+    /// 1, 2 or 3 (thesis §3.2.3).
+    pub model: u32,
+    /// Where the centre of its torso stands, m (y ignored).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// rad from +x, counter-clockwise seen from above.
+    #[serde(default)]
+    pub heading: f64,
+    /// When to run the thesis's failing experiment, s (model 2 raises its
+    /// front feet, model 3 tries a step); default 2; a negative time never.
+    #[serde(default = "default_demo")]
+    pub demo_at: f64,
+}
+
+fn default_demo() -> f64 {
+    2.0
 }
