@@ -5,6 +5,8 @@ use crate::Failure;
 use animats_evolve::{checkpoint, Config, State};
 use animats_render::{step_plot_png, Plot, Series};
 use animats_scene::params::{format_best, LaneBest};
+use animats_viewer::exhibition::Showcase;
+use animats_viewer::Exhibition;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -35,6 +37,12 @@ pub struct Args {
     /// Seconds between checkpoints (0: after every batch of generations).
     #[arg(long, default_value_t = 5.0)]
     checkpoint_every: f64,
+    /// Watch it live in the browser: every lane's current best hopping side
+    /// by side. The view stays open after the run until Ctrl-C.
+    #[arg(long)]
+    view: bool,
+    #[command(flatten)]
+    serving: crate::view::Serving,
 }
 
 const CHECKPOINT: &str = "checkpoint.json";
@@ -116,6 +124,18 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
 }
 
+/// Shows every lane's best so far to the viewer.
+fn publish(showcase: &Showcase, state: &State) {
+    for l in &state.lanes {
+        if let Some(fitness) = l.best_fitness {
+            let mut params = animats_creatures::roobot::HopParams::INITIAL;
+            params.0.copy_from_slice(&l.best);
+            showcase.set_best(l.lane, params, fitness);
+        }
+    }
+    showcase.set_generation(state.generation(), state.config.generations);
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
     let (dir, mut state) = match &args.resume {
@@ -178,6 +198,18 @@ pub fn run(args: Args) -> Result<(), Failure> {
         // last checkpoint still stands.
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
+    let viewing = if args.view {
+        let showcase = Showcase::new(state.config.lanes);
+        publish(&showcase, &state);
+        let exhibition =
+            Exhibition::new(showcase.clone(), state.config.settings()).map_err(Failure::Other)?;
+        let server = args.serving.bind(1.0)?;
+        let stop = stop.clone();
+        let thread = std::thread::spawn(move || server.serve(Box::new(exhibition), stop));
+        Some((showcase, thread))
+    } else {
+        None
+    };
 
     let total = state.config.generations;
     let bar = ProgressBar::new(total);
@@ -200,6 +232,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
             .map_err(Failure::Other)?;
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
+        if let Some((showcase, _)) = &viewing {
+            publish(showcase, &state);
+        }
         bar.set_position(state.generation());
         bar.set_message(format!(
             "{rate:.0} evals/s, best fitness {:.1}",
@@ -236,6 +271,15 @@ pub fn run(args: Args) -> Result<(), Failure> {
         "wrote {}/log.csv, best.toml, fitness.png, {CHECKPOINT}",
         dir.display()
     );
+    if let Some((_, thread)) = viewing {
+        if !interrupted {
+            println!("the view stays open: Ctrl-C to stop");
+        }
+        let served = thread
+            .join()
+            .unwrap_or_else(|_| Err("the viewer failed".into()));
+        served.map_err(Failure::Other)?;
+    }
     if interrupted {
         return Err(Failure::Interrupted(format!(
             "interrupted at generation {}; continue with `animats evolve --resume {}`",

@@ -10,6 +10,7 @@ mod evolve;
 mod hop;
 mod output;
 mod simulate;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -33,6 +34,8 @@ enum Command {
     Evolve(evolve::Args),
     /// Run the standard benchmark workloads beside hand-written baselines.
     Bench(bench::Args),
+    /// Run a scene live and watch it in the browser (3D, with controls).
+    View(view::Args),
 }
 
 /// A failed command, with the exit status it maps to.
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
         Command::Hop(args) => hop::run(args),
         Command::Evolve(args) => evolve::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::View(args) => view::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

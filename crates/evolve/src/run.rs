@@ -64,7 +64,8 @@ impl Config {
         Ok(())
     }
 
-    fn settings(&self) -> EvalSettings {
+    /// The evaluation settings this run uses.
+    pub fn settings(&self) -> EvalSettings {
         EvalSettings {
             seconds: self.seconds,
             dt: self.dt,

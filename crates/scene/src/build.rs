@@ -150,6 +150,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         ids: HashMap::new(),
     };
     let mut name_list = Vec::with_capacity(def.particle.len());
+    let mut kinds: Vec<&'static str> = Vec::with_capacity(def.particle.len());
     for (k, entry) in def.particle.iter().enumerate() {
         let p = entry.get_ref();
         let at = at(src, format!("particle[{k}]"), entry);
@@ -177,6 +178,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         let id = world.add_particle(pdef).map_err(|e| at.model(e))?;
         names.ids.insert(p.name.clone(), id);
         name_list.push(p.name.clone());
+        kinds.push("particle");
     }
 
     // [[food]]: before the creatures that smell it.
@@ -204,6 +206,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .map_err(|e| at.model(e))?;
         names.ids.insert(f.name.clone(), id);
         name_list.push(f.name.clone());
+        kinds.push("food");
     }
 
     // [floor]
@@ -345,6 +348,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
                 .ids
                 .insert(full.clone(), ParticleId::from_index(first + i));
             name_list.push(full);
+            kinds.push("roobot");
         }
         actors.push(Box::new(roobot));
     }
@@ -352,6 +356,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     let mut namer = Namer {
         names: &mut names,
         list: &mut name_list,
+        kinds: &mut kinds,
     };
     let seed = wd.seed;
 
@@ -390,7 +395,14 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         for i in 0..constants.tentacles {
             parts.extend((0..constants.segments).map(|s| format!("{name}.tentacle{i}.{s}")));
         }
-        namer.add(&at, first, &parts)?;
+        let domes = constants.tentacles;
+        namer.add(&at, first, &parts, |i| {
+            if i < domes {
+                "dome"
+            } else {
+                "tentacle"
+            }
+        })?;
         actors.push(Box::new(jelly));
     }
 
@@ -413,7 +425,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         let first = world.len();
         seaweed::build(&mut world, &c, position).map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..=c.segments).map(|i| format!("{name}.{i}")).collect();
-        namer.add(&at, first, &parts)?;
+        namer.add(&at, first, &parts, |_| "seaweed")?;
     }
 
     // [[bubble_column]]
@@ -437,7 +449,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         let column = BubbleColumn::build(&mut world, &c, base, Random::new(seed, 1000 + k as u64))
             .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.bubbles).map(|i| format!("{name}.{i}")).collect();
-        namer.add(&at, first, &parts)?;
+        namer.add(&at, first, &parts, |_| "bubble")?;
         actors.push(Box::new(column));
     }
 
@@ -459,7 +471,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         rocks::scatter(&mut world, &c, &mut Random::new(seed, 2000 + k as u64))
             .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
-        namer.add(&at, first, &parts)?;
+        namer.add(&at, first, &parts, |_| "rock")?;
     }
 
     // [[quadruped]]
@@ -491,7 +503,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             }
             parts.push(format!("{name}.foot{i}"));
         }
-        namer.add(&at, first, &parts)?;
+        namer.add(&at, first, &parts, |_| "quadruped")?;
         actors.push(Box::new(quad));
     }
 
@@ -502,6 +514,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     Ok(Scene {
         world,
         names: name_list,
+        kinds,
         dt,
         max_dt,
         duration,
@@ -513,11 +526,19 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
 struct Namer<'a> {
     names: &'a mut Names,
     list: &'a mut Vec<String>,
+    kinds: &'a mut Vec<&'static str>,
 }
 
 impl Namer<'_> {
-    fn add(&mut self, at: &At, first: usize, parts: &[String]) -> Result<(), SceneError> {
+    fn add(
+        &mut self,
+        at: &At,
+        first: usize,
+        parts: &[String],
+        kind: impl Fn(usize) -> &'static str,
+    ) -> Result<(), SceneError> {
         for (i, full) in parts.iter().enumerate() {
+            self.kinds.push(kind(i));
             if self.names.ids.contains_key(full) {
                 return Err(at.err("name", format!("duplicate particle name `{full}`")));
             }

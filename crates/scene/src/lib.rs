@@ -40,6 +40,9 @@ pub struct Scene {
     pub world: World,
     /// Name of each particle, indexed by [`ParticleId::index`].
     pub names: Vec<String>,
+    /// What each particle is part of, for drawing: `particle`, `food`,
+    /// `roobot`, `dome`, `tentacle`, `seaweed`, `bubble`, `rock`, `quadruped`.
+    pub kinds: Vec<&'static str>,
     /// Step, s.
     pub dt: f64,
     /// Largest stable step, s (real-time mode never exceeds it).

@@ -1,0 +1,73 @@
+//! `animats view SCENE`: run a scene live and watch it in the browser.
+
+use crate::{positive_f64, Failure};
+use animats_viewer::{Options, SceneStage, Server};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Where and how to serve a live view (shared with `animats evolve --view`).
+#[derive(clap::Args, Clone)]
+pub struct Serving {
+    /// Port to serve on (0: any free port; the address is printed).
+    #[arg(long, default_value_t = 8080)]
+    pub port: u16,
+    /// Address to bind: 127.0.0.1 serves this machine only; 0.0.0.0 serves
+    /// the network (anyone who can reach it can pause and reset the run).
+    #[arg(long, default_value = "127.0.0.1")]
+    pub host: String,
+    /// Frames streamed to the browser per second.
+    #[arg(long, default_value_t = 30.0, value_parser = positive_f64)]
+    pub display_fps: f64,
+    /// Most browser tabs watching at once.
+    #[arg(long, default_value_t = 16, value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub max_clients: u64,
+}
+
+impl Serving {
+    /// Binds the server, failing with a clear message (exit 2).
+    pub fn bind(&self, speed: f64) -> Result<Server, Failure> {
+        let server = Server::bind(Options {
+            host: self.host.clone(),
+            port: self.port,
+            display_hz: self.display_fps,
+            speed,
+            max_clients: self.max_clients as usize,
+        })
+        .map_err(Failure::Input)?;
+        let address = server.address().map_err(Failure::Other)?;
+        println!("animats view: watching at http://{address}/ (Ctrl-C to stop)");
+        Ok(server)
+    }
+}
+
+/// Arguments of `animats view`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    #[command(flatten)]
+    serving: Serving,
+    /// Real-time factor to start at (simulated seconds per wall second;
+    /// 0: flat out). The page can change it.
+    #[arg(long, default_value_t = 1.0)]
+    speed: f64,
+}
+
+/// Runs the command: serves until Ctrl-C.
+pub fn run(args: Args) -> Result<(), Failure> {
+    if !args.speed.is_finite() || args.speed < 0.0 {
+        return Err(Failure::Input(format!(
+            "--speed must be 0 (flat out) or a positive number, got {}",
+            args.speed
+        )));
+    }
+    let stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    let server = args.serving.bind(args.speed)?;
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = stop.clone();
+        let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
+    }
+    server.serve(Box::new(stage), stop).map_err(Failure::Other)
+}

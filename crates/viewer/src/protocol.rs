@@ -1,0 +1,130 @@
+//! The WebSocket protocol, all JSON text messages.
+//!
+//! Server → client:
+//! - `{"type":"scene", ...}` ([`Describe`]) on connecting and after a reset:
+//!   what there is to draw;
+//! - `{"type":"frame", ...}` ([`Frame`]) at the display rate: where it is
+//!   now, with `error` set once the simulation has failed.
+//!
+//! Client → server ([`Command`]): `{"cmd":"pause"}`, `{"cmd":"resume"}`,
+//! `{"cmd":"step"}`, `{"cmd":"speed","value":2.0}`, `{"cmd":"reset"}`,
+//! `{"cmd":"food","x":0.1,"z":-0.3}`. Extra fields are ignored (room to
+//! grow); anything else is logged and ignored.
+
+use serde::{Deserialize, Serialize};
+
+/// One particle to draw.
+#[derive(Clone, Debug, Serialize)]
+pub struct Part {
+    /// Its name.
+    pub name: String,
+    /// Its radius, m.
+    pub radius: f64,
+    /// What it is part of (see `animats_scene::Scene::kinds`).
+    pub kind: String,
+}
+
+/// A jellyfish's dome, drawn as a pulsing bell over its three dome masses.
+#[derive(Clone, Debug, Serialize)]
+pub struct Dome {
+    /// The jellyfish's name (its status carries the pulse phase).
+    pub name: String,
+    /// Indices of the dome masses.
+    pub particles: Vec<usize>,
+    /// Indices of its tentacle masses (the bell opens towards them).
+    pub tentacles: Vec<usize>,
+}
+
+/// What there is to draw.
+#[derive(Clone, Debug, Serialize)]
+pub struct Describe {
+    /// Always `scene`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// A title.
+    pub title: String,
+    /// Every particle, by index.
+    pub particles: Vec<Part>,
+    /// Springs as index pairs.
+    pub springs: Vec<[usize; 2]>,
+    /// Density of the fluid, kg/m³, if there is one (water is tinted).
+    pub fluid: Option<f64>,
+    /// Whether there is a floor.
+    pub floor: bool,
+    /// Jellyfish domes.
+    pub domes: Vec<Dome>,
+    /// Index of the food particle, if any (clicking the floor moves it).
+    pub food: Option<usize>,
+    /// Where to aim the camera first, and from how far, m.
+    pub target: [f64; 3],
+    /// Camera distance, m.
+    pub distance: f64,
+}
+
+/// A creature's state, for the overlay.
+#[derive(Clone, Debug, Serialize)]
+pub struct CreatureState {
+    /// Its name.
+    pub name: String,
+    /// Its controller state.
+    pub state: &'static str,
+    /// Its energy, if it has one.
+    pub energy: Option<f64>,
+    /// Its pulse phase, if it has one.
+    pub phase: Option<f64>,
+}
+
+/// Where everything is now.
+#[derive(Clone, Debug, Serialize)]
+pub struct Frame {
+    /// Always `frame`.
+    #[serde(rename = "type")]
+    pub kind: &'static str,
+    /// Simulated time, s.
+    pub t: f64,
+    /// Frames published per second (the display rate).
+    pub fps: f64,
+    /// Simulated seconds per wall second over the last second.
+    pub rtf: f64,
+    /// The real-time factor asked for.
+    pub speed: f64,
+    /// True while paused.
+    pub paused: bool,
+    /// Positions, x y z per particle, m (single precision is plenty to draw).
+    pub p: Vec<f32>,
+    /// Every creature's state.
+    pub creatures: Vec<CreatureState>,
+    /// A point the camera may follow (the leading roobot of an evolution).
+    pub focus: Option<[f64; 3]>,
+    /// Why the simulation stopped, if it failed (it is paused until reset).
+    pub error: Option<String>,
+    /// A line about the run for the overlay (an evolution's generation).
+    pub note: Option<String>,
+}
+
+/// What a client may ask.
+#[derive(Clone, Debug, PartialEq, Deserialize)]
+#[serde(tag = "cmd", rename_all = "lowercase")]
+pub enum Command {
+    /// Stop simulated time.
+    Pause,
+    /// Start it again.
+    Resume,
+    /// One step while paused.
+    Step,
+    /// Real-time factor, clamped to [0.01, 100]; 0 (or anything not
+    /// positive) means flat out.
+    Speed {
+        /// Simulated seconds per wall second.
+        value: f64,
+    },
+    /// Start the scene again.
+    Reset,
+    /// Move the food to (x, z), keeping its height.
+    Food {
+        /// m.
+        x: f64,
+        /// m.
+        z: f64,
+    },
+}

@@ -1,0 +1,234 @@
+//! The simulation thread: owns the [`Stage`], obeys the clients' commands,
+//! paces simulated time to the wall clock (or runs flat out), and publishes
+//! a frame at the display rate.
+//!
+//! Frames go out through a `watch` channel, which keeps only the newest: a
+//! slow client skips frames instead of slowing the simulation, and with no
+//! client attached nothing is even serialised.
+
+use crate::protocol::{Command, Frame};
+use crate::stage::Stage;
+use axum::extract::ws::Utf8Bytes;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use tokio::sync::watch;
+
+/// Slowest and fastest real-time factors a client may ask for.
+pub const SPEED_RANGE: (f64, f64) = (0.01, 100.0);
+/// When the simulation falls behind the wall clock by more than this many
+/// wall seconds, the debt is forgiven rather than caught up in a burst.
+const MAX_LAG: f64 = 0.25;
+
+/// The channels a runner publishes to.
+#[derive(Clone)]
+pub struct Outlets {
+    /// The scene description, JSON (re-sent after a reset).
+    pub scene: Arc<watch::Sender<Utf8Bytes>>,
+    /// The newest frame, JSON.
+    pub frames: Arc<watch::Sender<Utf8Bytes>>,
+}
+
+impl Outlets {
+    /// Empty channels.
+    pub fn new() -> Outlets {
+        Outlets {
+            scene: Arc::new(watch::channel(Utf8Bytes::from_static("")).0),
+            frames: Arc::new(watch::channel(Utf8Bytes::from_static("")).0),
+        }
+    }
+}
+
+impl Default for Outlets {
+    fn default() -> Self {
+        Outlets::new()
+    }
+}
+
+/// Runs a stage live.
+pub struct Runner {
+    stage: Box<dyn Stage>,
+    commands: Receiver<Command>,
+    out: Outlets,
+    stop: Arc<AtomicBool>,
+    period: Duration,
+    /// Real-time factor; 0 is flat out.
+    speed: f64,
+    paused: bool,
+    error: Option<String>,
+    positions: Vec<f32>,
+}
+
+impl Runner {
+    /// A runner publishing `display_hz` frames a second at real-time
+    /// factor `speed` (0: flat out).
+    pub fn new(
+        stage: Box<dyn Stage>,
+        commands: Receiver<Command>,
+        out: Outlets,
+        stop: Arc<AtomicBool>,
+        display_hz: f64,
+        speed: f64,
+    ) -> Runner {
+        let runner = Runner {
+            stage,
+            commands,
+            out,
+            stop,
+            period: Duration::from_secs_f64(1.0 / display_hz.clamp(1.0, 240.0)),
+            speed: clamp_speed(speed),
+            paused: false,
+            error: None,
+            positions: Vec::new(),
+        };
+        runner.publish_scene();
+        runner
+    }
+
+    fn publish_scene(&self) {
+        let json = serde_json::to_string(&self.stage.describe()).unwrap_or_default();
+        self.out.scene.send_replace(json.into());
+    }
+
+    /// Steps once, recording a failure (which pauses the run).
+    fn step(&mut self) {
+        let dt = self.stage.dt();
+        if let Err(e) = self.stage.step(dt) {
+            let message = format!(
+                "the simulation failed at t = {:.3} s: {e}",
+                self.stage.time()
+            );
+            eprintln!("viewer: {message} (paused; reset to start again)");
+            self.error = Some(message);
+            self.paused = true;
+        }
+    }
+
+    fn obey(&mut self, command: Command) {
+        match command {
+            Command::Pause => self.paused = true,
+            Command::Resume if self.error.is_none() => self.paused = false,
+            Command::Resume => {}
+            Command::Step if self.paused && self.error.is_none() => self.step(),
+            Command::Step => {}
+            Command::Speed { value } => self.speed = clamp_speed(value),
+            Command::Reset => match self.stage.reset() {
+                Ok(()) => {
+                    self.error = None;
+                    self.publish_scene();
+                }
+                Err(e) => eprintln!("viewer: cannot reset: {e}"),
+            },
+            Command::Food { x, z } => {
+                if x.is_finite() && z.is_finite() {
+                    self.stage.move_food(x, z);
+                }
+            }
+        }
+    }
+
+    /// Runs until the stop flag is raised or every command sender is gone.
+    pub fn run(mut self) {
+        let mut next_frame = Instant::now();
+        let mut last = Instant::now();
+        // Simulated time the wall clock says we should have reached.
+        let mut target = self.stage.time();
+        let mut window = (Instant::now(), self.stage.time(), 0u32);
+        let (mut fps, mut rtf) = (0.0, 0.0);
+        loop {
+            if self.stop.load(Ordering::Relaxed) {
+                return;
+            }
+            loop {
+                match self.commands.try_recv() {
+                    Ok(c) => {
+                        let reset = c == Command::Reset;
+                        self.obey(c);
+                        if reset {
+                            target = self.stage.time();
+                            window = (Instant::now(), self.stage.time(), 0);
+                        }
+                    }
+                    Err(TryRecvError::Empty) => break,
+                    Err(TryRecvError::Disconnected) => return,
+                }
+            }
+
+            let now = Instant::now();
+            let wall = now.duration_since(last).as_secs_f64();
+            last = now;
+            if self.paused {
+                target = self.stage.time();
+            } else if self.speed == 0.0 {
+                while Instant::now() < next_frame && !self.paused {
+                    self.step();
+                }
+                target = self.stage.time();
+            } else {
+                target += self.speed * wall.min(MAX_LAG);
+                let half = 0.5 * self.stage.dt();
+                while self.stage.time() + half < target
+                    && Instant::now() < next_frame
+                    && !self.paused
+                {
+                    self.step();
+                }
+                // Too slow for this speed: drop the debt, report the true rate.
+                target = target.min(self.stage.time() + self.speed * MAX_LAG);
+            }
+
+            let now = Instant::now();
+            if now < next_frame {
+                std::thread::sleep(next_frame - now);
+            }
+            next_frame += self.period;
+            let now = Instant::now();
+            if next_frame < now {
+                next_frame = now + self.period;
+            }
+
+            window.2 += 1;
+            let span = now.duration_since(window.0).as_secs_f64();
+            if span >= 1.0 {
+                fps = f64::from(window.2) / span;
+                rtf = (self.stage.time() - window.1) / span;
+                window = (now, self.stage.time(), 0);
+            }
+            // Nobody watching: nothing to serialise.
+            if self.out.frames.receiver_count() > 0 {
+                self.publish_frame(fps, rtf);
+            }
+        }
+    }
+
+    fn publish_frame(&mut self, fps: f64, rtf: f64) {
+        self.stage.positions(&mut self.positions);
+        let frame = Frame {
+            kind: "frame",
+            t: self.stage.time(),
+            fps,
+            rtf,
+            speed: self.speed,
+            paused: self.paused,
+            p: std::mem::take(&mut self.positions),
+            creatures: self.stage.creatures(),
+            focus: self.stage.focus(),
+            error: self.error.clone(),
+            note: self.stage.note(),
+        };
+        let json = serde_json::to_string(&frame).unwrap_or_default();
+        self.positions = frame.p;
+        self.out.frames.send_replace(json.into());
+    }
+}
+
+/// A requested real-time factor, made safe: not positive (or NaN) is flat
+/// out, the rest is clamped to [`SPEED_RANGE`].
+pub fn clamp_speed(value: f64) -> f64 {
+    if value > 0.0 {
+        value.clamp(SPEED_RANGE.0, SPEED_RANGE.1)
+    } else {
+        0.0
+    }
+}

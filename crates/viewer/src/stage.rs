@@ -1,0 +1,188 @@
+//! What the viewer shows: a [`Stage`] advances a world and describes it.
+//! [`SceneStage`] plays a scene file.
+
+use crate::protocol::{CreatureState, Describe, Dome, Part};
+use animats_engine::DVec3;
+use animats_scene::Scene;
+use std::path::PathBuf;
+
+/// Something the viewer can run and draw.
+pub trait Stage: Send {
+    /// What there is to draw.
+    fn describe(&self) -> Describe;
+    /// The step to advance by, s.
+    fn dt(&self) -> f64;
+    /// Simulated time, s.
+    fn time(&self) -> f64;
+    /// Advances by `dt`.
+    fn step(&mut self, dt: f64) -> Result<(), String>;
+    /// Writes every particle's position, x y z in order.
+    fn positions(&self, out: &mut Vec<f32>);
+    /// Every creature's state.
+    fn creatures(&self) -> Vec<CreatureState>;
+    /// A point the camera may follow.
+    fn focus(&self) -> Option<[f64; 3]> {
+        None
+    }
+    /// A line about the run for the overlay.
+    fn note(&self) -> Option<String> {
+        None
+    }
+    /// Starts again from the beginning.
+    fn reset(&mut self) -> Result<(), String>;
+    /// Moves the food to (x, z); false if there is none.
+    fn move_food(&mut self, _x: f64, _z: f64) -> bool {
+        false
+    }
+}
+
+/// A scene file, played live.
+pub struct SceneStage {
+    path: PathBuf,
+    scene: Scene,
+}
+
+impl SceneStage {
+    /// Loads the scene at `path`.
+    pub fn load(path: PathBuf) -> Result<SceneStage, String> {
+        let scene = animats_scene::load(&path).map_err(|e| e.to_string())?;
+        Ok(SceneStage { path, scene })
+    }
+
+    fn food(&self) -> Option<usize> {
+        self.scene.kinds.iter().position(|k| *k == "food")
+    }
+}
+
+/// Where to point the camera at a set of positions: their middle, from a
+/// distance that fits them, and the floor under them if there is one (what
+/// falls lands in view).
+pub fn framing(pos: &[DVec3], floor: bool) -> ([f64; 3], f64) {
+    if pos.is_empty() {
+        return ([0.0, 0.0, 0.0], 3.0);
+    }
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for p in pos {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    if floor {
+        lo.y = lo.y.min(0.0);
+    }
+    let c = (lo + hi) / 2.0;
+    let size = (hi - lo).length().max(0.5);
+    ([c.x, c.y.max(0.2), c.z], 1.2 * size + 0.5)
+}
+
+impl Stage for SceneStage {
+    fn describe(&self) -> Describe {
+        let w = &self.scene.world;
+        let p = w.particles();
+        let particles = (0..w.len())
+            .map(|i| Part {
+                name: self.scene.names[i].clone(),
+                radius: p.radius[i],
+                kind: self.scene.kinds[i].to_string(),
+            })
+            .collect();
+        let springs = w
+            .forces()
+            .springs
+            .iter()
+            .map(|s| {
+                let (a, b) = s.ends();
+                [a.index(), b.index()]
+            })
+            .collect();
+        let mut domes: Vec<Dome> = Vec::new();
+        for (i, k) in self.scene.kinds.iter().enumerate() {
+            if *k == "dome" {
+                let name = self.scene.names[i]
+                    .split(".dome")
+                    .next()
+                    .unwrap_or("")
+                    .to_string();
+                match domes.iter_mut().find(|d| d.name == name) {
+                    Some(d) => d.particles.push(i),
+                    None => domes.push(Dome {
+                        name,
+                        particles: vec![i],
+                        tentacles: Vec::new(),
+                    }),
+                }
+            }
+        }
+        for d in &mut domes {
+            let prefix = format!("{}.tentacle", d.name);
+            d.tentacles = (0..w.len())
+                .filter(|&i| {
+                    self.scene.kinds[i] == "tentacle" && self.scene.names[i].starts_with(&prefix)
+                })
+                .collect();
+        }
+        let floor = w.event::<animats_engine::FloorCollision>().is_some();
+        let (target, distance) = framing(&w.state().pos, floor);
+        Describe {
+            kind: "scene",
+            title: self.path.display().to_string(),
+            particles,
+            springs,
+            fluid: w.forces().fluids.first().map(|f| f.density),
+            floor,
+            domes,
+            food: self.food(),
+            target,
+            distance,
+        }
+    }
+
+    fn dt(&self) -> f64 {
+        self.scene.dt.min(self.scene.max_dt)
+    }
+
+    fn time(&self) -> f64 {
+        self.scene.world.time()
+    }
+
+    fn step(&mut self, dt: f64) -> Result<(), String> {
+        self.scene.step(dt).map(|_| ()).map_err(|e| e.to_string())
+    }
+
+    fn positions(&self, out: &mut Vec<f32>) {
+        out.clear();
+        for p in &self.scene.world.state().pos {
+            out.extend([p.x as f32, p.y as f32, p.z as f32]);
+        }
+    }
+
+    fn creatures(&self) -> Vec<CreatureState> {
+        self.scene
+            .actors
+            .iter()
+            .filter_map(|a| a.status())
+            .map(|s| CreatureState {
+                name: s.name,
+                state: s.state,
+                energy: s.energy,
+                phase: s.phase,
+            })
+            .collect()
+    }
+
+    fn reset(&mut self) -> Result<(), String> {
+        self.scene = animats_scene::load(&self.path).map_err(|e| e.to_string())?;
+        Ok(())
+    }
+
+    fn move_food(&mut self, x: f64, z: f64) -> bool {
+        match self.food() {
+            Some(i) => {
+                let id = animats_engine::ParticleId::from_index(i);
+                let y = self.scene.world.position(id).y;
+                self.scene.world.set_position(id, DVec3::new(x, y, z));
+                true
+            }
+            None => false,
+        }
+    }
+}

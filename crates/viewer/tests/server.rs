@@ -1,0 +1,336 @@
+//! The live server end to end over real sockets: what a browser sees, the
+//! controls, and hostile clients (which must not disturb the others).
+
+use animats_viewer::{Options, SceneStage, Server};
+use futures_util::{SinkExt, StreamExt};
+use serde_json::Value;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+use tokio::net::TcpStream;
+use tokio_tungstenite::tungstenite::Message;
+use tokio_tungstenite::{MaybeTlsStream, WebSocketStream};
+
+type Socket = WebSocketStream<MaybeTlsStream<TcpStream>>;
+
+fn seaworld() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/seaworld.toml")
+}
+
+/// A server on a free port, running SeaWorld; stopped on drop.
+struct Live {
+    url: String,
+    stop: Arc<AtomicBool>,
+    thread: Option<std::thread::JoinHandle<Result<(), String>>>,
+}
+
+impl Live {
+    fn start(max_clients: usize) -> Live {
+        let server = Server::bind(Options {
+            port: 0,
+            max_clients,
+            ..Options::default()
+        })
+        .expect("bind");
+        let url = format!("ws://{}/ws", server.address().expect("address"));
+        let stage = SceneStage::load(seaworld()).expect("scene");
+        let stop = Arc::new(AtomicBool::new(false));
+        let s = stop.clone();
+        let thread = Some(std::thread::spawn(move || server.serve(Box::new(stage), s)));
+        Live { url, stop, thread }
+    }
+}
+
+impl Drop for Live {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::SeqCst);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+async fn connect(url: &str) -> Socket {
+    tokio_tungstenite::connect_async(url)
+        .await
+        .expect("connect")
+        .0
+}
+
+/// The next JSON message, or None if the connection closed (10 s limit).
+async fn next(ws: &mut Socket) -> Option<Value> {
+    loop {
+        let m = tokio::time::timeout(Duration::from_secs(10), ws.next())
+            .await
+            .ok()??;
+        match m {
+            Ok(Message::Text(t)) => return serde_json::from_str(t.as_str()).ok(),
+            Ok(Message::Close(_)) | Err(_) => return None,
+            Ok(_) => continue,
+        }
+    }
+}
+
+/// The next frame, skipping scene messages.
+async fn frame(ws: &mut Socket) -> Value {
+    loop {
+        let m = next(ws).await.expect("a frame");
+        if m["type"] == "frame" {
+            return m;
+        }
+    }
+}
+
+/// The first frame sent after `f` holds.
+async fn frame_where(ws: &mut Socket, f: impl Fn(&Value) -> bool) -> Value {
+    for _ in 0..300 {
+        let m = frame(ws).await;
+        if f(&m) {
+            return m;
+        }
+    }
+    panic!("no such frame in 300");
+}
+
+async fn send(ws: &mut Socket, text: &str) {
+    ws.send(Message::text(text)).await.expect("send");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_client_gets_the_scene_then_frames_of_every_particle() {
+    let live = Live::start(4);
+    let mut ws = connect(&live.url).await;
+    let scene = next(&mut ws).await.expect("scene");
+    assert_eq!(scene["type"], "scene");
+    let n = scene["particles"].as_array().expect("particles").len();
+    assert_eq!(n, 181, "SeaWorld has 181 particles");
+    assert_eq!(scene["springs"].as_array().expect("springs").len(), 105);
+    assert_eq!(scene["domes"].as_array().expect("domes").len(), 3);
+    assert_eq!(scene["fluid"], 1000.0);
+    assert_eq!(scene["food"], 0);
+    let f = frame(&mut ws).await;
+    assert_eq!(f["p"].as_array().expect("positions").len(), 3 * n);
+    let states: Vec<&str> = f["creatures"]
+        .as_array()
+        .expect("creatures")
+        .iter()
+        .filter_map(|c| c["state"].as_str())
+        .collect();
+    assert_eq!(states.len(), 3, "three jellyfish report their FSM state");
+    assert!(states
+        .iter()
+        .all(|s| ["idle", "track", "hover"].contains(s)));
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn pause_step_resume_speed_and_reset() {
+    let live = Live::start(4);
+    let mut ws = connect(&live.url).await;
+    send(&mut ws, r#"{"cmd":"speed","value":4}"#).await;
+    frame_where(&mut ws, |f| {
+        f["speed"] == 4.0 && f["t"].as_f64().unwrap_or(0.0) > 0.5
+    })
+    .await;
+    send(&mut ws, r#"{"cmd":"pause"}"#).await;
+    let paused = frame_where(&mut ws, |f| f["paused"] == true).await;
+    let t = paused["t"].as_f64().expect("t");
+    for _ in 0..10 {
+        assert_eq!(
+            frame(&mut ws).await["t"].as_f64(),
+            Some(t),
+            "paused time stands still"
+        );
+    }
+    send(&mut ws, r#"{"cmd":"step"}"#).await;
+    let stepped = frame_where(&mut ws, |f| f["t"].as_f64() != Some(t)).await;
+    let dt = stepped["t"].as_f64().expect("t") - t;
+    assert!(
+        (dt - 0.01).abs() < 1e-9,
+        "one step is the scene's 10 ms, got {dt}"
+    );
+    send(&mut ws, r#"{"cmd":"resume"}"#).await;
+    frame_where(&mut ws, |f| f["t"].as_f64().unwrap_or(0.0) > t + 1.0).await;
+    send(&mut ws, r#"{"cmd":"reset"}"#).await;
+    // A reset re-sends the scene and starts time again.
+    loop {
+        let m = next(&mut ws).await.expect("message");
+        if m["type"] == "scene" {
+            break;
+        }
+    }
+    let f = frame(&mut ws).await;
+    assert!(
+        f["t"].as_f64().expect("t") < 0.5,
+        "time restarts after a reset"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_food_moves_where_it_is_put() {
+    let live = Live::start(4);
+    let mut ws = connect(&live.url).await;
+    let f0 = frame(&mut ws).await;
+    let y = f0["p"][1].as_f64().expect("food y");
+    send(&mut ws, r#"{"cmd":"food","x":0.6,"z":-0.4}"#).await;
+    let f = frame_where(&mut ws, |f| {
+        (f["p"][0].as_f64().unwrap_or(0.0) - 0.6).abs() < 1e-6
+    })
+    .await;
+    assert!((f["p"][2].as_f64().expect("z") + 0.4).abs() < 1e-6);
+    assert!(
+        (f["p"][1].as_f64().expect("y") - y).abs() < 1e-3,
+        "the food keeps its height"
+    );
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn hostile_clients_are_ignored_or_dropped_and_others_keep_watching() {
+    let live = Live::start(4);
+    let mut good = connect(&live.url).await;
+    frame(&mut good).await;
+
+    // Garbage, wrong fields, unknown commands, binary, NaN-ish numbers: ignored.
+    let mut bad = connect(&live.url).await;
+    for text in [
+        "hello",
+        "{",
+        r#"{"cmd":"explode"}"#,
+        r#"{"cmd":"speed"}"#,
+        r#"{"cmd":"speed","value":"fast"}"#,
+        r#"{"cmd":"food","x":1e999,"z":0}"#,
+        r#"{"cmd":"pause!"}"#,
+        r#"{"type":"pause"}"#,
+        "[1,2,3]",
+    ] {
+        send(&mut bad, text).await;
+    }
+    bad.send(Message::binary(vec![0u8, 159, 146, 150]))
+        .await
+        .expect("send");
+    let f = frame(&mut bad).await;
+    assert_eq!(f["paused"], false, "nothing above was obeyed");
+
+    // A huge message closes that connection.
+    let mut huge = connect(&live.url).await;
+    let _ = huge.send(Message::text("x".repeat(1 << 20))).await;
+    let mut closed = false;
+    for _ in 0..100 {
+        if next(&mut huge).await.is_none() {
+            closed = true;
+            break;
+        }
+    }
+    assert!(closed, "a 1 MiB message closes the connection");
+
+    // A stream of bad messages closes the connection.
+    let mut noisy = connect(&live.url).await;
+    for _ in 0..40 {
+        if noisy.send(Message::text("nonsense")).await.is_err() {
+            break;
+        }
+    }
+    let mut closed = false;
+    for _ in 0..100 {
+        if next(&mut noisy).await.is_none() {
+            closed = true;
+            break;
+        }
+    }
+    assert!(closed, "40 bad messages close the connection");
+
+    // The good client never noticed.
+    let t0 = frame(&mut good).await["t"].as_f64().expect("t");
+    let t1 = frame_where(&mut good, |f| f["t"].as_f64().unwrap_or(0.0) > t0 + 0.2).await;
+    assert_eq!(t1["paused"], false);
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn clients_beyond_the_limit_are_refused_and_the_rest_watch() {
+    let live = Live::start(2);
+    let mut a = connect(&live.url).await;
+    let mut b = connect(&live.url).await;
+    frame(&mut a).await;
+    frame(&mut b).await;
+    match tokio_tungstenite::connect_async(&live.url).await {
+        Err(tokio_tungstenite::tungstenite::Error::Http(r)) => assert_eq!(r.status(), 503),
+        Err(e) => panic!("expected 503, got {e}"),
+        Ok(_) => panic!("a third client was let in past the limit of 2"),
+    }
+    frame(&mut a).await;
+    // A place frees up when a client leaves.
+    drop(b);
+    let mut c = None;
+    for _ in 0..50 {
+        if let Ok((ws, _)) = tokio_tungstenite::connect_async(&live.url).await {
+            c = Some(ws);
+            break;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+    frame(c.as_mut().expect("a freed place")).await;
+}
+
+#[test]
+fn a_port_in_use_is_a_clear_error() {
+    let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    let port = taken.local_addr().expect("address").port();
+    let e = Server::bind(Options {
+        port,
+        ..Options::default()
+    })
+    .err()
+    .expect("the port is taken");
+    assert!(
+        e.contains(&format!("cannot listen on 127.0.0.1:{port}")),
+        "{e}"
+    );
+    assert!(e.contains("--port"), "{e}");
+}
+
+#[test]
+fn the_page_and_three_js_are_served_from_the_binary() {
+    let live = Live::start(2);
+    let host = live
+        .url
+        .trim_start_matches("ws://")
+        .trim_end_matches("/ws")
+        .to_string();
+    let get = |path: &str| -> (String, String) {
+        use std::io::{Read, Write};
+        let mut s = std::net::TcpStream::connect(&host).expect("connect");
+        write!(
+            s,
+            "GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+        )
+        .expect("write");
+        let mut r = String::new();
+        s.read_to_string(&mut r).expect("read");
+        let (head, body) = r.split_once("\r\n\r\n").unwrap_or((&r, ""));
+        (head.to_string(), body.to_string())
+    };
+    let (head, body) = get("/");
+    assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+    assert!(
+        body.contains("\"three\": \"/vendor/three.module.js\""),
+        "the page maps three.js to the embedded copy"
+    );
+    for path in [
+        "/app.js",
+        "/vendor/three.module.js",
+        "/vendor/three.core.js",
+        "/vendor/OrbitControls.js",
+    ] {
+        let (head, _) = get(path);
+        assert!(head.starts_with("HTTP/1.1 200"), "{path}: {head}");
+        assert!(
+            head.to_lowercase()
+                .contains("content-type: text/javascript"),
+            "{path}: {head}"
+        );
+    }
+    assert!(get("/vendor/../../etc/passwd")
+        .0
+        .starts_with("HTTP/1.1 404"));
+    assert!(get("/nothing").0.starts_with("HTTP/1.1 404"));
+}

@@ -1,0 +1,367 @@
+// The animats live view: draws the world the server streams over /ws with
+// three.js, and sends the controls back. Protocol: crates/viewer/src/protocol.rs.
+import * as THREE from 'three';
+import { OrbitControls } from '/vendor/OrbitControls.js';
+
+const COLOURS = {
+  particle: 0x6fa8dc, food: 0xffd34d, roobot: 0xe07b39, dome: 0xf4a6c8,
+  tentacle: 0xe58fb5, seaweed: 0x3f9a4a, bubble: 0xe8f4ff, rock: 0x7d7468,
+  quadruped: 0xb5835a,
+};
+const WATER = 0x0d3b5c;
+const AIR = 0xbfd4e6;
+
+const $ = (id) => document.getElementById(id);
+const canvas = $('view');
+const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+renderer.shadowMap.enabled = true;
+const scene = new THREE.Scene();
+const camera = new THREE.PerspectiveCamera(50, 1, 0.005, 2000);
+const controls = new OrbitControls(camera, canvas);
+controls.enableDamping = true;
+controls.addEventListener('start', () => { controls.autoRotate = false; });
+scene.add(new THREE.HemisphereLight(0xe8f0ff, 0x4a3f30, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(3, 8, 5);
+sun.castShadow = true;
+sun.shadow.mapSize.set(1024, 1024);
+scene.add(sun);
+scene.add(sun.target);
+
+/** Keeps the sun's shadow box around what the camera looks at. */
+function aimSun(size) {
+  const t = controls.target;
+  sun.target.position.copy(t);
+  sun.position.set(t.x + 0.3 * size, t.y + size, t.z + 0.5 * size);
+  const c = sun.shadow.camera;
+  c.left = c.bottom = -size;
+  c.right = c.top = size;
+  c.near = 0.01;
+  c.far = 4 * size;
+  c.updateProjectionMatrix();
+}
+
+const sphere = new THREE.SphereGeometry(1, 20, 14);
+const rod = new THREE.CylinderGeometry(1, 1, 1, 8, 1);
+// The bell: the upper half of a unit sphere, its rim on y = 0.
+const bell = new THREE.SphereGeometry(1, 28, 10, 0, 2 * Math.PI, 0, Math.PI / 2);
+
+// What the page knows; the browser test reads it.
+const viewer = {
+  scene: null, frame: null, frames: 0, arrivals: [], connected: false,
+  send, project, floorHit, three: { scene, camera, THREE },
+};
+window.__viewer = viewer;
+
+let socket = null;
+let drawn = null; // the three.js objects of the current scene
+let pending = null; // newest frame not yet drawn
+let framed = null; // title of the scene the camera was framed for
+
+function send(command) {
+  if (socket && socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify(command));
+}
+
+function connect() {
+  const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`;
+  socket = new WebSocket(url);
+  socket.onopen = () => { viewer.connected = true; $('status').textContent = 'live'; };
+  socket.onclose = () => {
+    viewer.connected = false;
+    $('status').textContent = 'disconnected: retrying';
+    setTimeout(connect, 1000);
+  };
+  socket.onmessage = (event) => {
+    let msg;
+    try { msg = JSON.parse(event.data); } catch { return; }
+    if (msg.type === 'scene') {
+      viewer.scene = msg;
+      build(msg);
+    } else if (msg.type === 'frame') {
+      viewer.frame = msg;
+      viewer.frames += 1;
+      const now = performance.now();
+      viewer.arrivals.push(now);
+      while (viewer.arrivals.length > 0 && viewer.arrivals[0] < now - 3000) viewer.arrivals.shift();
+      pending = msg;
+    }
+  };
+}
+
+function material(kind) {
+  const colour = COLOURS[kind] ?? COLOURS.particle;
+  const m = new THREE.MeshStandardMaterial({ color: colour, roughness: 0.6, metalness: 0.05 });
+  if (kind === 'food') m.emissive = new THREE.Color(0x664400);
+  if (kind === 'bubble') { m.transparent = true; m.opacity = 0.55; m.roughness = 0.1; }
+  if (kind === 'dome' || kind === 'tentacle') { m.transparent = true; m.opacity = 0.85; }
+  return m;
+}
+
+function build(desc) {
+  if (drawn) {
+    scene.remove(drawn.group);
+    drawn.group.traverse((o) => {
+      if (o.material) {
+        if (o.material.map) o.material.map.dispose();
+        o.material.dispose();
+      }
+    });
+  }
+  const group = new THREE.Group();
+  const water = desc.fluid !== null && desc.fluid > 500;
+  scene.background = new THREE.Color(water ? WATER : AIR);
+  scene.fog = water ? new THREE.FogExp2(WATER, 0.18) : new THREE.Fog(AIR, 30, 120);
+
+  let floor = null;
+  if (desc.floor) {
+    // A checkerboard of 10 cm (or 50 cm) squares shows scale and motion.
+    const cell = desc.distance < 4 ? 0.1 : 0.5;
+    const size = cell * 400;
+    const [a, b] = water ? [[194, 178, 128], [178, 162, 114]] : [[150, 168, 128], [128, 146, 108]];
+    const texels = new Uint8Array([...a, 255, ...b, 255, ...b, 255, ...a, 255]);
+    const checker = new THREE.DataTexture(texels, 2, 2);
+    checker.colorSpace = THREE.SRGBColorSpace;
+    checker.wrapS = checker.wrapT = THREE.RepeatWrapping;
+    checker.magFilter = THREE.NearestFilter;
+    checker.minFilter = THREE.LinearMipmapLinearFilter;
+    checker.generateMipmaps = true;
+    checker.repeat.set(size / cell / 2, size / cell / 2);
+    checker.needsUpdate = true;
+    floor = new THREE.Mesh(
+      new THREE.PlaneGeometry(size, size),
+      new THREE.MeshStandardMaterial({ map: checker, roughness: 0.95 }),
+    );
+    floor.rotation.x = -Math.PI / 2;
+    floor.receiveShadow = true;
+    group.add(floor);
+  }
+
+  // Spheres, one instanced mesh per kind.
+  const byKind = new Map();
+  desc.particles.forEach((p, i) => {
+    if (!byKind.has(p.kind)) byKind.set(p.kind, []);
+    byKind.get(p.kind).push(i);
+  });
+  const spheres = [];
+  for (const [kind, indices] of byKind) {
+    const mesh = new THREE.InstancedMesh(sphere, material(kind), indices.length);
+    mesh.frustumCulled = false;
+    mesh.castShadow = kind !== 'bubble';
+    group.add(mesh);
+    spheres.push({ mesh, indices, radii: indices.map((i) => Math.max(desc.particles[i].radius, 0.001)) });
+  }
+
+  // Springs as thin cylinders, coloured like their first end.
+  let springs = null;
+  if (desc.springs.length > 0) {
+    const mesh = new THREE.InstancedMesh(rod, new THREE.MeshStandardMaterial({ roughness: 0.7 }), desc.springs.length);
+    mesh.frustumCulled = false;
+    mesh.castShadow = true;
+    const colour = new THREE.Color();
+    const radii = desc.springs.map(([a, b], k) => {
+      colour.setHex(COLOURS[desc.particles[a].kind] ?? COLOURS.particle).multiplyScalar(0.8);
+      mesh.setColorAt(k, colour);
+      const r = Math.min(desc.particles[a].radius, desc.particles[b].radius);
+      return Math.min(Math.max(0.3 * r, 0.0015), 0.012);
+    });
+    group.add(mesh);
+    springs = { mesh, radii };
+  }
+
+  // Jellyfish domes: translucent bells over their dome masses.
+  const domes = desc.domes.map((d) => {
+    const mesh = new THREE.Mesh(bell, new THREE.MeshStandardMaterial({
+      color: 0xf7b6d2, transparent: true, opacity: 0.45, side: THREE.DoubleSide, roughness: 0.3,
+      emissive: 0x301020,
+    }));
+    mesh.frustumCulled = false;
+    group.add(mesh);
+    return { ...d, mesh };
+  });
+
+  scene.add(group);
+  drawn = { group, spheres, springs, domes, floor, water, size: desc.distance };
+
+  // Depth precision: the near plane scales with the scene, or the grid
+  // flickers into the floor.
+  camera.near = Math.max(0.001, desc.distance / 400);
+  camera.far = Math.max(100, desc.distance * 300);
+  camera.updateProjectionMatrix();
+  $('hint').textContent = 'drag: orbit · right-drag: pan · wheel: zoom'
+    + (desc.food !== null ? ' · click the floor: move the food' : '')
+    + ' · space: pause · s: step · r: reset';
+  if (framed !== desc.title) {
+    framed = desc.title;
+    const [x, y, z] = desc.target;
+    controls.target.set(x, y, z);
+    const dir = new THREE.Vector3(0.55, 0.45, 1.0).normalize();
+    camera.position.set(x, y, z).addScaledVector(dir, desc.distance);
+    controls.update();
+  }
+  $('title').textContent = desc.title;
+  $('followbox').style.display = 'none';
+}
+
+const m4 = new THREE.Matrix4();
+const q = new THREE.Quaternion();
+const v = new THREE.Vector3();
+const w = new THREE.Vector3();
+const s3 = new THREE.Vector3();
+const UP = new THREE.Vector3(0, 1, 0);
+const ONE = new THREE.Quaternion();
+
+function at(p, i, out) { return out.set(p[3 * i] ?? 0, p[3 * i + 1] ?? 0, p[3 * i + 2] ?? 0); }
+
+function draw(frame) {
+  const p = frame.p;
+  for (const { mesh, indices, radii } of drawn.spheres) {
+    indices.forEach((i, j) => {
+      at(p, i, v);
+      s3.setScalar(radii[j]);
+      mesh.setMatrixAt(j, m4.compose(v, ONE, s3));
+    });
+    mesh.instanceMatrix.needsUpdate = true;
+  }
+  if (drawn.springs) {
+    const { mesh, radii } = drawn.springs;
+    viewer.scene.springs.forEach(([a, b], k) => {
+      at(p, a, v);
+      at(p, b, w);
+      const length = v.distanceTo(w);
+      w.sub(v);
+      if (length > 1e-9) q.setFromUnitVectors(UP, w.divideScalar(length)); else q.identity();
+      v.addScaledVector(w, 0.5 * length);
+      s3.set(radii[k], Math.max(length, 1e-6), radii[k]);
+      mesh.setMatrixAt(k, m4.compose(v, q, s3));
+    });
+    mesh.instanceMatrix.needsUpdate = true;
+  }
+  const states = new Map(frame.creatures.map((c) => [c.name, c]));
+  for (const d of drawn.domes) {
+    const pts = d.particles.map((i) => at(p, i, new THREE.Vector3()));
+    if (pts.length < 3) continue;
+    const c = new THREE.Vector3();
+    pts.forEach((x) => c.add(x));
+    c.divideScalar(pts.length);
+    const n = new THREE.Vector3().subVectors(pts[0], pts[1]).cross(new THREE.Vector3().subVectors(pts[2], pts[0])).normalize();
+    // The bell opens towards the tentacles.
+    if (d.tentacles.length > 0) {
+      const t = new THREE.Vector3();
+      d.tentacles.forEach((i) => t.add(at(p, i, w)));
+      t.divideScalar(d.tentacles.length);
+      if (n.dot(c.clone().sub(t)) < 0) n.negate();
+    }
+    const radius = pts.reduce((r, x) => r + x.distanceTo(c), 0) / pts.length;
+    const st = states.get(d.name);
+    // Contraction follows the pulse: full at the top of the power stroke.
+    const squeeze = st && st.state !== 'idle' && st.phase != null ? Math.max(0, Math.sin(st.phase)) : 0;
+    d.mesh.position.copy(c);
+    d.mesh.quaternion.setFromUnitVectors(UP, n);
+    d.mesh.scale.set(radius * (1.08 - 0.28 * squeeze), radius * (0.75 + 0.45 * squeeze), radius * (1.08 - 0.28 * squeeze));
+  }
+  if (frame.focus && $('follow').checked) {
+    const target = new THREE.Vector3(...frame.focus);
+    const shift = target.sub(controls.target).multiplyScalar(0.08);
+    controls.target.add(shift);
+    camera.position.add(shift);
+  }
+  overlay(frame);
+}
+
+function overlay(frame) {
+  const now = performance.now();
+  const recent = viewer.arrivals.filter((t) => t > now - 1000).length;
+  const lines = [
+    `t        ${frame.t.toFixed(2)} s${frame.paused ? '  (paused)' : ''}`,
+    `frames   ${frame.fps.toFixed(1)}/s sent, ${recent}/s here`,
+    `rtf      ${frame.rtf.toFixed(2)} × real time` + (frame.speed > 0 ? ` (asked ${frame.speed}×)` : ' (flat out)'),
+  ];
+  $('stats').textContent = lines.join('\n');
+  $('note').textContent = frame.note ?? '';
+  $('pause').textContent = frame.paused ? 'resume' : 'pause';
+  $('followbox').style.display = frame.focus ? '' : 'none';
+  const err = $('error');
+  err.style.display = frame.error ? 'block' : 'none';
+  err.textContent = frame.error ?? '';
+  const list = $('creatures');
+  const html = frame.creatures.map((c) => {
+    const energy = c.energy == null ? ''
+      : `<span title="energy ${c.energy.toFixed(2)}"><span class="bar"><i style="width:${(100 * Math.min(1, Math.max(0, c.energy))).toFixed(0)}%"></i></span> ${c.energy.toFixed(2)}</span>`;
+    return `<div class="creature" data-name="${escape(c.name)}"><span>${escape(c.name)}</span><span class="state state-${escape(c.state)}">${escape(c.state)}</span>${energy}</div>`;
+  }).join('');
+  if (list.innerHTML !== html) list.innerHTML = html;
+}
+
+function escape(s) {
+  return String(s).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+}
+
+function resize() {
+  const width = window.innerWidth;
+  const height = window.innerHeight;
+  renderer.setSize(width, height, false);
+  camera.aspect = width / height;
+  camera.updateProjectionMatrix();
+}
+window.addEventListener('resize', resize);
+resize();
+
+/** Where world point (x, y, z) appears on the page, in CSS pixels. */
+function project(x, y, z) {
+  const p = new THREE.Vector3(x, y, z).project(camera);
+  const r = canvas.getBoundingClientRect();
+  return { x: r.left + (p.x + 1) / 2 * r.width, y: r.top + (1 - p.y) / 2 * r.height, visible: p.z < 1 };
+}
+
+/** Where a click at page pixel (px, py) meets the floor (or, with no floor, the food's level). */
+function floorHit(px, py) {
+  const r = canvas.getBoundingClientRect();
+  const ndc = new THREE.Vector2((px - r.left) / r.width * 2 - 1, -((py - r.top) / r.height) * 2 + 1);
+  const ray = new THREE.Raycaster();
+  ray.setFromCamera(ndc, camera);
+  let level = 0;
+  if (!viewer.scene.floor && viewer.scene.food !== null && viewer.frame) level = viewer.frame.p[3 * viewer.scene.food + 1];
+  const hit = new THREE.Vector3();
+  return ray.ray.intersectPlane(new THREE.Plane(new THREE.Vector3(0, 1, 0), -level), hit) ? hit : null;
+}
+
+// A click (not a drag) on the floor moves the food.
+let down = null;
+canvas.addEventListener('pointerdown', (e) => { down = { x: e.clientX, y: e.clientY }; });
+canvas.addEventListener('pointerup', (e) => {
+  if (!down || e.button !== 0) return;
+  const moved = Math.hypot(e.clientX - down.x, e.clientY - down.y);
+  down = null;
+  if (moved > 4 || !viewer.scene || viewer.scene.food === null) return;
+  const hit = floorHit(e.clientX, e.clientY);
+  if (hit) send({ cmd: 'food', x: hit.x, z: hit.z });
+});
+
+$('pause').addEventListener('click', () => send({ cmd: viewer.frame && viewer.frame.paused ? 'resume' : 'pause' }));
+$('step').addEventListener('click', () => send({ cmd: 'step' }));
+$('reset').addEventListener('click', () => send({ cmd: 'reset' }));
+$('speed').addEventListener('change', (e) => send({ cmd: 'speed', value: Number(e.target.value) }));
+window.addEventListener('keydown', (e) => {
+  if (e.target.tagName === 'SELECT') return;
+  if (e.key === ' ') { $('pause').click(); e.preventDefault(); }
+  if (e.key === 's') send({ cmd: 'step' });
+  if (e.key === 'r') send({ cmd: 'reset' });
+});
+
+function animate() {
+  requestAnimationFrame(animate);
+  if (pending && drawn) {
+    // An evolution is shown as the thesis did: the camera orbits the
+    // leader until the user takes over.
+    if (pending.focus && !viewer.orbited) { viewer.orbited = true; controls.autoRotate = true; }
+    draw(pending);
+    pending = null;
+  }
+  controls.update();
+  if (drawn) aimSun(drawn.size);
+  renderer.render(scene, camera);
+}
+controls.autoRotateSpeed = 0.6;
+connect();
+animate();
