@@ -278,7 +278,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let served = thread
             .join()
             .unwrap_or_else(|_| Err("the viewer failed".into()));
-        served.map_err(Failure::Other)?;
+        served.map(|_| ()).map_err(Failure::Other)?;
     }
     if interrupted {
         return Err(Failure::Interrupted(format!(

@@ -69,5 +69,16 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let stop = stop.clone();
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    server.serve(Box::new(stage), stop).map_err(Failure::Other)
+    let s = server
+        .serve(Box::new(stage), stop)
+        .map_err(Failure::Other)?;
+    println!(
+        "simulated {:.2} s in {:.2} s ({:.1}x real time, {} steps), {} frames streamed",
+        s.simulated,
+        s.wall,
+        s.real_time_factor(),
+        s.steps,
+        s.frames
+    );
+    Ok(())
 }

@@ -21,6 +21,7 @@ pub mod stage;
 pub use exhibition::Exhibition;
 pub use stage::{SceneStage, Stage};
 
+pub use runner::Summary;
 use runner::{Outlets, Runner};
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -83,8 +84,9 @@ impl Server {
         self.listener.local_addr().map_err(|e| e.to_string())
     }
 
-    /// Runs `stage` and serves it until `stop` is raised.
-    pub fn serve(self, stage: Box<dyn Stage>, stop: Arc<AtomicBool>) -> Result<(), String> {
+    /// Runs `stage` and serves it until `stop` is raised; says what the
+    /// simulation did.
+    pub fn serve(self, stage: Box<dyn Stage>, stop: Arc<AtomicBool>) -> Result<Summary, String> {
         let out = Outlets::new();
         let (commands, received) = std::sync::mpsc::channel();
         let runner = Runner::new(
@@ -129,7 +131,9 @@ impl Server {
         // Open WebSockets are not waited for.
         runtime.shutdown_timeout(Duration::from_millis(200));
         stop.store(true, Ordering::Relaxed);
-        let _ = simulation.join();
-        served
+        let summary = simulation
+            .join()
+            .map_err(|_| "the simulation thread failed".to_string())?;
+        served.map(|()| summary)
     }
 }

@@ -58,6 +58,31 @@ pub struct Runner {
     paused: bool,
     error: Option<String>,
     positions: Vec<f32>,
+    summary: Summary,
+}
+
+/// What a run did, for the report when it stops.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Summary {
+    /// Simulated seconds stepped (over resets).
+    pub simulated: f64,
+    /// Wall seconds the runner ran.
+    pub wall: f64,
+    /// Physics steps taken.
+    pub steps: u64,
+    /// Frames published to clients.
+    pub frames: u64,
+}
+
+impl Summary {
+    /// Simulated seconds per wall second.
+    pub fn real_time_factor(&self) -> f64 {
+        if self.wall > 0.0 {
+            self.simulated / self.wall
+        } else {
+            0.0
+        }
+    }
 }
 
 impl Runner {
@@ -81,6 +106,7 @@ impl Runner {
             paused: false,
             error: None,
             positions: Vec::new(),
+            summary: Summary::default(),
         };
         runner.publish_scene();
         runner
@@ -94,6 +120,8 @@ impl Runner {
     /// Steps once, recording a failure (which pauses the run).
     fn step(&mut self) {
         let dt = self.stage.dt();
+        self.summary.steps += 1;
+        self.summary.simulated += dt;
         if let Err(e) = self.stage.step(dt) {
             let message = format!(
                 "the simulation failed at t = {:.3} s: {e}",
@@ -129,7 +157,14 @@ impl Runner {
     }
 
     /// Runs until the stop flag is raised or every command sender is gone.
-    pub fn run(mut self) {
+    pub fn run(mut self) -> Summary {
+        let started = Instant::now();
+        self.run_until_stopped();
+        self.summary.wall = started.elapsed().as_secs_f64();
+        self.summary
+    }
+
+    fn run_until_stopped(&mut self) {
         let mut next_frame = Instant::now();
         let mut last = Instant::now();
         // Simulated time the wall clock says we should have reached.
@@ -198,6 +233,7 @@ impl Runner {
             // Nobody watching: nothing to serialise.
             if self.out.frames.receiver_count() > 0 {
                 self.publish_frame(fps, rtf);
+                self.summary.frames += 1;
             }
         }
     }

@@ -22,7 +22,7 @@ fn seaworld() -> PathBuf {
 struct Live {
     url: String,
     stop: Arc<AtomicBool>,
-    thread: Option<std::thread::JoinHandle<Result<(), String>>>,
+    thread: Option<std::thread::JoinHandle<Result<animats_viewer::Summary, String>>>,
 }
 
 impl Live {

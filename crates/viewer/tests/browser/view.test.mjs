@@ -1,0 +1,178 @@
+// The live view in a real browser: starts `animats view scenes/seaworld.toml`
+// on a free port, loads the page in headless Chromium (software WebGL), and
+// checks what a person watching would: something is drawn, frames arrive at
+// 20 Hz or more, pause stops time and resume restarts it, the overlay shows
+// every jellyfish's FSM state, a second tab watches the same run, and a
+// click on the floor moves the food and a jellyfish heads for it.
+//
+//   cd crates/viewer/tests/browser && npm ci && node view.test.mjs
+//
+// Environment: ANIMATS_BIN (default ../../../../target/debug/animats),
+// CHROMIUM (default /usr/bin/chromium), SCREENSHOT (default
+// ../../../../target/browser/seaworld.png).
+import { spawn } from 'node:child_process';
+import { mkdirSync } from 'node:fs';
+import { dirname, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const root = resolve(here, '../../../..');
+const bin = process.env.ANIMATS_BIN ?? resolve(root, 'target/debug/animats');
+const screenshot = process.env.SCREENSHOT ?? resolve(root, 'target/browser/seaworld.png');
+
+let failures = 0;
+function check(ok, what, detail = '') {
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}${detail ? ': ' + detail : ''}`);
+  if (!ok) failures += 1;
+}
+
+/** Starts the server; resolves with its URL once it prints it. */
+function serve() {
+  const child = spawn(bin, ['view', resolve(root, 'scenes/seaworld.toml'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+  return new Promise((ok, fail) => {
+    let out = '';
+    const timer = setTimeout(() => fail(new Error(`no address from ${bin} within 20 s: ${out}`)), 20000);
+    child.on('error', fail);
+    child.on('exit', (code) => fail(new Error(`${bin} exited with ${code}: ${out}`)));
+    child.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/http:\/\/[^\s]+\//);
+      if (m) { clearTimeout(timer); ok({ child, url: m[0] }); }
+    });
+  });
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+const { child, url } = await serve();
+console.log(`serving at ${url}`);
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+});
+try {
+  const page = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+  const errors = [];
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.__viewer && window.__viewer.frames > 5, null, { timeout: 30000 });
+  const v = (f, arg) => page.evaluate(f, arg);
+
+  // Frames arrive at the display rate (30 Hz asked; 20 Hz at least),
+  // counted by the page's own clock over its last two seconds.
+  await sleep(2500);
+  const rate = await v(() => {
+    const now = performance.now();
+    return window.__viewer.arrivals.filter((t) => t > now - 2000).length / 2;
+  });
+  check(rate >= 20, 'WebSocket frames arrive at 20 Hz or more', `${rate.toFixed(1)} Hz`);
+
+  // Something is drawn: the canvas has pixel variance.
+  const pixels = await v(() => {
+    const src = document.getElementById('view');
+    const c = document.createElement('canvas');
+    c.width = 220; c.height = 140;
+    const g = c.getContext('2d');
+    g.drawImage(src, 0, 0, c.width, c.height);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let sum = 0, sum2 = 0;
+    const colours = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+      const y = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
+      sum += y; sum2 += y * y;
+      colours.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | (d[i + 2] >> 3));
+    }
+    const n = d.length / 4;
+    return { variance: sum2 / n - (sum / n) ** 2, colours: colours.size };
+  });
+  check(pixels.variance > 50 && pixels.colours > 100, 'the canvas is not blank',
+    `luminance variance ${pixels.variance.toFixed(0)}, ${pixels.colours} colours`);
+
+  // The overlay shows each jellyfish's FSM state and energy.
+  const rows = await v(() => [...document.querySelectorAll('#creatures .creature')].map((r) => r.innerText.replace(/\s+/g, ' ').trim()));
+  const states = rows.map((r) => (r.match(/\b(idle|track|hover)\b/) ?? [])[0]);
+  check(rows.length === 3 && states.every((s) => s) && rows.every((r) => /\d\.\d\d/.test(r)),
+    'the overlay shows every jellyfish\'s FSM state and energy', rows.join(' | '));
+
+  // Pause stops simulated time; resume continues it.
+  await page.click('#pause');
+  await page.waitForFunction(() => window.__viewer.frame.paused, null, { timeout: 5000 });
+  const t1 = await v(() => window.__viewer.frame.t);
+  await sleep(1000);
+  const t2 = await v(() => window.__viewer.frame.t);
+  const shown = await v(() => document.getElementById('stats').innerText);
+  check(t1 === t2 && shown.includes('paused'), 'pausing stops simulated time', `t ${t1} then ${t2} a second later`);
+  await page.click('#pause');
+  await page.waitForFunction(() => !window.__viewer.frame.paused, null, { timeout: 5000 });
+  const resumed = await v(() => [window.__viewer.frame.t, performance.now()]);
+  await sleep(1000);
+  const later = await v(() => [window.__viewer.frame.t, performance.now()]);
+  const pace = (later[0] - resumed[0]) / ((later[1] - resumed[1]) / 1000);
+  check(later[0] > t2 && pace > 0.5 && pace < 1.5, 'resuming continues it at 1x',
+    `t ${t2} -> ${later[0]}: ${pace.toFixed(2)} simulated s per s`);
+
+  // Several tabs watch the same run.
+  const second = await browser.newPage({ viewport: { width: 400, height: 300 } });
+  await second.goto(url);
+  await second.waitForFunction(() => window.__viewer && window.__viewer.frames > 5, null, { timeout: 30000 });
+  const tabs = async () => Promise.all([page, second].map((p) => p.evaluate(() => [window.__viewer.frames, window.__viewer.frame.t])));
+  const [a0, b0] = await tabs();
+  await sleep(1000);
+  const [a1, b1] = await tabs();
+  check(a1[0] > a0[0] + 10 && b1[0] > b0[0] + 10 && Math.abs(a1[1] - b1[1]) < 3,
+    'a second tab watches the same run', `frames +${a1[0] - a0[0]} and +${b1[0] - b0[0]} in 1 s; t ${a1[1]} and ${b1[1]}`);
+  await second.close();
+
+  // Clicking the floor moves the food; a tracking jellyfish heads for it.
+  const target = { x: 0.6, z: 0.6 };
+  await page.selectOption('#speed', '4');
+  const domes = () => v(() => {
+    const { scene, frame } = window.__viewer;
+    return scene.domes.map((d) => {
+      let x = 0, z = 0;
+      for (const i of d.particles) { x += frame.p[3 * i]; z += frame.p[3 * i + 2]; }
+      return { name: d.name, x: x / d.particles.length, z: z / d.particles.length };
+    });
+  });
+  const spot = await v(({ x, z }) => window.__viewer.project(x, 0, z), target);
+  await page.mouse.click(spot.x, spot.y);
+  await page.waitForFunction(({ x, z }) => {
+    const { scene, frame } = window.__viewer;
+    const i = scene.food;
+    return Math.hypot(frame.p[3 * i] - x, frame.p[3 * i + 2] - z) < 0.02;
+  }, target, { timeout: 5000 }).catch(() => {});
+  const food = await v(() => { const { scene, frame } = window.__viewer; const i = scene.food; return [frame.p[3 * i], frame.p[3 * i + 1], frame.p[3 * i + 2]]; });
+  check(Math.hypot(food[0] - target.x, food[2] - target.z) < 0.02, 'clicking the floor moves the food there',
+    `clicked (${target.x}, ${target.z}) at pixel (${spot.x.toFixed(0)}, ${spot.y.toFixed(0)}); food at (${food.map((c) => c.toFixed(3)).join(', ')})`);
+  const tClick = await v(() => window.__viewer.frame.t);
+  const before = await domes();
+  await page.waitForFunction((t) => window.__viewer.frame.t > t + 15, tClick, { timeout: 30000 });
+  const after = await domes();
+  const heading = before.map((a, k) => {
+    const b = after[k];
+    const to = [target.x - a.x, target.z - a.z];
+    const went = [b.x - a.x, b.z - a.z];
+    const d0 = Math.hypot(...to);
+    const d1 = Math.hypot(target.x - b.x, target.z - b.z);
+    const cos = (to[0] * went[0] + to[1] * went[1]) / (d0 * Math.hypot(...went));
+    return { name: a.name, cos, d0, d1, ok: cos > 0.7 && d1 < 0.8 * d0 };
+  });
+  check(heading.some((h) => h.ok), 'a tracking jellyfish turns towards the food and swims to it',
+    heading.map((h) => `${h.name} heading cos ${h.cos.toFixed(2)}, ${h.d0.toFixed(2)} -> ${h.d1.toFixed(2)} m`).join('; '));
+
+  await page.selectOption('#speed', '1');
+  await sleep(500);
+  mkdirSync(dirname(screenshot), { recursive: true });
+  await page.screenshot({ path: screenshot });
+  console.log(`screenshot: ${screenshot}`);
+  check(errors.length === 0, 'no script errors on the page', errors.join('; '));
+} finally {
+  await browser.close();
+  child.kill('SIGINT');
+}
+if (failures > 0) {
+  console.log(`${failures} browser check(s) failed`);
+  process.exit(1);
+}
+console.log('all browser checks passed');
