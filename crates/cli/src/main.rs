@@ -9,6 +9,7 @@ mod bench;
 mod evolve;
 mod hop;
 mod output;
+mod render;
 mod simulate;
 mod view;
 
@@ -36,6 +37,8 @@ enum Command {
     Bench(bench::Args),
     /// Run a scene live and watch it in the browser (3D, with controls).
     View(view::Args),
+    /// Render a scene headless to a PNG, an animated GIF or an MP4.
+    Render(render::Args),
 }
 
 /// A failed command, with the exit status it maps to.
@@ -58,6 +61,7 @@ fn main() -> ExitCode {
         Command::Evolve(args) => evolve::run(args),
         Command::Bench(args) => bench::run(args),
         Command::View(args) => view::run(args),
+        Command::Render(args) => render::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

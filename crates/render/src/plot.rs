@@ -9,7 +9,8 @@ use std::sync::Once;
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
-fn font() {
+/// Registers the embedded font (once).
+pub(crate) fn font() {
     REGISTER.call_once(|| {
         // The embedded font is known-good; registration only fails on a bad font.
         let _ = register_font("sans-serif", FontStyle::Normal, FONT);

@@ -145,7 +145,13 @@ impl Stage for SceneStage {
     }
 
     fn step(&mut self, dt: f64) -> Result<(), String> {
-        self.scene.step(dt).map(|_| ()).map_err(|e| e.to_string())
+        self.scene.step(dt).map(|_| ()).map_err(|e| match e {
+            animats_engine::SimError::NonFinite { particle, time } => format!(
+                "particle `{}` went non-finite at t = {time} s (try a smaller step)",
+                self.scene.name(particle)
+            ),
+            other => other.to_string(),
+        })
     }
 
     fn positions(&self, out: &mut Vec<f32>) {

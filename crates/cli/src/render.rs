@@ -1,0 +1,358 @@
+//! `animats render SCENE --seconds S --out FILE`: headless pictures of a
+//! scene with the software renderer: the last frame or a frame sheet as
+//! PNG, an animated GIF, or an MP4 through ffmpeg.
+
+use crate::{positive_f64, Failure};
+use animats_engine::DVec3;
+use animats_render::gif_file::encode_gif;
+use animats_render::video::{encode_mp4, ffmpeg_available};
+use animats_render::{render, Camera, DomeParts, Image, Parts};
+use animats_viewer::protocol::Describe;
+use animats_viewer::{SceneStage, Stage};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::time::Instant;
+
+/// Where the camera is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraSpec {
+    /// The live view's starting framing, fixed.
+    Auto,
+    /// That framing, moved along with the creatures (in whole checker
+    /// periods of the floor).
+    Follow,
+    /// An eye and a target, m.
+    At(DVec3, DVec3),
+}
+
+impl FromStr for CameraSpec {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        let vector = |v: &str| -> Result<DVec3, String> {
+            let c: Vec<f64> = v
+                .split(',')
+                .map(|x| x.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| format!("`{v}` is not three numbers x,y,z"))?;
+            match c[..] {
+                [x, y, z] if c.iter().all(|u| u.is_finite()) => Ok(DVec3::new(x, y, z)),
+                _ => Err(format!("`{v}` is not three finite numbers x,y,z")),
+            }
+        };
+        match s {
+            "auto" => Ok(CameraSpec::Auto),
+            "follow" => Ok(CameraSpec::Follow),
+            _ => {
+                let (eye, target) = s
+                    .split_once(':')
+                    .ok_or("expected auto, follow, or EYE:TARGET as x,y,z:x,y,z")?;
+                let (eye, target) = (vector(eye)?, vector(target)?);
+                if eye.distance(target) < 1e-9 {
+                    return Err("the eye and the target are the same point".into());
+                }
+                Ok(CameraSpec::At(eye, target))
+            }
+        }
+    }
+}
+
+/// Arguments of `animats render`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Simulated seconds to render.
+    #[arg(long, value_parser = positive_f64)]
+    seconds: f64,
+    /// The picture: .png (the last frame, or a sheet with --sheet), .gif
+    /// (animated), or .mp4 (needs ffmpeg).
+    #[arg(long, short)]
+    out: PathBuf,
+    /// Pixels across.
+    #[arg(long, default_value_t = 640, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    width: u32,
+    /// Pixels down.
+    #[arg(long, default_value_t = 400, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    height: u32,
+    /// Frames per simulated second (GIF and MP4).
+    #[arg(long, default_value_t = 25.0, value_parser = positive_f64)]
+    fps: f64,
+    /// Camera: `auto` (the live view's framing), `follow` (that framing,
+    /// moving across the floor with the creatures, in steps of two floor
+    /// squares so the floor stands still) or `EYE:TARGET` as `x,y,z:x,y,z`, metres.
+    #[arg(long, default_value = "auto")]
+    camera: CameraSpec,
+    /// Vertical field of view, degrees.
+    #[arg(long, default_value_t = 50.0, value_parser = fov)]
+    fov: f64,
+    /// Write a PNG sheet of this many frames, evenly spaced from t = 0 to
+    /// the end, instead of the last frame.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(2..=100))]
+    sheet: Option<u32>,
+    /// Leave out the time caption.
+    #[arg(long)]
+    no_caption: bool,
+}
+
+fn fov(s: &str) -> Result<f64, String> {
+    let v = positive_f64(s)?;
+    if v < 170.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be below 170 degrees, got {s}"))
+    }
+}
+
+#[derive(Clone, Copy, PartialEq)]
+enum Format {
+    Png,
+    Gif,
+    Mp4,
+}
+
+/// Simulated instants of the frames.
+fn frame_times(
+    seconds: f64,
+    format: Format,
+    fps: f64,
+    sheet: Option<u32>,
+) -> Result<Vec<f64>, Failure> {
+    Ok(match (format, sheet) {
+        (Format::Png, None) => vec![seconds],
+        (Format::Png, Some(n)) => (0..n)
+            .map(|k| seconds * f64::from(k) / f64::from(n - 1))
+            .collect(),
+        _ => {
+            let n = (seconds * fps + 1e-9).floor();
+            if n > 20_000.0 {
+                return Err(Failure::Input(format!(
+                    "{n} frames is too many: lower --seconds or --fps"
+                )));
+            }
+            (0..=n as u64).map(|k| k as f64 / fps).collect()
+        }
+    })
+}
+
+/// One instant: where everything is and how far each bell has contracted.
+struct Snapshot {
+    t: f64,
+    positions: Vec<DVec3>,
+    squeeze: Vec<f64>,
+}
+
+fn snapshot(stage: &SceneStage, describe: &Describe) -> Snapshot {
+    let mut p = Vec::new();
+    stage.positions(&mut p);
+    let positions = p
+        .chunks_exact(3)
+        .map(|c| DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
+        .collect();
+    let creatures = stage.creatures();
+    let squeeze = describe
+        .domes
+        .iter()
+        .map(|d| {
+            creatures
+                .iter()
+                .find(|c| c.name == d.name)
+                .and_then(|c| c.phase.filter(|_| c.state != "idle"))
+                .map_or(0.0, |phase| phase.sin().max(0.0))
+        })
+        .collect();
+    Snapshot {
+        t: stage.time(),
+        positions,
+        squeeze,
+    }
+}
+
+/// Centre of the creatures (or of everything, if there are none).
+fn creatures_centre(describe: &Describe, positions: &[DVec3]) -> DVec3 {
+    let alive = |k: &str| matches!(k, "roobot" | "quadruped" | "dome" | "tentacle");
+    let mut picked: Vec<DVec3> = describe
+        .particles
+        .iter()
+        .zip(positions)
+        .filter(|(p, _)| alive(&p.kind))
+        .map(|(_, x)| *x)
+        .collect();
+    if picked.is_empty() {
+        picked = positions.to_vec();
+    }
+    picked.iter().sum::<DVec3>() / picked.len().max(1) as f64
+}
+
+/// Writes `bytes` to `path` through a temporary file: no partial picture is
+/// ever left under the final name.
+fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Failure> {
+    animats_evolve::checkpoint::write_atomically(path, bytes).map_err(Failure::Other)
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), Failure> {
+    let ext = args
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let format = match ext.as_deref() {
+        Some("png") => Format::Png,
+        Some("gif") => Format::Gif,
+        Some("mp4") => Format::Mp4,
+        _ => {
+            return Err(Failure::Input(format!(
+                "{}: the output must end in .png, .gif or .mp4",
+                args.out.display()
+            )))
+        }
+    };
+    if args.sheet.is_some() && format != Format::Png {
+        return Err(Failure::Input("--sheet makes a .png".into()));
+    }
+    if format == Format::Mp4 && !ffmpeg_available() {
+        return Err(Failure::Input(format!(
+            "{}: writing .mp4 needs ffmpeg, which is not installed here (or not on PATH); install it (apt install ffmpeg) or write a .gif",
+            args.out.display()
+        )));
+    }
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if !dir.is_dir() {
+            return Err(Failure::Input(format!(
+                "{}: the directory {} does not exist",
+                args.out.display(),
+                dir.display()
+            )));
+        }
+    }
+    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
+
+    let mut stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    let describe = stage.describe();
+    let parts = Parts {
+        kinds: describe.particles.iter().map(|p| p.kind.clone()).collect(),
+        radii: describe.particles.iter().map(|p| p.radius).collect(),
+        springs: describe.springs.clone(),
+        domes: describe
+            .domes
+            .iter()
+            .map(|d| DomeParts {
+                dome: d.particles.clone(),
+                tentacles: d.tentacles.clone(),
+                squeeze: 0.0,
+            })
+            .collect(),
+        floor: describe.floor,
+        water: describe.fluid.is_some_and(|rho| rho > 500.0),
+        cell: if describe.distance < 4.0 { 0.1 } else { 0.5 },
+    };
+
+    let start = Instant::now();
+    let dt = stage.dt();
+    let mut snapshots = Vec::with_capacity(times.len());
+    for &t in &times {
+        while stage.time() < t - 0.5 * dt {
+            stage.step(dt).map_err(|e| {
+                Failure::Blowup(format!(
+                    "{}: {e}; nothing was written",
+                    args.scene.display()
+                ))
+            })?;
+        }
+        snapshots.push(snapshot(&stage, &describe));
+    }
+
+    let base = Camera::framing(DVec3::from_array(describe.target), describe.distance);
+    let start_centre = creatures_centre(&describe, &snapshots[0].positions);
+    let camera = |s: &Snapshot| -> Camera {
+        let c = match &args.camera {
+            CameraSpec::Auto => base,
+            CameraSpec::Follow => {
+                // In whole periods of the floor's checker: the floor looks
+                // the same in every frame, which also keeps GIFs small.
+                let period = 2.0 * parts.cell;
+                let moved = creatures_centre(&describe, &s.positions) - start_centre;
+                let shift = (DVec3::new(moved.x, 0.0, moved.z) / period).round() * period;
+                Camera {
+                    eye: base.eye + shift,
+                    target: base.target + shift,
+                    ..base
+                }
+            }
+            CameraSpec::At(eye, target) => Camera {
+                eye: *eye,
+                target: *target,
+                ..base
+            },
+        };
+        Camera {
+            fov_y: args.fov,
+            ..c
+        }
+    };
+    let frames: Vec<Image> = snapshots
+        .par_iter()
+        .map(|s| {
+            let mut parts = parts.clone();
+            for (d, q) in parts.domes.iter_mut().zip(&s.squeeze) {
+                d.squeeze = *q;
+            }
+            let mut picture = parts.picture(&s.positions);
+            if !args.no_caption {
+                picture.caption = Some(format!("t = {:.2} s", s.t));
+            }
+            render(&picture, &camera(s), args.width, args.height)
+        })
+        .collect();
+
+    let bytes = match (format, args.sheet) {
+        (Format::Png, None) => frames
+            .last()
+            .map(Image::png)
+            .transpose()
+            .map_err(Failure::Other)?,
+        (Format::Png, Some(n)) => {
+            let columns = f64::from(n).sqrt().ceil() as u32;
+            Some(
+                Image::sheet(&frames, columns)
+                    .png()
+                    .map_err(Failure::Other)?,
+            )
+        }
+        (Format::Gif, _) => {
+            // GIF delays are in hundredths of a second.
+            let delay = (100.0 / args.fps).round().clamp(2.0, 65535.0) as u16;
+            Some(encode_gif(&frames, delay).map_err(Failure::Other)?)
+        }
+        (Format::Mp4, _) => None,
+    };
+    match bytes {
+        Some(b) => write_atomically(&args.out, &b)?,
+        None => {
+            let partial = args.out.with_extension("mp4.partial");
+            let encoded = encode_mp4(&frames, args.fps, &partial);
+            if let Err(e) = encoded {
+                let _ = std::fs::remove_file(&partial);
+                return Err(Failure::Other(e));
+            }
+            std::fs::rename(&partial, &args.out).map_err(|e| {
+                Failure::Other(format!("{}: cannot write: {e}", args.out.display()))
+            })?;
+        }
+    }
+    let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
+    println!(
+        "{}: {} frame{} of {}x{} rendered in {:.2} s, to t = {:.2} s; wrote {} ({size} bytes)",
+        args.scene.display(),
+        frames.len(),
+        if frames.len() == 1 { "" } else { "s" },
+        args.width,
+        args.height,
+        start.elapsed().as_secs_f64(),
+        snapshots.last().map_or(0.0, |s| s.t),
+        args.out.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,372 @@
+//! `animats render`: pictures of the right size, not blank, with the floor
+//! and the creatures where the camera puts them, the same bytes every run,
+//! and clear refusals.
+
+mod common;
+use animats_engine::DVec3;
+use animats_render::camera::View;
+use animats_render::{Camera, Image};
+use common::{animats, scratch, text, write};
+
+fn decode_png(path: &std::path::Path) -> Image {
+    let file = std::fs::File::open(path).expect("open png");
+    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .expect("png header");
+    let mut buf = vec![0; reader.output_buffer_size().expect("size")];
+    let info = reader.next_frame(&mut buf).expect("png data");
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    buf.truncate(info.buffer_size());
+    Image {
+        width: info.width,
+        height: info.height,
+        rgb: buf,
+    }
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let o = animats(args);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{args:?}: {err}");
+    out
+}
+
+#[test]
+fn a_png_shows_the_ball_and_the_floor_where_the_camera_puts_them() {
+    let dir = scratch("render-png");
+    let out = dir.join("ball.png");
+    let (eye, target) = (DVec3::new(0.0, 0.8, 2.0), DVec3::new(0.0, 0.4, 0.0));
+    run_ok(&[
+        "render",
+        "scenes/bouncing_ball.toml",
+        "--seconds",
+        "0.2",
+        "--width",
+        "320",
+        "--height",
+        "200",
+        "--camera",
+        "0,0.8,2:0,0.4,0",
+        "--no-caption",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let img = decode_png(&out);
+    assert_eq!((img.width, img.height), (320, 200));
+
+    // Where the ball is at t = 0.2 s, from the library.
+    let mut scene = animats_scene::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/bouncing_ball.toml"
+    )))
+    .expect("scene");
+    for _ in 0..200 {
+        scene.step(0.001).expect("step");
+    }
+    let ball = scene.world.position(scene.particle("ball").expect("ball"));
+    assert!(
+        (ball.y - (1.05 - 0.5 * 9.8 * 0.04)).abs() < 1e-3,
+        "free fall: {ball}"
+    );
+    let view = View::new(
+        &Camera {
+            eye,
+            target,
+            fov_y: 50.0,
+        },
+        320,
+        200,
+    );
+    let (x, y, _) = view.project(ball).expect("in view");
+    let p = img.pixel(x as u32, y as u32);
+    // The scene's particles are steel blue (0x6fa8dc), shaded.
+    assert!(
+        p[2] > p[0] + 40 && p[2] > 100,
+        "the ball at ({x:.0}, {y:.0}): {p:?}"
+    );
+    // The floor under it (a checker of green-grey) and the sky at the top.
+    let (fx, fy, _) = view
+        .project(DVec3::new(0.05, 0.0, 0.35))
+        .expect("floor in view");
+    let f = img.pixel(fx as u32, fy as u32);
+    assert!(
+        f[1] > f[2] && f[1] > 90,
+        "floor at ({fx:.0}, {fy:.0}): {f:?}"
+    );
+    let sky = img.pixel(160, 1);
+    assert!(
+        sky[2] >= sky[0] && sky.iter().all(|&c| c > 150),
+        "sky: {sky:?}"
+    );
+
+    // Not blank: many colours and real contrast.
+    let lum: Vec<f64> = img
+        .rgb
+        .chunks_exact(3)
+        .map(|c| f64::from(c[0]) + f64::from(c[1]) + f64::from(c[2]))
+        .collect();
+    let mean = lum.iter().sum::<f64>() / lum.len() as f64;
+    let var = lum.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / lum.len() as f64;
+    assert!(var > 500.0, "variance {var}");
+}
+
+#[test]
+fn the_same_scene_renders_the_same_bytes() {
+    let dir = scratch("render-same");
+    for name in ["a", "b"] {
+        for ext in ["png", "gif"] {
+            let out = dir.join(format!("{name}.{ext}"));
+            run_ok(&[
+                "render",
+                "scenes/seaworld.toml",
+                "--seconds",
+                "1",
+                "--fps",
+                "5",
+                "--width",
+                "160",
+                "--height",
+                "100",
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+        }
+    }
+    for ext in ["png", "gif"] {
+        let a = std::fs::read(dir.join(format!("a.{ext}"))).expect("a");
+        let b = std::fs::read(dir.join(format!("b.{ext}"))).expect("b");
+        assert!(a.len() > 1000, "{ext}: {} bytes", a.len());
+        assert!(a == b, "{ext}: two runs differ");
+    }
+    let gif = std::fs::read(dir.join("a.gif")).expect("gif");
+    let mut decoder = gif::DecodeOptions::new()
+        .read_info(gif.as_slice())
+        .expect("gif");
+    let mut frames = 0;
+    while decoder.read_next_frame().expect("frame").is_some() {
+        frames += 1;
+    }
+    assert_eq!(frames, 6, "t = 0, 0.2, ... 1.0 s at 5 frames a second");
+}
+
+#[test]
+fn a_sheet_tiles_the_frames() {
+    let dir = scratch("render-sheet");
+    let out = dir.join("sheet.png");
+    let stdout = run_ok(&[
+        "render",
+        "scenes/roobot.toml",
+        "--seconds",
+        "2",
+        "--sheet",
+        "5",
+        "--width",
+        "120",
+        "--height",
+        "80",
+        "--camera",
+        "follow",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("5 frames of 120x80"), "{stdout}");
+    let img = decode_png(&out);
+    assert_eq!((img.width, img.height), (360, 160), "3 columns, 2 rows");
+}
+
+#[test]
+fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
+    let dir = scratch("render-bad");
+    let refuse = |args: &[&str], expect: &str| {
+        let o = animats(args);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(expect), "{args:?}: {err}");
+    };
+    let out = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    refuse(
+        &[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--out",
+            &out("x.bmp"),
+        ],
+        ".png, .gif or .mp4",
+    );
+    refuse(
+        &[
+            "render",
+            "nope.toml",
+            "--seconds",
+            "1",
+            "--out",
+            &out("x.png"),
+        ],
+        "nope.toml",
+    );
+    refuse(
+        &[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--out",
+            "/nonexistent-dir/x.png",
+        ],
+        "does not exist",
+    );
+    refuse(
+        &[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--camera",
+            "1,2:3",
+            "--out",
+            &out("x.png"),
+        ],
+        "--camera",
+    );
+    refuse(
+        &[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "-1",
+            "--out",
+            &out("x.png"),
+        ],
+        "--seconds",
+    );
+    refuse(
+        &[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--sheet",
+            "4",
+            "--out",
+            &out("x.gif"),
+        ],
+        "--sheet",
+    );
+
+    // No ffmpeg on the PATH: a clear message, nothing written.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_animats"))
+        .args([
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--out",
+            &out("x.mp4"),
+        ])
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
+        .env("PATH", dir.to_str().unwrap())
+        .output()
+        .expect("run");
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("needs ffmpeg"), "{err}");
+    assert!(!dir.join("x.mp4").exists());
+
+    let scene = write(
+        &dir,
+        "stiff.toml",
+        r#"
+[world]
+gravity = [0.0, 0.0, 0.0]
+dt = 0.01
+integrator = "euler"
+
+[[particle]]
+name = "anchor"
+mass = 1.0
+position = [0.0, 0.0, 0.0]
+radius = 0.01
+fixed = true
+
+[[particle]]
+name = "wobbly"
+mass = 0.001
+position = [1.1, 0.0, 0.0]
+radius = 0.01
+
+[[spring]]
+a = "anchor"
+b = "wobbly"
+stiffness = 1e6
+rest_length = 1.0
+"#,
+    );
+    let gif = dir.join("blow.gif");
+    let o = animats(&[
+        "render",
+        &scene,
+        "--seconds",
+        "10",
+        "--out",
+        gif.to_str().unwrap(),
+    ]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("`wobbly`") && err.contains("nothing was written"),
+        "{err}"
+    );
+    assert!(!gif.exists());
+}
+
+#[test]
+fn an_mp4_comes_from_ffmpeg_when_it_is_installed() {
+    if !animats_render::video::ffmpeg_available() {
+        // CI installs ffmpeg (.ci/run); the refusal without it is tested above.
+        eprintln!("ffmpeg is not installed: the MP4 test cannot run here");
+        return;
+    }
+    let dir = scratch("render-mp4");
+    let mut files = Vec::new();
+    for name in ["a.mp4", "b.mp4"] {
+        let out = dir.join(name);
+        run_ok(&[
+            "render",
+            "scenes/seaworld.toml",
+            "--seconds",
+            "1",
+            "--fps",
+            "10",
+            "--width",
+            "161",
+            "--height",
+            "100",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        files.push(std::fs::read(&out).expect("mp4"));
+    }
+    assert_eq!(&files[0][4..8], b"ftyp", "an MP4 file");
+    assert!(files[0] == files[1], "the same scene gives the same MP4");
+    assert!(!dir.join("a.mp4.partial").exists());
+    let probe = std::process::Command::new("ffprobe")
+        .args(["-v", "error", "-count_frames", "-select_streams", "v:0"])
+        .args([
+            "-show_entries",
+            "stream=width,height,nb_read_frames",
+            "-of",
+            "csv=p=0",
+        ])
+        .arg(dir.join("a.mp4"))
+        .output();
+    if let Ok(p) = probe {
+        let info = String::from_utf8_lossy(&p.stdout);
+        assert_eq!(
+            info.trim(),
+            "162,100,11",
+            "padded to an even width; 11 frames (t = 0 to 1 s)"
+        );
+    }
+}

@@ -1,0 +1,349 @@
+//! The software renderer: every primitive is ray-cast exactly over its
+//! projected bounding box into a colour and depth buffer, at twice the
+//! output resolution (then averaged down: antialiasing). No GPU, no display,
+//! no threads inside a frame: the same picture gives the same bytes.
+//!
+//! Order: sky or water and the checkered floor (one ray per pixel), blob
+//! shadows of the spheres under a light from straight above, spheres and
+//! rods (depth-tested), then the translucent bells blended over them, then
+//! the fog of the water (or of distance in air), then the caption.
+
+use crate::camera::{Camera, View};
+use crate::image::Image;
+use crate::picture::{hex, Bell, Colour, Picture, Rod, Sphere};
+use glam::DVec3;
+
+/// Samples per pixel along each axis.
+const SUPERSAMPLE: u32 = 2;
+/// Where the light comes from (the live view's sun).
+const SUN: DVec3 = DVec3::new(0.3, 1.0, 0.5);
+/// Water fog density, 1/m (the live view's).
+const WATER_FOG: f64 = 0.18;
+
+/// Colour and depth buffers at the supersampled size.
+struct Canvas {
+    width: u32,
+    height: u32,
+    colour: Vec<Colour>,
+    /// Distance along each pixel's ray to what it shows; infinite for sky.
+    depth: Vec<f64>,
+    /// Where each pixel's ray meets the floor, if it shows the floor.
+    floor: Vec<Option<DVec3>>,
+}
+
+/// Renders `picture` seen by `camera` as a `width` × `height` image.
+pub fn render(picture: &Picture, camera: &Camera, width: u32, height: u32) -> Image {
+    let (w, h) = (width.max(1) * SUPERSAMPLE, height.max(1) * SUPERSAMPLE);
+    let view = View::new(camera, w, h);
+    let n = (w * h) as usize;
+    let mut c = Canvas {
+        width: w,
+        height: h,
+        colour: vec![Colour::ZERO; n],
+        depth: vec![f64::INFINITY; n],
+        floor: vec![None; n],
+    };
+    let sun = SUN.normalize();
+    backdrop(&mut c, &view, picture);
+    if picture.floor.is_some() {
+        for s in picture.spheres.iter().filter(|s| s.shadow) {
+            shadow(&mut c, &view, s);
+        }
+    }
+    for s in &picture.spheres {
+        sphere(&mut c, &view, s, sun);
+    }
+    for r in &picture.rods {
+        rod(&mut c, &view, r, sun);
+    }
+    for b in &picture.bells {
+        bell(&mut c, &view, b, sun);
+    }
+    fog(&mut c, &view, picture.water);
+    let mut image = downsample(&c, width.max(1), height.max(1));
+    if let Some(caption) = &picture.caption {
+        image.caption(caption);
+    }
+    image
+}
+
+fn water_colour(ray: DVec3) -> Colour {
+    // Lighter towards the surface.
+    hex(0x0d3b5c).lerp(hex(0x2a6f97), (0.5 + 0.5 * ray.y).clamp(0.0, 1.0))
+}
+
+fn sky_colour(ray: DVec3) -> Colour {
+    hex(0xdfe9f2).lerp(hex(0x9fbdd8), ray.y.clamp(0.0, 1.0).sqrt())
+}
+
+/// Sky (or water) and the floor, one ray per pixel.
+fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
+    let (light, dark) = if picture.water {
+        (hex(0xc2b280), hex(0xb2a272))
+    } else {
+        (hex(0x96a880), hex(0x80926c))
+    };
+    for y in 0..c.height {
+        for x in 0..c.width {
+            let i = (y * c.width + x) as usize;
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            c.colour[i] = if picture.water {
+                water_colour(ray)
+            } else {
+                sky_colour(ray)
+            };
+            let Some(cell) = picture.floor else { continue };
+            if ray.y >= -1e-9 || view.eye.y <= 0.0 {
+                continue;
+            }
+            let t = -view.eye.y / ray.y;
+            let p = view.eye + ray * t;
+            let odd =
+                ((p.x / cell).floor() as i64 + (p.z / cell).floor() as i64).rem_euclid(2) == 1;
+            let base = if odd { dark } else { light };
+            // Lambert under the sun, as the live view's floor.
+            c.colour[i] = base * (0.55 + 0.45 * SUN.normalize().y);
+            c.depth[i] = t;
+            c.floor[i] = Some(p);
+        }
+    }
+}
+
+/// Pixel bounds (x0, y0, x1, y1) of the projection of the points, padded.
+fn bounds(c: &Canvas, view: &View, points: &[DVec3], pad: f64) -> Option<(u32, u32, u32, u32)> {
+    let (mut x0, mut y0, mut x1, mut y1) = (
+        f64::INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for p in points {
+        let (x, y, _) = view.project(*p)?;
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    let (w, h) = (f64::from(c.width), f64::from(c.height));
+    let (x0, y0) = ((x0 - pad).floor().max(0.0), (y0 - pad).floor().max(0.0));
+    let (x1, y1) = ((x1 + pad).ceil().min(w), (y1 + pad).ceil().min(h));
+    (x0 < x1 && y0 < y1).then_some((x0 as u32, y0 as u32, x1 as u32, y1 as u32))
+}
+
+/// The box corners of a sphere, for its screen bounds.
+fn corners(centre: DVec3, r: f64) -> [DVec3; 8] {
+    let mut out = [DVec3::ZERO; 8];
+    for (k, o) in out.iter_mut().enumerate() {
+        let s = |bit: usize| if k & bit == 0 { -r } else { r };
+        *o = centre + DVec3::new(s(1), s(2), s(4));
+    }
+    out
+}
+
+/// Screen bounds of a box, or the whole canvas when it reaches behind the eye.
+fn box_bounds(c: &Canvas, view: &View, pts: &[DVec3]) -> Option<(u32, u32, u32, u32)> {
+    if pts.iter().any(|p| view.depth(*p) <= 1e-6) {
+        if pts.iter().all(|p| view.depth(*p) <= 1e-6) {
+            return None;
+        }
+        return Some((0, 0, c.width, c.height));
+    }
+    bounds(c, view, pts, 1.0)
+}
+
+fn shade(base: Colour, normal: DVec3, ray: DVec3, sun: DVec3) -> Colour {
+    let diffuse = normal.dot(sun).max(0.0);
+    let half = (sun - ray).normalize();
+    let specular = libm::pow(normal.dot(half).max(0.0), 40.0) * 0.25;
+    base * (0.42 + 0.62 * diffuse) + DVec3::splat(specular)
+}
+
+/// A soft dark disc on the floor under a sphere, fading with its height.
+fn shadow(c: &mut Canvas, view: &View, s: &Sphere) {
+    let h = s.centre.y;
+    if h <= 0.0 {
+        return;
+    }
+    let r = s.radius * 1.1;
+    let strength = 0.45 * libm::exp(-h / (6.0 * s.radius + 0.3));
+    let ground = DVec3::new(s.centre.x, 0.0, s.centre.z);
+    let square = [
+        ground + DVec3::new(-r, 0.0, -r),
+        ground + DVec3::new(r, 0.0, -r),
+        ground + DVec3::new(-r, 0.0, r),
+        ground + DVec3::new(r, 0.0, r),
+    ];
+    let Some((x0, y0, x1, y1)) = box_bounds(c, view, &square) else {
+        return;
+    };
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let i = (y * c.width + x) as usize;
+            let Some(p) = c.floor[i] else { continue };
+            let d = DVec3::new(p.x - ground.x, 0.0, p.z - ground.z).length() / r;
+            if d < 1.0 {
+                c.colour[i] *= 1.0 - strength * (1.0 - d * d);
+            }
+        }
+    }
+}
+
+fn sphere(c: &mut Canvas, view: &View, s: &Sphere, sun: DVec3) {
+    let Some((x0, y0, x1, y1)) = box_bounds(c, view, &corners(s.centre, s.radius)) else {
+        return;
+    };
+    let oc = view.eye - s.centre;
+    let cc = oc.length_squared() - s.radius * s.radius;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let b = oc.dot(ray);
+            let disc = b * b - cc;
+            if disc < 0.0 {
+                continue;
+            }
+            let t = -b - disc.sqrt();
+            let i = (y * c.width + x) as usize;
+            if t <= 0.0 || t >= c.depth[i] {
+                continue;
+            }
+            let normal = (oc + ray * t) / s.radius;
+            c.depth[i] = t;
+            c.floor[i] = None;
+            c.colour[i] = shade(s.colour, normal, ray, sun);
+        }
+    }
+}
+
+fn rod(c: &mut Canvas, view: &View, r: &Rod, sun: DVec3) {
+    let ba = r.b - r.a;
+    let baba = ba.length_squared();
+    if baba < 1e-18 {
+        return;
+    }
+    let mut pts = corners(r.a, r.radius).to_vec();
+    pts.extend(corners(r.b, r.radius));
+    let Some((x0, y0, x1, y1)) = box_bounds(c, view, &pts) else {
+        return;
+    };
+    let oc = view.eye - r.a;
+    let baoc = ba.dot(oc);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            // Ray against the finite cylinder (the ends are under the spheres).
+            let bard = ba.dot(ray);
+            let k2 = baba - bard * bard;
+            if k2.abs() < 1e-18 {
+                continue;
+            }
+            let k1 = baba * oc.dot(ray) - baoc * bard;
+            let k0 = baba * oc.length_squared() - baoc * baoc - r.radius * r.radius * baba;
+            let h = k1 * k1 - k2 * k0;
+            if h < 0.0 {
+                continue;
+            }
+            let t = (-k1 - h.sqrt()) / k2;
+            let along = baoc + t * bard;
+            let i = (y * c.width + x) as usize;
+            if t <= 0.0 || along < 0.0 || along > baba || t >= c.depth[i] {
+                continue;
+            }
+            let normal = (oc + ray * t - ba * (along / baba)) / r.radius;
+            c.depth[i] = t;
+            c.floor[i] = None;
+            c.colour[i] = shade(r.colour, normal, ray, sun);
+        }
+    }
+}
+
+fn bell(c: &mut Canvas, view: &View, b: &Bell, sun: DVec3) {
+    if b.radius <= 0.0 || b.height <= 0.0 {
+        return;
+    }
+    // A frame with the axis as local y; the ellipsoid becomes a unit sphere
+    // after scaling by (radius, height, radius).
+    let ey = b.axis;
+    let ex = if ey.x.abs() < 0.9 { DVec3::X } else { DVec3::Z }
+        .cross(ey)
+        .normalize();
+    let ez = ex.cross(ey);
+    let scale = DVec3::new(b.radius, b.height, b.radius);
+    let local = |v: DVec3| DVec3::new(v.dot(ex), v.dot(ey), v.dot(ez)) / scale;
+    let reach = b.radius.max(b.height);
+    let Some((x0, y0, x1, y1)) = box_bounds(c, view, &corners(b.centre, reach)) else {
+        return;
+    };
+    let o = local(view.eye - b.centre);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let d = local(ray);
+            let (a2, b2, c2) = (d.length_squared(), o.dot(d), o.length_squared() - 1.0);
+            let disc = b2 * b2 - a2 * c2;
+            if disc < 0.0 {
+                continue;
+            }
+            let sq = disc.sqrt();
+            let i = (y * c.width + x) as usize;
+            // The first hit on the upper half: the outside of the crown, or
+            // the inside seen through the open rim.
+            for t in [(-b2 - sq) / a2, (-b2 + sq) / a2] {
+                let p = o + d * t;
+                if t <= 0.0 || p.y < 0.0 {
+                    continue;
+                }
+                if t < c.depth[i] {
+                    let n = (ex * (p.x / b.radius) + ey * (p.y / b.height) + ez * (p.z / b.radius))
+                        .normalize();
+                    let n = if n.dot(ray) > 0.0 { -n } else { n };
+                    let lit = shade(b.colour, n, ray, sun);
+                    c.colour[i] = c.colour[i].lerp(lit, 0.45);
+                }
+                break;
+            }
+        }
+    }
+}
+
+/// Water fades everything into its colour with distance; air only the far
+/// floor into the haze of the horizon.
+fn fog(c: &mut Canvas, view: &View, water: bool) {
+    for y in 0..c.height {
+        for x in 0..c.width {
+            let i = (y * c.width + x) as usize;
+            let t = c.depth[i];
+            if !t.is_finite() {
+                continue;
+            }
+            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let (haze, density) = if water {
+                (water_colour(ray), WATER_FOG)
+            } else {
+                (sky_colour(DVec3::new(ray.x, 0.0, ray.z)), 1.0 / 60.0)
+            };
+            let keep = libm::exp(-density * t);
+            c.colour[i] = haze.lerp(c.colour[i], keep);
+        }
+    }
+}
+
+/// Averages each SUPERSAMPLE × SUPERSAMPLE block into one 8-bit pixel.
+fn downsample(c: &Canvas, width: u32, height: u32) -> Image {
+    let mut rgb = Vec::with_capacity((width * height * 3) as usize);
+    let k = f64::from(SUPERSAMPLE * SUPERSAMPLE);
+    for y in 0..height {
+        for x in 0..width {
+            let mut sum = Colour::ZERO;
+            for dy in 0..SUPERSAMPLE {
+                for dx in 0..SUPERSAMPLE {
+                    let i = ((y * SUPERSAMPLE + dy) * c.width + x * SUPERSAMPLE + dx) as usize;
+                    sum += c.colour[i];
+                }
+            }
+            let v = sum / k;
+            rgb.extend([v.x, v.y, v.z].map(|u| (u.clamp(0.0, 1.0) * 255.0 + 0.5) as u8));
+        }
+    }
+    Image { width, height, rgb }
+}
