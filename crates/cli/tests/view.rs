@@ -23,21 +23,37 @@ fn it_prints_its_address_serves_the_page_and_stops_on_ctrl_c_with_a_summary() {
         .and_then(|s| s.split('/').next())
         .unwrap_or_else(|| panic!("no address in {line:?}"))
         .to_string();
-    assert!(address.starts_with("127.0.0.1:"), "binds this machine only by default: {line}");
+    assert!(
+        address.starts_with("127.0.0.1:"),
+        "binds this machine only by default: {line}"
+    );
 
     let mut s = std::net::TcpStream::connect(&address).expect("connect");
-    write!(s, "GET / HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n").expect("write");
+    write!(
+        s,
+        "GET / HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("write");
     let mut page = String::new();
     s.read_to_string(&mut page).expect("read");
-    assert!(page.starts_with("HTTP/1.1 200") && page.contains("animats view"), "{page}");
+    assert!(
+        page.starts_with("HTTP/1.1 200") && page.contains("animats view"),
+        "{page}"
+    );
 
     let pid = child.id().to_string();
-    Command::new("kill").args(["-INT", &pid]).status().expect("kill");
+    Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .expect("kill");
     let status = child.wait().expect("wait");
     let mut rest = String::new();
     out.read_to_string(&mut rest).expect("rest");
     assert_eq!(status.code(), Some(0), "{rest}");
-    assert!(rest.contains("x real time"), "a summary with the real-time factor: {rest}");
+    assert!(
+        rest.contains("x real time"),
+        "a summary with the real-time factor: {rest}"
+    );
 }
 
 #[test]
@@ -52,14 +68,27 @@ fn a_missing_scene_or_a_port_in_use_exits_2() {
     let o = animats(&["view", "scenes/seaworld.toml", "--port", &port]);
     let (_, err) = text(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("cannot listen on 127.0.0.1:") && err.contains("--port"), "{err}");
+    assert!(
+        err.contains("cannot listen on 127.0.0.1:") && err.contains("--port"),
+        "{err}"
+    );
 }
 
 #[test]
 fn evolve_view_serves_during_and_after_the_run_until_ctrl_c() {
     let dir = common::scratch("evolve-view");
     let mut child = Command::new(env!("CARGO_BIN_EXE_animats"))
-        .args(["evolve", "--generations", "20", "--lanes", "2", "--view", "--port", "0", "--out"])
+        .args([
+            "evolve",
+            "--generations",
+            "20",
+            "--lanes",
+            "2",
+            "--view",
+            "--port",
+            "0",
+            "--out",
+        ])
         .arg(&dir)
         .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .stdout(Stdio::piped())
@@ -84,12 +113,23 @@ fn evolve_view_serves_during_and_after_the_run_until_ctrl_c() {
         .unwrap_or_else(|| panic!("no address in {seen}"))
         .to_string();
     let mut s = std::net::TcpStream::connect(&address).expect("connect after the run");
-    write!(s, "GET /app.js HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n").expect("write");
+    write!(
+        s,
+        "GET /app.js HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("write");
     let mut page = String::new();
     s.read_to_string(&mut page).expect("read");
     assert!(page.starts_with("HTTP/1.1 200"), "{page}");
-    Command::new("kill").args(["-INT", &child.id().to_string()]).status().expect("kill");
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
     let status = child.wait().expect("wait");
-    assert_eq!(status.code(), Some(0), "the run had finished: Ctrl-C only closes the view");
+    assert_eq!(
+        status.code(),
+        Some(0),
+        "the run had finished: Ctrl-C only closes the view"
+    );
     assert!(dir.join("best.toml").exists());
 }
