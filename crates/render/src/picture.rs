@@ -154,7 +154,19 @@ impl Parts {
                 }
             })
             .collect();
-        let bells = self.domes.iter().filter_map(|d| bell(d, &at)).collect();
+        let bells = self
+            .domes
+            .iter()
+            .filter_map(|d| {
+                let size = d
+                    .dome
+                    .iter()
+                    .map(|&i| self.radii.get(i).copied().unwrap_or(0.0))
+                    .sum::<f64>()
+                    / d.dome.len().max(1) as f64;
+                bell(d, &at, size)
+            })
+            .collect();
         Picture {
             spheres,
             rods,
@@ -166,9 +178,10 @@ impl Parts {
     }
 }
 
-/// The bell over a dome: rim through the dome masses, opening towards the
-/// tentacles, flatter and narrower as it contracts (as the live view draws it).
-fn bell(d: &DomeParts, at: &impl Fn(usize) -> DVec3) -> Option<Bell> {
+/// The bell over a dome: wrapping the dome masses (of radius `size`),
+/// opening towards the tentacles, narrower and taller as it contracts (as
+/// the live view draws it).
+fn bell(d: &DomeParts, at: &impl Fn(usize) -> DVec3, size: f64) -> Option<Bell> {
     if d.dome.len() < 3 {
         return None;
     }
@@ -181,10 +194,10 @@ fn bell(d: &DomeParts, at: &impl Fn(usize) -> DVec3) -> Option<Bell> {
             axis = -axis;
         }
     }
-    let radius = p.iter().map(|x| x.distance(centre)).sum::<f64>() / p.len() as f64;
+    let radius = p.iter().map(|x| x.distance(centre)).sum::<f64>() / p.len() as f64 + size;
     let s = d.squeeze.clamp(0.0, 1.0);
     Some(Bell {
-        centre,
+        centre: centre - axis * (0.5 * size),
         axis,
         radius: radius * (1.08 - 0.28 * s),
         height: radius * (0.75 + 0.45 * s),

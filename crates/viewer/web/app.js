@@ -177,7 +177,8 @@ function build(desc) {
     }));
     mesh.frustumCulled = false;
     group.add(mesh);
-    return { ...d, mesh };
+    const mass = d.particles.reduce((r, i) => r + desc.particles[i].radius, 0) / Math.max(1, d.particles.length);
+    return { ...d, mesh, mass };
   });
 
   scene.add(group);
@@ -252,11 +253,12 @@ function draw(frame) {
       t.divideScalar(d.tentacles.length);
       if (n.dot(c.clone().sub(t)) < 0) n.negate();
     }
-    const radius = pts.reduce((r, x) => r + x.distanceTo(c), 0) / pts.length;
+    // The bell wraps the dome masses: their ring plus their own radius.
+    const radius = pts.reduce((r, x) => r + x.distanceTo(c), 0) / pts.length + d.mass;
     const st = states.get(d.name);
     // Contraction follows the pulse: full at the top of the power stroke.
     const squeeze = st && st.state !== 'idle' && st.phase != null ? Math.max(0, Math.sin(st.phase)) : 0;
-    d.mesh.position.copy(c);
+    d.mesh.position.copy(c).addScaledVector(n, -0.5 * d.mass);
     d.mesh.quaternion.setFromUnitVectors(UP, n);
     d.mesh.scale.set(radius * (1.08 - 0.28 * squeeze), radius * (0.75 + 0.45 * squeeze), radius * (1.08 - 0.28 * squeeze));
   }
