@@ -10,7 +10,7 @@ use animats_render::{render, Camera, DomeParts, Image, Parts};
 use animats_viewer::protocol::Describe;
 use animats_viewer::{SceneStage, Stage};
 use rayon::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::str::FromStr;
 use std::time::Instant;
 
@@ -185,12 +185,6 @@ fn creatures_centre(describe: &Describe, positions: &[DVec3]) -> DVec3 {
     picked.iter().sum::<DVec3>() / picked.len().max(1) as f64
 }
 
-/// Writes `bytes` to `path` through a temporary file: no partial picture is
-/// ever left under the final name.
-fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Failure> {
-    animats_evolve::checkpoint::write_atomically(path, bytes).map_err(Failure::Other)
-}
-
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
     let ext = args
@@ -329,7 +323,10 @@ pub fn run(args: Args) -> Result<(), Failure> {
         (Format::Mp4, _) => None,
     };
     match bytes {
-        Some(b) => write_atomically(&args.out, &b)?,
+        // Through a temporary file: no partial picture under the final name.
+        Some(b) => {
+            animats_evolve::checkpoint::write_atomically(&args.out, &b).map_err(Failure::Other)?
+        }
         None => {
             let partial = args.out.with_extension("mp4.partial");
             let encoded = encode_mp4(&frames, args.fps, &partial);

@@ -6,7 +6,7 @@ mod common;
 use animats_engine::DVec3;
 use animats_render::camera::View;
 use animats_render::{Camera, Image};
-use common::{animats, scratch, text, write};
+use common::{animats, scratch, text, write, STIFF_SCENE};
 
 fn decode_png(path: &std::path::Path) -> Image {
     let file = std::fs::File::open(path).expect("open png");
@@ -177,84 +177,38 @@ fn a_sheet_tiles_the_frames() {
 #[test]
 fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
     let dir = scratch("render-bad");
-    let refuse = |args: &[&str], expect: &str| {
-        let o = animats(args);
-        let (_, err) = text(&o);
-        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(expect), "{args:?}: {err}");
-    };
-    let out = |name: &str| dir.join(name).to_string_lossy().into_owned();
-    refuse(
-        &[
-            "render",
-            "scenes/seaworld.toml",
-            "--seconds",
-            "1",
-            "--out",
-            &out("x.bmp"),
-        ],
-        ".png, .gif or .mp4",
-    );
-    refuse(
-        &[
-            "render",
-            "nope.toml",
-            "--seconds",
-            "1",
-            "--out",
-            &out("x.png"),
-        ],
-        "nope.toml",
-    );
-    refuse(
-        &[
-            "render",
-            "scenes/seaworld.toml",
-            "--seconds",
-            "1",
-            "--out",
-            "/nonexistent-dir/x.png",
-        ],
-        "does not exist",
-    );
-    refuse(
-        &[
-            "render",
-            "scenes/seaworld.toml",
-            "--seconds",
-            "1",
+    let x = |name: &str| dir.join(name).to_string_lossy().into_owned();
+    let (bmp, png, gif) = (x("x.bmp"), x("x.png"), x("x.gif"));
+    let sea = "scenes/seaworld.toml";
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &[sea, "--seconds", "1", "--out", &bmp],
+            ".png, .gif or .mp4",
+        ),
+        (&["nope.toml", "--seconds", "1", "--out", &png], "nope.toml"),
+        (
+            &[sea, "--seconds", "1", "--out", "/nonexistent-dir/x.png"],
+            "does not exist",
+        ),
+        (
+            &[sea, "--seconds", "1", "--camera", "1,2:3", "--out", &png],
             "--camera",
-            "1,2:3",
-            "--out",
-            &out("x.png"),
-        ],
-        "--camera",
-    );
-    refuse(
-        &[
-            "render",
-            "scenes/seaworld.toml",
-            "--seconds",
-            "-1",
-            "--out",
-            &out("x.png"),
-        ],
-        "--seconds",
-    );
-    refuse(
-        &[
-            "render",
-            "scenes/seaworld.toml",
-            "--seconds",
-            "1",
+        ),
+        (&[sea, "--seconds", "-1", "--out", &png], "--seconds"),
+        (
+            &[sea, "--seconds", "1", "--sheet", "4", "--out", &gif],
             "--sheet",
-            "4",
-            "--out",
-            &out("x.gif"),
-        ],
-        "--sheet",
-    );
-
+        ),
+    ];
+    for (args, expect) in cases {
+        let all: Vec<&str> = std::iter::once("render")
+            .chain(args.iter().copied())
+            .collect();
+        let o = animats(&all);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{all:?}: {err}");
+        assert!(err.contains(expect), "{all:?}: {err}");
+    }
     // No ffmpeg on the PATH: a clear message, nothing written.
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_animats"))
         .args([
@@ -263,7 +217,7 @@ fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
             "--seconds",
             "1",
             "--out",
-            &out("x.mp4"),
+            &x("x.mp4"),
         ])
         .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .env("PATH", dir.to_str().unwrap())
@@ -274,35 +228,7 @@ fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
     assert!(err.contains("needs ffmpeg"), "{err}");
     assert!(!dir.join("x.mp4").exists());
 
-    let scene = write(
-        &dir,
-        "stiff.toml",
-        r#"
-[world]
-gravity = [0.0, 0.0, 0.0]
-dt = 0.01
-integrator = "euler"
-
-[[particle]]
-name = "anchor"
-mass = 1.0
-position = [0.0, 0.0, 0.0]
-radius = 0.01
-fixed = true
-
-[[particle]]
-name = "wobbly"
-mass = 0.001
-position = [1.1, 0.0, 0.0]
-radius = 0.01
-
-[[spring]]
-a = "anchor"
-b = "wobbly"
-stiffness = 1e6
-rest_length = 1.0
-"#,
-    );
+    let scene = write(&dir, "stiff.toml", STIFF_SCENE);
     let gif = dir.join("blow.gif");
     let o = animats(&[
         "render",

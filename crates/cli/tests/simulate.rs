@@ -284,36 +284,7 @@ fn a_blow_up_exits_3_naming_time_and_particle_and_leaves_no_complete_output() {
     // A stiff spring and a huge step under explicit Euler: the amplitude
     // grows by about ωh ≈ 300 per step and overflows within a few hundred steps.
     let dir = scratch("blowup");
-    let scene = write(
-        &dir,
-        "stiff.toml",
-        r#"
-[world]
-gravity = [0.0, 0.0, 0.0]
-dt = 0.01
-integrator = "euler"
-duration = 100.0
-
-[[particle]]
-name = "anchor"
-mass = 1.0
-position = [0.0, 0.0, 0.0]
-radius = 0.01
-fixed = true
-
-[[particle]]
-name = "wobbly"
-mass = 0.001
-position = [1.1, 0.0, 0.0]
-radius = 0.01
-
-[[spring]]
-a = "anchor"
-b = "wobbly"
-stiffness = 1e6
-rest_length = 1.0
-"#,
-    );
+    let scene = write(&dir, "stiff.toml", STIFF_SCENE);
     let out = dir.join("traj.csv");
     let o = animats(&["simulate", &scene, "--output", out.to_str().unwrap()]);
     let (_, err) = text(&o);

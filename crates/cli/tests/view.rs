@@ -3,7 +3,37 @@
 mod common;
 use common::{animats, text};
 use std::io::{BufRead, BufReader, Read, Write};
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, Stdio};
+
+/// The `host:port` in the `http://host:port/` that `text` prints.
+fn address_in(text: &str) -> String {
+    text.split("http://")
+        .nth(1)
+        .and_then(|s| s.split('/').next())
+        .unwrap_or_else(|| panic!("no address in {text:?}"))
+        .to_string()
+}
+
+/// The raw HTTP response to `GET path`.
+fn get(address: &str, path: &str) -> String {
+    let mut s = std::net::TcpStream::connect(address).expect("connect");
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("write");
+    let mut response = String::new();
+    s.read_to_string(&mut response).expect("read");
+    response
+}
+
+/// Sends Ctrl-C (SIGINT) to `child`.
+fn ctrl_c(child: &Child) {
+    Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+}
 
 #[test]
 fn it_prints_its_address_serves_the_page_and_stops_on_ctrl_c_with_a_summary() {
@@ -17,35 +47,19 @@ fn it_prints_its_address_serves_the_page_and_stops_on_ctrl_c_with_a_summary() {
     let mut out = BufReader::new(child.stdout.take().expect("stdout"));
     let mut line = String::new();
     out.read_line(&mut line).expect("first line");
-    let address = line
-        .split("http://")
-        .nth(1)
-        .and_then(|s| s.split('/').next())
-        .unwrap_or_else(|| panic!("no address in {line:?}"))
-        .to_string();
+    let address = address_in(&line);
     assert!(
         address.starts_with("127.0.0.1:"),
         "binds this machine only by default: {line}"
     );
 
-    let mut s = std::net::TcpStream::connect(&address).expect("connect");
-    write!(
-        s,
-        "GET / HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n"
-    )
-    .expect("write");
-    let mut page = String::new();
-    s.read_to_string(&mut page).expect("read");
+    let page = get(&address, "/");
     assert!(
         page.starts_with("HTTP/1.1 200") && page.contains("animats view"),
         "{page}"
     );
 
-    let pid = child.id().to_string();
-    Command::new("kill")
-        .args(["-INT", &pid])
-        .status()
-        .expect("kill");
+    ctrl_c(&child);
     let status = child.wait().expect("wait");
     let mut rest = String::new();
     out.read_to_string(&mut rest).expect("rest");
@@ -106,25 +120,12 @@ fn evolve_view_serves_during_and_after_the_run_until_ctrl_c() {
         line.clear();
     }
     assert!(seen.contains("the view stays open"), "{seen}");
-    let address = seen
-        .split("http://")
-        .nth(1)
-        .and_then(|s| s.split('/').next())
-        .unwrap_or_else(|| panic!("no address in {seen}"))
-        .to_string();
-    let mut s = std::net::TcpStream::connect(&address).expect("connect after the run");
-    write!(
-        s,
-        "GET /app.js HTTP/1.1\r\nHost: {address}\r\nConnection: close\r\n\r\n"
-    )
-    .expect("write");
-    let mut page = String::new();
-    s.read_to_string(&mut page).expect("read");
-    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
-    Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .expect("kill");
+    let page = get(&address_in(&seen), "/app.js");
+    assert!(
+        page.starts_with("HTTP/1.1 200"),
+        "served after the run: {page}"
+    );
+    ctrl_c(&child);
     let status = child.wait().expect("wait");
     assert_eq!(
         status.code(),

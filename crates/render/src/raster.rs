@@ -83,6 +83,9 @@ fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
     } else {
         (hex(0x96a880), hex(0x80926c))
     };
+    // Lambert under the sun, as the live view's floor.
+    let lit = 0.55 + 0.45 * SUN.normalize().y;
+    let (light, dark) = (light * lit, dark * lit);
     for y in 0..c.height {
         for x in 0..c.width {
             let i = (y * c.width + x) as usize;
@@ -100,9 +103,7 @@ fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
             let p = view.eye + ray * t;
             let odd =
                 ((p.x / cell).floor() as i64 + (p.z / cell).floor() as i64).rem_euclid(2) == 1;
-            let base = if odd { dark } else { light };
-            // Lambert under the sun, as the live view's floor.
-            c.colour[i] = base * (0.55 + 0.45 * SUN.normalize().y);
+            c.colour[i] = if odd { dark } else { light };
             c.depth[i] = t;
             c.floor[i] = Some(p);
         }

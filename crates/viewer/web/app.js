@@ -50,7 +50,7 @@ const bell = new THREE.SphereGeometry(1, 28, 10, 0, 2 * Math.PI, 0, Math.PI / 2)
 // What the page knows; the browser test reads it.
 const viewer = {
   scene: null, frame: null, frames: 0, arrivals: [], connected: false,
-  send, project, floorHit, three: { scene, camera, THREE },
+  send, project, floorHit,
 };
 window.__viewer = viewer;
 

@@ -35,3 +35,33 @@ pub fn write(dir: &Path, name: &str, contents: &str) -> String {
     std::fs::write(&p, contents).unwrap();
     p.to_string_lossy().into_owned()
 }
+
+/// A scene that blows up: a stiff spring and a huge step under explicit
+/// Euler, so the amplitude grows by about ωh ≈ 300 per step and overflows
+/// within a few hundred steps; the particle to blame is `wobbly`.
+pub const STIFF_SCENE: &str = r#"
+[world]
+gravity = [0.0, 0.0, 0.0]
+dt = 0.01
+integrator = "euler"
+duration = 100.0
+
+[[particle]]
+name = "anchor"
+mass = 1.0
+position = [0.0, 0.0, 0.0]
+radius = 0.01
+fixed = true
+
+[[particle]]
+name = "wobbly"
+mass = 0.001
+position = [1.1, 0.0, 0.0]
+radius = 0.01
+
+[[spring]]
+a = "anchor"
+b = "wobbly"
+stiffness = 1e6
+rest_length = 1.0
+"#;
