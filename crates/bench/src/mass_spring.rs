@@ -3,7 +3,8 @@
 //! structure-of-arrays loop they are compared with.
 
 use animats_engine::{
-    DVec3, FloorDef, IntegratorKind, ParticleDef, ParticleId, SpringDef, Targets, World,
+    DVec3, DiscreteEvent, EventContext, EventState, IntegratorKind, ParticleDef, ParticleId,
+    Properties, SpringDef, World,
 };
 use std::f64::consts::PI;
 
@@ -109,15 +110,52 @@ pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
         );
         w.add_spring(def).expect("valid workload spring");
     }
-    w.add_floor(FloorDef {
-        envelope: f64::INFINITY,
-        rest_speed: 0.0,
-        contact: false,
-        targets: Targets::All,
-        ..FloorDef::default()
-    })
-    .expect("valid workload floor");
+    w.add_event(Box::new(WorkloadFloor::default()));
     w
+}
+
+/// The workloads' floor rule, applied after each whole step: `if y < 0 { if
+/// v_y < 0 { v_y ← −e v_y }; y ← 0 }` for point particles. The engine's own
+/// floor is more careful (it reflects the speed at the plane, so an impact
+/// never adds energy, and lets bounces end): a user event reproduces the
+/// published rule exactly, as any user can plug in their own.
+#[derive(Clone, Debug, Default)]
+pub struct WorkloadFloor {
+    below: Vec<u32>,
+}
+
+impl DiscreteEvent for WorkloadFloor {
+    fn check(&mut self, ctx: &EventContext) -> EventState {
+        self.below.clear();
+        for (i, x) in ctx.pos.iter().enumerate() {
+            if x.y < 0.0 && ctx.particles.inv_mass[i] != 0.0 {
+                self.below.push(i as u32);
+            }
+        }
+        if self.below.is_empty() {
+            EventState::None
+        } else {
+            EventState::Occurring
+        }
+    }
+
+    fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        for &i in &self.below {
+            let i = i as usize;
+            if vel[i].y < 0.0 {
+                vel[i].y *= -p.restitution[i];
+            }
+            pos[i].y = 0.0;
+        }
+    }
+
+    fn name(&self) -> &str {
+        "workload floor"
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
 }
 
 /// The plain hand-written structure-of-arrays loop over an edge list.

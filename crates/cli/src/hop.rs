@@ -3,6 +3,7 @@
 use crate::output::Trajectory;
 use crate::{positive_f64, Failure};
 use animats_creatures::roobot::evaluate::{evaluate_with, EvalSettings};
+use animats_creatures::roobot::gait::GaitLog;
 
 /// Arguments of `animats hop`.
 #[derive(clap::Args)]
@@ -43,7 +44,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
     };
     let mut step = 0u64;
     let mut write_error = None;
-    let e = evaluate_with(params, &settings, |world, _| {
+    let mut gait = GaitLog::default();
+    let e = evaluate_with(params, &settings, |world, roobot| {
+        gait.observe(world, roobot);
         if let Some(t) = trajectory.as_mut() {
             if step % args.every == 0 {
                 if let Err(e) = t.record(world.time(), step, world.state()) {
@@ -71,6 +74,23 @@ pub fn run(args: Args) -> Result<(), Failure> {
     println!("hops:       {}", e.hops);
     println!("speed:      {:.4} m/s (mean forward)", e.mean_speed());
     println!("ended:      {}", e.ending);
+    match gait.stance_summary() {
+        Some((lo, mid, hi)) => println!(
+            "stances:    {} (FSM stance, s: min {lo:.3}, median {mid:.3}, max {hi:.3})",
+            gait.stances.len()
+        ),
+        None => println!("stances:    0"),
+    }
+    if let (Some((lo, mid, hi)), Some((_, slide_mid, slide_max))) =
+        (gait.contact_summary(), gait.slide_summary())
+    {
+        println!(
+            "contacts:   {} (foot on the floor, s: min {lo:.3}, median {mid:.3}, max {hi:.3}; slide median {:.1} mm, max {:.1} mm)",
+            gait.contacts.len(),
+            slide_mid * 1e3,
+            slide_max * 1e3
+        );
+    }
     if let Some(t) = trajectory {
         let frames = t.frames();
         let path = t.finish().map_err(Failure::Other)?;

@@ -27,15 +27,27 @@ pub enum EventState {
     Missed,
 }
 
-/// The trial state an event inspects.
+/// The trial state an event inspects, and the state it started from.
 #[derive(Clone, Copy)]
 pub struct EventContext<'a> {
     /// Simulated time at the end of the trial step, s.
     pub t: f64,
+    /// Length of the trial (a whole step, or a piece of one after a
+    /// backtrack), s.
+    pub h: f64,
+    /// The length of the whole step the trial belongs to, s: the time
+    /// resolution of the simulation, which a piece is not.
+    pub step: f64,
+    /// The integrator's [`free_flight_shift`](crate::IntegratorKind::free_flight_shift).
+    pub flight_shift: f64,
     /// Positions at the end of the trial step.
     pub pos: &'a [DVec3],
     /// Velocities at the end of the trial step.
     pub vel: &'a [DVec3],
+    /// Positions at the start of the trial step.
+    pub start_pos: &'a [DVec3],
+    /// Velocities at the start of the trial step.
+    pub start_vel: &'a [DVec3],
     /// The particles' properties.
     pub particles: &'a Properties,
 }

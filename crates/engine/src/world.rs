@@ -420,7 +420,7 @@ impl World {
         }
         let t0 = self.time;
         // The whole step first; pieces only after a missed event.
-        let events = self.trial(t0, dt);
+        let events = self.trial(t0, dt, dt);
         let report = if events == EventState::Missed {
             self.backtrack(t0, dt)?
         } else {
@@ -439,10 +439,11 @@ impl World {
         Ok(report)
     }
 
-    /// Integrates from the current state over `[t, t + h]` into the trial
-    /// buffer and asks every event about the result; returns the worst state.
+    /// Integrates from the current state over `[t, t + h]` (part of a step
+    /// of `step`) into the trial buffer and asks every event about the
+    /// result; returns the worst state.
     #[inline]
-    fn trial(&mut self, t: f64, h: f64) -> EventState {
+    fn trial(&mut self, t: f64, h: f64, step: f64) -> EventState {
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,
@@ -460,8 +461,13 @@ impl World {
         if !self.events.is_empty() {
             let ctx = EventContext {
                 t: t + h,
+                h,
+                step,
+                flight_shift: self.integrator.free_flight_shift(),
                 pos: &self.next.pos,
                 vel: &self.next.vel,
+                start_pos: &self.state.pos,
+                start_vel: &self.state.vel,
                 particles: &self.particles,
             };
             for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
@@ -507,7 +513,7 @@ impl World {
         while done < total {
             let t = t0 + dt * (done as f64 / total as f64);
             let h = dt * (piece as f64 / total as f64);
-            let mut worst = self.trial(t, h);
+            let mut worst = self.trial(t, h, dt);
             if worst == EventState::Missed {
                 if piece > 1 {
                     piece /= 2;

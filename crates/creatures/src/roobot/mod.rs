@@ -4,6 +4,7 @@
 //! - `fsm.rs`: the four-state hopping controller.
 //! - `params.rs`: its 14 parameters.
 //! - `evaluate.rs`: one fitness evaluation, as the thesis's `HopEvolver` runs it.
+//! - `gait.rs`: stance durations and foot slide, for reports.
 //!
 //! Actuators: the leg's rest length, the hip motor (acts only in flight) and
 //! the ankle motor (acts only in stance). Sensors: foot height, leg angle
@@ -12,6 +13,7 @@
 pub mod body;
 pub mod evaluate;
 pub mod fsm;
+pub mod gait;
 pub mod params;
 
 use crate::actuator::Actuator;

@@ -5,10 +5,32 @@
 //! plane somewhere inside the step and the step must be retaken in shorter
 //! pieces). Handling moves the sphere up to touch the plane and, if it is
 //! moving into the plane, reflects its normal velocity with its restitution,
-//! `v_y ← -r v_y` (Eq. 16). Impacts slower than `rest_speed` do not bounce:
-//! the sphere comes to rest, and the floor's contact force holds it (without
-//! this, a resting sphere would bounce a little on every step forever).
-//! A sphere below the plane but already moving up is only moved up.
+//! `v_y ← -r v_y` (Eq. 16).
+//!
+//! Two refinements of the thesis's response keep an impact from adding
+//! energy and let a bouncing sphere come to rest (docs/DESIGN.md, "Floor
+//! impacts"):
+//! - The velocity reflected is the one the sphere had *at the plane*, not
+//!   at the end of the trial, which includes the acceleration of the part of
+//!   the step spent below the plane. Under the trial's mean normal
+//!   acceleration `a` (from its start and end velocities), a sphere `d` below
+//!   the plane moving at `v` crossed it at `v_c² = v² + 2 a d`. Moving the
+//!   sphere up by `d` then costs exactly the energy that `v → v_c` returns,
+//!   so with `r ≤ 1` the impact never adds mechanical energy (`r = 1`
+//!   conserves it under a constant force).
+//! - Explicit Euler gains ½ a² h² of kinetic energy in every step of free
+//!   flight, which would feed each bounce and keep a small one going for
+//!   ever; the rebound is also computed from the velocity its flight
+//!   conserves ([`IntegratorKind::free_flight_shift`](crate::IntegratorKind::free_flight_shift)) and the smaller of the
+//!   two is used, so that neither energy rises.
+//! - A rebound too slow to leave the plane for a whole step (flight time
+//!   `2 r v_c / |a|` at most the step) cannot be resolved at this step size,
+//!   and neither can an impact slower than `rest_speed`: the sphere rests,
+//!   and the floor's contact force holds it. The rebound speeds fall
+//!   geometrically, so the bounces end after finitely many impacts.
+//!
+//! A sphere below the plane but already moving up is moved up with the
+//! speed it would have at the plane.
 
 use crate::error::ModelError;
 use crate::event::{DiscreteEvent, EventContext, EventState};
@@ -36,8 +58,20 @@ pub struct FloorCollision {
     pub rest_speed: f64,
     /// The particles that collide with the floor.
     pub targets: Targets,
-    hits: Vec<u32>,
+    hits: Vec<Hit>,
     collisions: Vec<Collision>,
+}
+
+/// A sphere found below the plane by the last check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Hit {
+    index: u32,
+    /// The trial's mean acceleration along the normal, m/s².
+    accel: f64,
+    /// The step the trial belongs to, s.
+    step: f64,
+    /// The integrator's free-flight shift.
+    shift: f64,
 }
 
 impl Default for FloorCollision {
@@ -84,7 +118,12 @@ impl DiscreteEvent for FloorCollision {
         let mut deepest = 0.0f64;
         let mut hit = |i: usize, gap: f64| {
             if p.inv_mass[i] != 0.0 {
-                self.hits.push(i as u32);
+                self.hits.push(Hit {
+                    index: i as u32,
+                    accel: (ctx.vel[i].y - ctx.start_vel[i].y) / ctx.h,
+                    step: ctx.step,
+                    shift: ctx.flight_shift,
+                });
                 deepest = deepest.min(gap);
             }
         };
@@ -117,22 +156,46 @@ impl DiscreteEvent for FloorCollision {
     }
 
     fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
-        for &i in &self.hits {
-            let i = i as usize;
+        for hit in &self.hits {
+            let i = hit.index as usize;
+            let depth = particles.radius[i] - pos[i].y;
             pos[i].y = particles.radius[i];
-            let vy = vel[i].y;
-            if vy < 0.0 {
-                vel[i].y = if -vy < self.rest_speed {
-                    0.0
-                } else {
-                    -particles.restitution[i] * vy
-                };
-                self.collisions.push(Collision {
-                    particle: ParticleId(i as u32),
-                    t,
-                    impact_speed: -vy,
-                });
+            let (vy, a) = (vel[i].y, hit.accel);
+            // The normal speed at the plane under the trial's mean
+            // acceleration; below zero the sphere could not have got this
+            // deep this fast, and it is simply put on the plane.
+            let at_plane = (vy * vy + 2.0 * a * depth).max(0.0).sqrt();
+            if vy >= 0.0 {
+                vel[i].y = at_plane;
+                continue;
             }
+            // The rebound, in the plain velocity and in the one the
+            // integrator's free flight conserves (`w = v + s a h`); the
+            // smaller raises neither energy. For explicit Euler the second is
+            // smaller: it keeps the ½ a² h² that each step of flight gains
+            // out of the next bounce, without which a bounce never ends.
+            let e = particles.restitution[i];
+            let shift = hit.shift * a * hit.step;
+            let w = vy + shift;
+            let w_at_plane = (w * w + 2.0 * a * depth).max(0.0).sqrt();
+            let rebound = (e * at_plane).min(e * w_at_plane - shift);
+            // A rebound that cannot keep the sphere off the plane for a
+            // whole step is not resolvable at this step: it rests.
+            let flight = if a < 0.0 {
+                2.0 * rebound / -a
+            } else {
+                f64::INFINITY
+            };
+            vel[i].y = if at_plane < self.rest_speed || flight <= hit.step {
+                0.0
+            } else {
+                rebound
+            };
+            self.collisions.push(Collision {
+                particle: ParticleId(i as u32),
+                t,
+                impact_speed: at_plane,
+            });
         }
     }
 

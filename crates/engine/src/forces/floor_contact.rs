@@ -4,11 +4,14 @@
 //!
 //! A particle is in contact when (the thesis's three conditions) it touches the
 //! plane (its lowest point is within `contact_tolerance` of it), it is not
-//! moving towards or away from it (normal speed at most `rest_speed`), and it
-//! is forced towards it (the net force of every other force points down).
+//! moving towards or away from it (not moving up at all, nor down faster
+//! than `rest_speed`), and it is forced towards it (the net force of every
+//! other force points down). A slow rebound is not resting: holding it up
+//! for a step would feed the bounce.
 //! Then the floor pushes back with `N = -F_y`, and
 //! - below `static_speed` of sliding, static friction cancels the tangential
-//!   force and the residual slip, up to `mu_s |N|`;
+//!   force and the residual slip, up to `mu_s |N|`; past that limit, kinetic
+//!   friction `mu_k |N|` opposes the slip that the force would produce;
 //! - otherwise kinetic friction `mu_k |N|` opposes the sliding, capped so that
 //!   it never reverses the sliding velocity within one step.
 //!
@@ -61,7 +64,10 @@ impl FloorContact {
             return;
         }
         let v = ctx.vel[i];
-        if v.y.abs() > self.rest_speed || f.y >= 0.0 {
+        // Leaving the plane (a rebound, however slow) or hitting it: not
+        // resting. A resting sphere's normal velocity is exactly zero: the
+        // collision event sets it so, and this force keeps it so.
+        if v.y > 0.0 || v.y < -self.rest_speed || f.y >= 0.0 {
             return;
         }
         let normal = -f.y;
@@ -74,18 +80,20 @@ impl FloorContact {
             // Static friction: hold the particle still (cancel the applied
             // tangential force and the residual slip) if it can.
             let hold = -ft - vt * (m / ctx.dt);
-            if hold.length() <= p.mu_s[i] * normal {
+            let needed = hold.length();
+            if needed <= p.mu_s[i] * normal {
                 *f += hold;
                 return;
             }
+            // It breaks away: kinetic friction opposes the slip that the
+            // applied force produces (the direction of `-hold`), not a
+            // residual velocity that may be roundoff.
+            *f += hold * ((p.mu_k[i] * normal).min(needed) / needed);
+            return;
         }
-        // Kinetic friction against the sliding (or, from rest, against the
-        // applied force that breaks static friction).
-        let dir = if speed > 0.0 {
-            vt / speed
-        } else {
-            ft.normalize_or_zero()
-        };
+        // Kinetic friction against the sliding, capped so that it never
+        // reverses the sliding within one step (thesis §3.1.2.7).
+        let dir = vt / speed;
         let stop = m * speed / ctx.dt + ft.dot(dir); // friction that would just stop it
         let kinetic = (p.mu_k[i] * normal).min(stop.max(0.0));
         *f -= dir * kinetic;
