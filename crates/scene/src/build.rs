@@ -20,6 +20,36 @@ use animats_engine::{
 use std::collections::HashMap;
 use toml::Spanned;
 
+/// The most particles a scene may make, all its entries together: far past
+/// any scene that runs at a useful speed (cloth-128 has 16,384), and small
+/// enough that building it cannot exhaust memory (about 1 kB a particle with
+/// its name, springs and scratch space).
+pub const MAX_PARTICLES: usize = 1_000_000;
+
+/// At least as many particles as any built-in creature has.
+const CREATURE_PARTICLES: usize = 64;
+
+/// Refuses a count that would take the world past [`MAX_PARTICLES`], before
+/// anything is allocated for it.
+fn room(at: &At, field: &str, count: usize, world: &World) -> Result<(), SceneError> {
+    let left = MAX_PARTICLES.saturating_sub(world.len());
+    if count > left {
+        return Err(at.err(
+            field,
+            format!(
+                "{} would take the scene past its limit of {MAX_PARTICLES} particles ({} before it)",
+                if field.is_empty() {
+                    "this entry".to_string()
+                } else {
+                    format!("{count}")
+                },
+                world.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Where an entry came from, for error messages.
 struct At<'s> {
     src: &'s Source<'s>,
@@ -154,6 +184,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     for (k, entry) in def.particle.iter().enumerate() {
         let p = entry.get_ref();
         let at = at(src, format!("particle[{k}]"), entry);
+        room(&at, "", 1, &world)?;
         check_name(&at, &p.name)?;
         if names.ids.contains_key(&p.name) {
             return Err(at.err("name", format!("duplicate particle name `{}`", p.name)));
@@ -185,6 +216,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     for (k, entry) in def.food.iter().enumerate() {
         let f = entry.get_ref();
         let at = at(src, format!("food[{k}]"), entry);
+        room(&at, "", 1, &world)?;
         check_name(&at, &f.name)?;
         if names.ids.contains_key(&f.name) {
             return Err(at.err("name", format!("duplicate particle name `{}`", f.name)));
@@ -329,6 +361,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             }
         }
         .map_err(|e| at.err("params", e.to_string()))?;
+        room(&at, "", CREATURE_PARTICLES, &world)?;
         let first = world.len();
         let roobot = Roobot::build(
             &mut world,
@@ -386,6 +419,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         if let Some(c) = j.ceiling {
             constants.ceiling = at.positive("ceiling", c)?;
         }
+        room(&at, "", CREATURE_PARTICLES, &world)?;
         let first = world.len();
         let jelly = Jellyfish::build(&mut world, &name, &constants, position, food)
             .map_err(|e| at.model(e))?;
@@ -422,6 +456,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             damping: w.damping.unwrap_or(d.damping),
         };
         let position = at.vec3("position", w.position)?;
+        room(&at, "segments", c.segments.saturating_add(1), &world)?;
         let first = world.len();
         seaweed::build(&mut world, &c, position).map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..=c.segments).map(|i| format!("{name}.{i}")).collect();
@@ -445,6 +480,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         };
         let position = at.vec3("position", b.position)?;
         let base = DVec3::new(position.x, 0.0, position.z);
+        room(&at, "bubbles", c.bubbles, &world)?;
         let first = world.len();
         let column = BubbleColumn::build(&mut world, &c, base, Random::new(seed, 1000 + k as u64))
             .map_err(|e| at.model(e))?;
@@ -467,6 +503,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             from: r.from.map_or(Ok(d.from), |v| at.vec3("from", v))?,
             to: r.to.map_or(Ok(d.to), |v| at.vec3("to", v))?,
         };
+        room(&at, "count", c.count, &world)?;
         let first = world.len();
         rocks::scatter(&mut world, &c, &mut Random::new(seed, 2000 + k as u64))
             .map_err(|e| at.model(e))?;
@@ -485,6 +522,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         let position = at.vec3("position", q.position)?;
         let heading = at.finite("heading", q.heading)?;
         let demo_at = at.finite("demo_at", q.demo_at)?;
+        room(&at, "", CREATURE_PARTICLES, &world)?;
         let first = world.len();
         let mut quad = Quadruped::build(
             &mut world,

@@ -38,7 +38,9 @@ impl fmt::Display for SceneError {
             write!(f, ":{line}")?;
         }
         write!(f, ": ")?;
-        match (&self.entry, &self.field) {
+        let entry = self.entry.as_deref().filter(|e| !e.is_empty());
+        let field = self.field.as_deref().filter(|k| !k.is_empty());
+        match (entry, field) {
             (Some(e), Some(k)) => write!(f, "{e}.{k}: ")?,
             (Some(e), None) => write!(f, "{e}: ")?,
             (None, Some(k)) => write!(f, "{k}: ")?,

@@ -77,9 +77,22 @@ impl Scene {
     }
 }
 
+/// The largest scene file read, bytes (a scene at the particle limit,
+/// [`build::MAX_PARTICLES`], comes from a few short entries, not megabytes).
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
 /// Reads and builds the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
+    let size = std::fs::metadata(path)
+        .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))?
+        .len();
+    if size > MAX_FILE_BYTES {
+        return Err(SceneError::file(
+            &file,
+            format!("the scene file is {size} bytes, more than the limit of {MAX_FILE_BYTES}"),
+        ));
+    }
     let text = std::fs::read_to_string(path)
         .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))?;
     parse(&text, &file)

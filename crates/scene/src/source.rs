@@ -23,26 +23,30 @@ impl Source<'_> {
     /// (0-based) `[[name]]` header before it, `name` for a `[name]` table, or
     /// `None` at top level.
     pub fn entry_at(&self, offset: usize) -> Option<String> {
-        let before = &self.text[..offset.min(self.text.len())];
+        // Whole lines up to and including the one holding `offset`: a header
+        // cut in the middle would give a garbled name.
+        let end = self.text[offset.min(self.text.len())..]
+            .find('\n')
+            .map_or(self.text.len(), |i| offset.min(self.text.len()) + i);
         let mut counts: Vec<(String, usize)> = Vec::new();
         let mut current = None;
-        for line in before.lines() {
-            let line = line.trim();
-            if let Some(name) = line.strip_prefix("[[").and_then(|l| l.split("]]").next()) {
-                let name = name.trim().to_string();
-                let k = match counts.iter_mut().find(|(n, _)| *n == name) {
-                    Some((_, c)) => {
-                        *c += 1;
-                        *c - 1
-                    }
-                    None => {
-                        counts.push((name.clone(), 1));
-                        0
-                    }
-                };
-                current = Some(format!("{name}[{k}]"));
-            } else if let Some(name) = line.strip_prefix('[').and_then(|l| l.split(']').next()) {
-                current = Some(name.trim().to_string());
+        for line in self.text[..end].lines() {
+            match header(line) {
+                Some((name, true)) => {
+                    let k = match counts.iter_mut().find(|(n, _)| *n == name) {
+                        Some((_, c)) => {
+                            *c += 1;
+                            *c - 1
+                        }
+                        None => {
+                            counts.push((name.clone(), 1));
+                            0
+                        }
+                    };
+                    current = Some(format!("{name}[{k}]"));
+                }
+                Some((name, false)) => current = Some(name),
+                None => {}
             }
         }
         current
@@ -63,4 +67,29 @@ impl Source<'_> {
                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
         ok.then(|| key.to_string())
     }
+}
+
+/// The table a header line opens: `([[name]]` → `(name, true)`, `[name]` →
+/// `(name, false)`), tolerating spaces and a missing closing bracket; `None`
+/// for any other line or an empty name.
+fn header(line: &str) -> Option<(String, bool)> {
+    let line = line.trim();
+    let (rest, array) = match line.strip_prefix("[[") {
+        Some(rest) => (rest, true),
+        None => (line.strip_prefix('[')?, false),
+    };
+    let name: String = rest
+        .split(']')
+        .next()
+        .unwrap_or("")
+        .split('.')
+        .map(str::trim)
+        .collect::<Vec<_>>()
+        .join(".");
+    let ok = !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '-' | '.'))
+        && !name.split('.').any(str::is_empty);
+    ok.then_some((name, array))
 }

@@ -137,3 +137,76 @@ proptest! {
         let _ = animats_scene::parse(&text, "noise.toml");
     }
 }
+
+/// Counts that would make a world too big to build are refused before
+/// anything is allocated, naming the entry and the field: no hang, no
+/// "capacity overflow" panic, no exhausted memory.
+#[test]
+fn oversized_counts_are_refused_naming_the_entry_and_field() {
+    let huge = [
+        "1000001".to_string(),
+        "100000000000000".to_string(),
+        (u64::MAX / 2).to_string(),
+        i64::MAX.to_string(),
+    ];
+    for n in &huge {
+        for (entry, table) in [
+            ("rocks[0].count", format!("[[rocks]]\ncount = {n}\n")),
+            (
+                "seaweed[0].segments",
+                format!("[[seaweed]]\nposition = [0.0, 0.0, 0.0]\nsegments = {n}\n"),
+            ),
+            (
+                "bubble_column[0].bubbles",
+                format!("[[bubble_column]]\nposition = [0.0, 0.0, 0.0]\nbubbles = {n}\n"),
+            ),
+        ] {
+            let message = match animats_scene::parse(&table, "big.toml") {
+                Ok(_) => panic!("accepted {table}"),
+                Err(e) => e.to_string(),
+            };
+            assert!(message.starts_with("big.toml:"), "{message}");
+            assert!(message.contains(&format!(": {entry}: ")), "{message}");
+            assert!(message.contains("limit"), "{message}");
+        }
+    }
+    // Counts beyond any integer type are a type error, also named.
+    let message = animats_scene::parse("[[rocks]]\ncount = 100000000000000000000\n", "big.toml")
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(message.starts_with("big.toml:2: rocks[0].count: "), "{message}");
+    // Many entries that are each small add up to the same limit.
+    let mut text = String::new();
+    for k in 0..11 {
+        text.push_str(&format!("[[rocks]]\nname = \"r{k}_\"\ncount = 100000\n"));
+    }
+    let message = animats_scene::parse(&text, "many.toml")
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(message.starts_with("many.toml:"), "{message}");
+    assert!(message.contains("rocks[10].count"), "{message}");
+}
+
+/// Header lines that TOML refuses still give a readable entry, never an
+/// empty or garbled one.
+#[test]
+fn malformed_headers_never_garble_the_entry_name() {
+    for (text, expect) in [
+        ("[[spring]\n", "bad.toml:1: spring[0]: "),
+        ("[[ spring ]]\na = \"x\"\n", "bad.toml:1: spring[0]: "),
+        ("[[]]\nx = 1\n", "bad.toml:1: "),
+        ("[ ]\nx = 1\n", "bad.toml:1: "),
+        ("[world]\n[world.x]\ny = 1\n", "bad.toml:2: world.x: "),
+    ] {
+        let message = animats_scene::parse(text, "bad.toml")
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(message.starts_with(expect), "{text:?} gave {message}");
+        assert!(!message.contains("]["), "{message}");
+        assert!(!message.contains(": :"), "{message}");
+        assert!(!message.contains(" .") && !message.contains(".:"), "{message}");
+    }
+}
