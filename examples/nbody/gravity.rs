@@ -7,6 +7,7 @@
 use animats_engine::{DVec3, Force, ForceContext, ParticleId};
 
 /// Newton's gravitation between every pair of bodies.
+#[derive(Clone)]
 pub struct NBodyGravity {
     /// Gravitational constant.
     g: f64,

@@ -19,9 +19,9 @@ fn height_sensor_reports_the_lowest_point_clamped_to_unit() {
         .unwrap();
     let s = HeightSensor { particle: p };
     assert!((s.level(&w) - 0.25).abs() < 1e-15);
-    w.set_position(p, DVec3::new(0.0, 3.0, 0.0));
+    w.set_position(p, DVec3::new(0.0, 3.0, 0.0)).unwrap();
     assert_eq!(s.level(&w), 1.0);
-    w.set_position(p, DVec3::new(0.0, 0.05, 0.0));
+    w.set_position(p, DVec3::new(0.0, 0.05, 0.0)).unwrap();
     assert_eq!(s.level(&w), 0.0);
 }
 
@@ -39,10 +39,12 @@ fn tilt_sensor_maps_the_lean_angle_linearly_around_one_half() {
     assert_eq!(s.level(&w), 0.5);
     // Hip 30° forward of the foot: level 0.5 + (π/6)/(2π) = 0.5 + 1/12.
     let a = std::f64::consts::PI / 6.0;
-    w.set_position(hip, DVec3::new(a.sin(), a.cos(), 0.0));
+    w.set_position(hip, DVec3::new(a.sin(), a.cos(), 0.0))
+        .unwrap();
     assert!((s.level(&w) - (0.5 + 1.0 / 12.0)).abs() < 1e-12);
     // Leaning backwards is below one half; sideways lean does not count.
-    w.set_position(hip, DVec3::new(-a.sin(), a.cos(), 0.7));
+    w.set_position(hip, DVec3::new(-a.sin(), a.cos(), 0.7))
+        .unwrap();
     assert!((s.level(&w) - (0.5 - 1.0 / 12.0)).abs() < 1e-12);
 }
 

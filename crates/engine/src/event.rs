@@ -53,7 +53,8 @@ pub struct EventContext<'a> {
 }
 
 /// A discrete event: detected after a trial step, handled by changing the state.
-pub trait DiscreteEvent: Send {
+/// Events are `Clone` (derive it), so that a world can be cloned whole.
+pub trait DiscreteEvent: Send + CloneEvent {
     /// Inspects the trial state. May remember what it found for `handle`.
     fn check(&mut self, ctx: &EventContext) -> EventState;
 
@@ -78,4 +79,22 @@ pub trait DiscreteEvent: Send {
     /// Lets a caller that knows the concrete type read its records back
     /// (e.g. the floor's collisions of the last step).
     fn as_any(&self) -> &dyn std::any::Any;
+}
+
+/// Clones a boxed event; implemented for every `DiscreteEvent + Clone`.
+pub trait CloneEvent {
+    /// A boxed copy.
+    fn clone_box(&self) -> Box<dyn DiscreteEvent>;
+}
+
+impl<T: DiscreteEvent + Clone + 'static> CloneEvent for T {
+    fn clone_box(&self) -> Box<dyn DiscreteEvent> {
+        Box::new(self.clone())
+    }
+}
+
+impl Clone for Box<dyn DiscreteEvent> {
+    fn clone(&self) -> Self {
+        self.as_ref().clone_box()
+    }
 }

@@ -46,7 +46,9 @@ pub enum Stage {
 /// assume it is called once per step: higher-order integrators call it at each
 /// trial state. Forces that conserve energy say so and report their potential
 /// energy, which the world uses to report energy drift.
-pub trait Force: Send {
+///
+/// A force is `Clone` (derive it), so that a world can be cloned whole.
+pub trait Force: Send + CloneForce {
     /// Adds this force's contribution at the trial state `ctx` to `forces`.
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]);
 
@@ -112,5 +114,24 @@ impl Targets {
             Targets::All => None,
             Targets::Only(ids) => ids.iter().map(|id| id.index()).max(),
         }
+    }
+}
+
+/// Clones a boxed force; implemented for every `Force + Clone`, so a user
+/// force needs only `#[derive(Clone)]`.
+pub trait CloneForce {
+    /// A boxed copy.
+    fn clone_box(&self) -> Box<dyn Force>;
+}
+
+impl<T: Force + Clone + 'static> CloneForce for T {
+    fn clone_box(&self) -> Box<dyn Force> {
+        Box::new(self.clone())
+    }
+}
+
+impl Clone for Box<dyn Force> {
+    fn clone(&self) -> Self {
+        self.as_ref().clone_box()
     }
 }

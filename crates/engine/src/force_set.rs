@@ -13,13 +13,17 @@ use glam::DVec3;
 /// The forces of a world. Built-in kinds live in their own collections; user
 /// forces ([`Force`] trait objects) are kept in the order they were added.
 ///
+/// The collections whose parameters actuators drive (springs, joints,
+/// constant forces) are public; the ones whose particle lists could be made
+/// to point outside the world (gravity, fluids, n-body groups, the floor) are
+/// read here and changed only through [`World`](crate::World), which checks.
+///
 /// Order of evaluation: gravity, springs, angle joints, torque joints,
 /// constant forces, fluids, n-body gravity, user body forces; then the
 /// contact stage (floor, user contact forces), which reads the net force.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub struct Forces {
-    /// Uniform gravity, if any.
-    pub gravity: Option<Gravity>,
+    pub(crate) gravity: Option<Gravity>,
     /// Damped springs.
     pub springs: Springs,
     /// Angle joints.
@@ -28,17 +32,34 @@ pub struct Forces {
     pub torque_joints: TorqueJoints,
     /// Constant forces.
     pub constant_forces: ConstantForces,
-    /// Fluid media (drag and buoyancy).
-    pub fluids: Vec<FluidMedium>,
-    /// Mutual gravitation groups.
-    pub nbody: Vec<NBodyGravity>,
-    /// The floor's normal reaction and friction, if there is a floor.
-    pub floor: Option<FloorContact>,
+    pub(crate) fluids: Vec<FluidMedium>,
+    pub(crate) nbody: Vec<NBodyGravity>,
+    pub(crate) floor: Option<FloorContact>,
     pub(crate) user_body: Vec<Box<dyn Force>>,
     pub(crate) user_contact: Vec<Box<dyn Force>>,
 }
 
 impl Forces {
+    /// Uniform gravity, if any.
+    pub fn gravity(&self) -> Option<&Gravity> {
+        self.gravity.as_ref()
+    }
+
+    /// Fluid media (drag and buoyancy), in the order they were added.
+    pub fn fluids(&self) -> &[FluidMedium] {
+        &self.fluids
+    }
+
+    /// Mutual gravitation groups.
+    pub fn nbody(&self) -> &[NBodyGravity] {
+        &self.nbody
+    }
+
+    /// The floor's normal reaction and friction, if there is a floor.
+    pub fn floor(&self) -> Option<&FloorContact> {
+        self.floor.as_ref()
+    }
+
     /// The world's gravitational acceleration (zero without gravity).
     pub fn g(&self) -> DVec3 {
         self.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g)

@@ -26,6 +26,7 @@ pub mod force_set;
 pub mod forces;
 pub mod integrators;
 pub mod particle;
+pub mod snapshot;
 pub mod world;
 
 pub use error::{ModelError, SimError};
@@ -47,6 +48,7 @@ pub use forces::{
 };
 pub use integrators::IntegratorKind;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
+pub use snapshot::Snapshot;
 pub use world::{Energy, FloorDef, Stats, StepReport, World};
 
 pub use glam::DVec3;

@@ -37,7 +37,7 @@ pub struct StepReport {
 }
 
 /// Totals since the world was created.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Stats {
     /// Completed steps.
     pub steps: u64,
@@ -114,18 +114,24 @@ impl Default for FloorDef {
 /// assert!(world.position(bob).y < 1.0); // it swung down
 /// # Ok::<(), Box<dyn std::error::Error>>(())
 /// ```
+///
+/// A world is a plain value: [`Clone`] copies it whole (user forces and
+/// events included), and [`snapshot`](World::snapshot) /
+/// [`restore`](World::restore) save and reload its state through serde; a
+/// copy or a restored world continues bit for bit as the original would.
+#[derive(Clone)]
 pub struct World {
-    state: State,
+    pub(crate) state: State,
     next: State,
-    particles: Properties,
-    forces: Forces,
+    pub(crate) particles: Properties,
+    pub(crate) forces: Forces,
     events: Vec<Box<dyn DiscreteEvent>>,
     event_states: Vec<EventState>,
     integrator: IntegratorKind,
     scratch: Scratch,
-    time: f64,
-    time_carry: f64,
-    stats: Stats,
+    pub(crate) time: f64,
+    pub(crate) time_carry: f64,
+    pub(crate) stats: Stats,
     last: StepReport,
 }
 
@@ -195,31 +201,59 @@ impl World {
         self.state.vel[p.index()]
     }
 
-    /// Moves `p` (a fixed particle too: nails can be moved by hand).
-    pub fn set_position(&mut self, p: ParticleId, x: DVec3) {
-        self.state.pos[p.index()] = x;
-    }
-
-    /// Sets the velocity of `p` (ignored for a fixed particle, which never moves).
-    pub fn set_velocity(&mut self, p: ParticleId, v: DVec3) {
-        if !self.particles.fixed[p.index()] {
-            self.state.vel[p.index()] = v;
+    /// An error unless `p` is a particle of this world.
+    fn check_id(&self, p: ParticleId) -> Result<usize, ModelError> {
+        let i = p.index();
+        if i < self.len() {
+            Ok(i)
+        } else {
+            Err(ModelError::new(
+                "particle",
+                format!(
+                    "particle #{i} does not exist in this world ({} particles)",
+                    self.len()
+                ),
+            ))
         }
     }
 
+    /// Moves `p` (a fixed particle too: nails can be moved by hand).
+    pub fn set_position(&mut self, p: ParticleId, x: DVec3) -> Result<(), ModelError> {
+        let i = self.check_id(p)?;
+        crate::particle::finite_vec("position", x)?;
+        self.state.pos[i] = x;
+        Ok(())
+    }
+
+    /// Sets the velocity of `p` (ignored for a fixed particle, which never moves).
+    pub fn set_velocity(&mut self, p: ParticleId, v: DVec3) -> Result<(), ModelError> {
+        let i = self.check_id(p)?;
+        crate::particle::finite_vec("velocity", v)?;
+        if !self.particles.fixed[i] {
+            self.state.vel[i] = v;
+        }
+        Ok(())
+    }
+
     /// Changes the mass of `p` (kg, > 0; a fixed particle stays fixed).
-    pub fn set_mass(&mut self, p: ParticleId, mass: f64) {
-        let i = p.index();
+    pub fn set_mass(&mut self, p: ParticleId, mass: f64) -> Result<(), ModelError> {
+        let i = self.check_id(p)?;
+        crate::particle::positive("mass", mass)?;
         self.particles.mass[i] = mass;
         if !self.particles.fixed[i] {
             self.particles.inv_mass[i] = 1.0 / mass;
         }
+        Ok(())
     }
 
-    /// Changes the volume of `p`; its radius follows (a sphere).
-    pub fn set_volume(&mut self, p: ParticleId, volume: f64) {
-        self.particles.volume[p.index()] = volume;
-        self.particles.radius[p.index()] = crate::particle::sphere_radius(volume);
+    /// Changes the volume of `p` (m³, >= 0: a point mass has none); its
+    /// radius follows (a sphere).
+    pub fn set_volume(&mut self, p: ParticleId, volume: f64) -> Result<(), ModelError> {
+        let i = self.check_id(p)?;
+        crate::particle::non_negative("volume", volume)?;
+        self.particles.volume[i] = volume;
+        self.particles.radius[i] = crate::particle::sphere_radius(volume);
+        Ok(())
     }
 
     /// The current positions and velocities of every particle.
@@ -256,7 +290,7 @@ impl World {
 
     /// Gravity `g` on every particle (replacing any earlier gravity).
     pub fn set_gravity(&mut self, g: DVec3) {
-        self.forces.gravity = Some(Gravity::new(g));
+        self.forces.gravity = g.is_finite().then(|| Gravity::new(g));
     }
 
     /// Sets (or with `None` removes) the world's gravity force.
@@ -315,6 +349,24 @@ impl World {
         self.check_targets(nbody.targets())?;
         self.forces.nbody.push(nbody);
         Ok(self.forces.nbody.len() - 1)
+    }
+
+    /// Changes the current of fluid `index` (as returned by
+    /// [`add_fluid`](World::add_fluid)).
+    pub fn set_fluid_current(
+        &mut self,
+        index: usize,
+        current: crate::forces::current::Current,
+    ) -> Result<(), ModelError> {
+        let fluid =
+            self.forces.fluids.get_mut(index).ok_or_else(|| {
+                ModelError::new("fluid", format!("no fluid #{index} in this world"))
+            })?;
+        let mut changed = fluid.clone();
+        changed.current = current;
+        changed.validate()?;
+        *fluid = changed;
+        Ok(())
     }
 
     /// Adds the floor, the plane y = 0: its collision event and, unless
@@ -407,7 +459,9 @@ impl World {
     /// was missed, the trial is thrown away and the step is retaken in halves
     /// (recursively, down to `dt / 2^MAX_BACKTRACK_DEPTH`); occurring events
     /// are handled. If any particle ends non-finite the world stays at its
-    /// last good state and an error names the particle.
+    /// last good state (with its time: after a blow-up inside a backtracked
+    /// step, the time of the last piece accepted) and an error names the
+    /// particle.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(SimError::BadStep(dt));
@@ -525,6 +579,9 @@ impl World {
                 worst = EventState::Occurring;
             }
             if let Err(e) = self.accept(worst, t + h) {
+                // The pieces already accepted moved the state: move the
+                // clock with them, so time and state still agree.
+                self.advance_clock(dt * (done as f64 / total as f64));
                 self.last = report;
                 return Err(e);
             }

@@ -217,6 +217,7 @@ fn static_friction_holds_below_mu_s_n_and_kinetic_acts_above() {
 /// A user-defined event, written outside the engine: a wall at x = 1 that
 /// reflects spheres elastically. It plugs into the world without any change
 /// to an integrator, and gets the backtracking for free.
+#[derive(Clone)]
 struct Wall {
     envelope: f64,
     hits: Vec<usize>,
@@ -392,7 +393,7 @@ fn a_push_above_static_friction_accelerates_at_the_kinetic_rate_along_itself() {
             let (mut w, p) = ball_world(kind, 0.5, 0.01, 0.05);
             // At rest on the plane, with a lateral velocity left over from
             // roundoff that static friction would cancel.
-            w.set_velocity(p, DVec3::new(0.0, 0.0, 1e-15));
+            w.set_velocity(p, DVec3::new(0.0, 0.0, 1e-15)).unwrap();
             w.add_constant_force(vec![p], DVec3::new(push, 0.0, 0.0))
                 .unwrap();
             let steps = (1.0 / dt).round() as usize;

@@ -268,7 +268,8 @@ fn light_sphere_rises_with_the_right_acceleration_and_neutral_one_stays() {
 #[test]
 fn a_neutral_sphere_drifts_with_a_uniform_current() {
     let (mut w, p) = sphere_in_water(1000.0, 0.02);
-    w.forces_mut().fluids[0].current = Current::Uniform(DVec3::new(0.2, 0.0, 0.0));
+    w.set_fluid_current(0, Current::Uniform(DVec3::new(0.2, 0.0, 0.0)))
+        .unwrap();
     for _ in 0..20_000 {
         w.step(1e-3).unwrap();
     }
@@ -294,7 +295,7 @@ fn a_nailed_particle_never_moves() {
     w.add_spring(SpringDef::new(nail, ParticleId::from_index(0), 100.0, 1.0))
         .unwrap();
     w.add_fluid(FluidMedium::water()).unwrap();
-    w.set_velocity(nail, DVec3::X); // ignored
+    w.set_velocity(nail, DVec3::X).unwrap(); // ignored
     for kind in IntegratorKind::ALL {
         w.set_integrator(kind);
         for _ in 0..1000 {
@@ -312,6 +313,7 @@ fn a_nailed_particle_never_moves() {
 fn user_forces_are_evaluated_at_every_trial_state() {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::Arc;
+    #[derive(Clone)]
     struct Tether {
         p: ParticleId,
         k: f64,

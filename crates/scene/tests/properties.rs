@@ -175,7 +175,10 @@ fn oversized_counts_are_refused_naming_the_entry_and_field() {
         .err()
         .map(|e| e.to_string())
         .unwrap_or_default();
-    assert!(message.starts_with("big.toml:2: rocks[0].count: "), "{message}");
+    assert!(
+        message.starts_with("big.toml:2: rocks[0].count: "),
+        "{message}"
+    );
     // Many entries that are each small add up to the same limit.
     let mut text = String::new();
     for k in 0..11 {
@@ -207,6 +210,9 @@ fn malformed_headers_never_garble_the_entry_name() {
         assert!(message.starts_with(expect), "{text:?} gave {message}");
         assert!(!message.contains("]["), "{message}");
         assert!(!message.contains(": :"), "{message}");
-        assert!(!message.contains(" .") && !message.contains(".:"), "{message}");
+        assert!(
+            !message.contains(" .") && !message.contains(".:"),
+            "{message}"
+        );
     }
 }

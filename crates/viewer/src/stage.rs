@@ -127,7 +127,7 @@ impl Stage for SceneStage {
             title: self.path.display().to_string(),
             particles,
             springs,
-            fluid: w.forces().fluids.first().map(|f| f.density),
+            fluid: w.forces().fluids().first().map(|f| f.density),
             floor,
             domes,
             food: self.food(),
@@ -185,8 +185,10 @@ impl Stage for SceneStage {
             Some(i) => {
                 let id = animats_engine::ParticleId::from_index(i);
                 let y = self.scene.world.position(id).y;
-                self.scene.world.set_position(id, DVec3::new(x, y, z));
-                true
+                self.scene
+                    .world
+                    .set_position(id, DVec3::new(x, y, z))
+                    .is_ok()
             }
             None => false,
         }

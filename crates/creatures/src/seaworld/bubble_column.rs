@@ -157,12 +157,14 @@ impl BubbleColumn {
     /// Moves `bubble` back to the base with a fresh random volume.
     fn respawn(&mut self, world: &mut World, bubble: ParticleId) {
         let (mass, volume) = Self::draw(&self.c, &mut self.random);
-        world.set_mass(bubble, mass);
-        world.set_volume(bubble, volume);
+        // The column's own bubble, with a mass and volume drawn from ranges
+        // validated when it was built: these cannot be refused.
+        let _ = world.set_mass(bubble, mass);
+        let _ = world.set_volume(bubble, volume);
         let r = world.particles().radius[bubble.index()];
         let at = self.base + Self::scatter(&self.c, &mut self.random) + DVec3::Y * r;
-        world.set_position(bubble, at);
-        world.set_velocity(bubble, DVec3::ZERO);
+        let _ = world.set_position(bubble, at);
+        let _ = world.set_velocity(bubble, DVec3::ZERO);
         self.recycled += 1;
     }
 }

@@ -38,7 +38,7 @@ pub struct TorqueJointDef {
 pub struct TorqueJoint {
     end: u32,
     joint: u32,
-    axis: DVec3,
+    pub(crate) axis: DVec3,
     /// N m; set it each step to drive the motor.
     pub torque: f64,
 }
