@@ -13,7 +13,8 @@ pub struct Serving {
     #[arg(long, default_value_t = 8080)]
     pub port: u16,
     /// Address to bind: 127.0.0.1 serves this machine only; 0.0.0.0 serves
-    /// the network (anyone who can reach it can pause and reset the run).
+    /// the network, to browsers that open the printed URL with its access
+    /// token (the page can pause, reset and move things).
     #[arg(long, default_value = "127.0.0.1")]
     pub host: String,
     /// Frames streamed to the browser per second.
@@ -35,8 +36,8 @@ impl Serving {
             max_clients: self.max_clients as usize,
         })
         .map_err(Failure::Input)?;
-        let address = server.address().map_err(Failure::Other)?;
-        println!("animats view: watching at http://{address}/ (Ctrl-C to stop)");
+        let url = server.url().map_err(Failure::Other)?;
+        println!("animats view: watching at {url} (Ctrl-C to stop)");
         Ok(server)
     }
 }

@@ -10,8 +10,10 @@
 //!   exhibition in `exhibition.rs`);
 //! - `runner.rs`: the simulation thread, pacing and commands;
 //! - `server.rs`: routes, the WebSocket, and the bounds on hostile clients;
+//! - `access.rs`: the access token required off the loopback address;
 //! - `web/`: the page (`index.html`, `app.js`) and three.js.
 
+pub mod access;
 pub mod exhibition;
 pub mod protocol;
 pub mod runner;
@@ -59,6 +61,7 @@ impl Default for Options {
 pub struct Server {
     listener: std::net::TcpListener,
     options: Options,
+    token: Option<String>,
 }
 
 impl Server {
@@ -76,12 +79,34 @@ impl Server {
         listener
             .set_nonblocking(true)
             .map_err(|e| format!("cannot listen on {address}: {e}"))?;
-        Ok(Server { listener, options })
+        // Off the loopback address anyone who can reach the port could
+        // steer the run: require a token.
+        let token = (!access::is_loopback(&options.host)).then(access::new_token);
+        Ok(Server {
+            listener,
+            options,
+            token,
+        })
     }
 
     /// The address it listens on.
     pub fn address(&self) -> Result<SocketAddr, String> {
         self.listener.local_addr().map_err(|e| e.to_string())
+    }
+
+    /// The access token the page and WebSocket require (none on a loopback
+    /// address).
+    pub fn token(&self) -> Option<&str> {
+        self.token.as_deref()
+    }
+
+    /// The page's URL, with the token when one is required.
+    pub fn url(&self) -> Result<String, String> {
+        let address = self.address()?;
+        Ok(match &self.token {
+            Some(t) => format!("http://{address}/?token={t}"),
+            None => format!("http://{address}/"),
+        })
     }
 
     /// Runs `stage` and serves it until `stop` is raised; says what the
@@ -107,6 +132,7 @@ impl Server {
             commands,
             clients: Arc::new(AtomicUsize::new(0)),
             max_clients: self.options.max_clients,
+            token: self.token.as_deref().map(Arc::from),
         };
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .enable_all()

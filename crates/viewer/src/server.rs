@@ -9,7 +9,7 @@
 use crate::protocol::Command;
 use crate::runner::Outlets;
 use axum::extract::ws::{Message, Utf8Bytes, WebSocket, WebSocketUpgrade};
-use axum::extract::{Path, State};
+use axum::extract::{Path, RawQuery, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::get;
@@ -45,15 +45,22 @@ pub struct App {
     pub clients: Arc<AtomicUsize>,
     /// At most this many at once.
     pub max_clients: usize,
+    /// The access token the page and the WebSocket must show, if any.
+    pub token: Option<Arc<str>>,
+}
+
+fn forbidden() -> Response {
+    (
+        StatusCode::FORBIDDEN,
+        "this view needs the access token printed with its address (…/?token=…)",
+    )
+        .into_response()
 }
 
 /// The routes: `/` (the page), `/app.js`, `/vendor/*` (three.js), `/ws`.
 pub fn router(app: App) -> Router {
     Router::new()
-        .route(
-            "/",
-            get(|| async { page("text/html; charset=utf-8", INDEX_HTML) }),
-        )
+        .route("/", get(index))
         .route("/app.js", get(|| async { page(JS, APP_JS) }))
         .route("/vendor/{file}", get(vendor))
         .route("/ws", get(upgrade))
@@ -61,6 +68,13 @@ pub fn router(app: App) -> Router {
 }
 
 const JS: &str = "text/javascript; charset=utf-8";
+
+async fn index(State(app): State<App>, RawQuery(query): RawQuery) -> Response {
+    if !crate::access::allowed(app.token.as_deref(), query.as_deref()) {
+        return forbidden();
+    }
+    page("text/html; charset=utf-8", INDEX_HTML)
+}
 
 fn page(content_type: &'static str, body: &'static str) -> Response {
     ([(header::CONTENT_TYPE, content_type)], body).into_response()
@@ -84,7 +98,15 @@ impl Drop for Place {
     }
 }
 
-async fn upgrade(State(app): State<App>, ws: WebSocketUpgrade) -> Response {
+async fn upgrade(
+    State(app): State<App>,
+    RawQuery(query): RawQuery,
+    ws: WebSocketUpgrade,
+) -> Response {
+    if !crate::access::allowed(app.token.as_deref(), query.as_deref()) {
+        eprintln!("viewer: refused a client without the access token");
+        return forbidden();
+    }
     if app.clients.fetch_add(1, Ordering::SeqCst) >= app.max_clients {
         app.clients.fetch_sub(1, Ordering::SeqCst);
         eprintln!(

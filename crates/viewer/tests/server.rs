@@ -27,18 +27,26 @@ struct Live {
 
 impl Live {
     fn start(max_clients: usize) -> Live {
+        Live::on("127.0.0.1", max_clients).0
+    }
+
+    /// Serves on `host` (port 0); also returns the access token, if any.
+    fn on(host: &str, max_clients: usize) -> (Live, Option<String>) {
         let server = Server::bind(Options {
+            host: host.into(),
             port: 0,
             max_clients,
             ..Options::default()
         })
         .expect("bind");
-        let url = format!("ws://{}/ws", server.address().expect("address"));
+        let token = server.token().map(str::to_string);
+        let port = server.address().expect("address").port();
+        let url = format!("ws://127.0.0.1:{port}/ws");
         let stage = SceneStage::load(seaworld()).expect("scene");
         let stop = Arc::new(AtomicBool::new(false));
         let s = stop.clone();
         let thread = Some(std::thread::spawn(move || server.serve(Box::new(stage), s)));
-        Live { url, stop, thread }
+        (Live { url, stop, thread }, token)
     }
 }
 
@@ -288,27 +296,63 @@ fn a_port_in_use_is_a_clear_error() {
     assert!(e.contains("--port"), "{e}");
 }
 
+/// GET `path` from the server whose WebSocket is at `ws_url`: (status line
+/// and headers, body).
+fn get(ws_url: &str, path: &str) -> (String, String) {
+    use std::io::{Read, Write};
+    let host = ws_url.trim_start_matches("ws://").trim_end_matches("/ws");
+    let mut s = std::net::TcpStream::connect(host).expect("connect");
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
+    )
+    .expect("write");
+    let mut r = String::new();
+    s.read_to_string(&mut r).expect("read");
+    let (head, body) = r.split_once("\r\n\r\n").unwrap_or((&r, ""));
+    (head.to_string(), body.to_string())
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn off_the_loopback_address_the_page_and_socket_need_the_token() {
+    // Bound to every interface (reached here through 127.0.0.1): a token.
+    let (live, token) = Live::on("0.0.0.0", 4);
+    let token = token.expect("a non-loopback host must require a token");
+    assert_eq!(token.len(), 32);
+    let url = live.url.clone();
+    let heads = tokio::task::spawn_blocking({
+        let token = token.clone();
+        move || {
+            ["/", "/?token=0123", "/?token=", &format!("/?token={token}")]
+                .map(|path| get(&url, path).0)
+        }
+    })
+    .await
+    .expect("join");
+    for head in &heads[..3] {
+        assert!(head.starts_with("HTTP/1.1 403"), "{head}");
+    }
+    assert!(heads[3].starts_with("HTTP/1.1 200"), "{}", heads[3]);
+    // The WebSocket: refused without the token (403), served with it.
+    match tokio_tungstenite::connect_async(live.url.as_str()).await {
+        Err(tokio_tungstenite::tungstenite::Error::Http(response)) => {
+            assert_eq!(response.status(), 403)
+        }
+        Err(e) => panic!("refused, but not with 403: {e}"),
+        Ok(_) => panic!("a WebSocket without the token was accepted"),
+    }
+    let mut ws = connect(&format!("{}?token={token}", live.url)).await;
+    let scene = next(&mut ws).await.expect("the scene");
+    assert_eq!(scene["type"], "scene");
+    // On the loopback address there is none.
+    let (_local, none) = Live::on("127.0.0.1", 1);
+    assert!(none.is_none());
+}
+
 #[test]
 fn the_page_and_three_js_are_served_from_the_binary() {
     let live = Live::start(2);
-    let host = live
-        .url
-        .trim_start_matches("ws://")
-        .trim_end_matches("/ws")
-        .to_string();
-    let get = |path: &str| -> (String, String) {
-        use std::io::{Read, Write};
-        let mut s = std::net::TcpStream::connect(&host).expect("connect");
-        write!(
-            s,
-            "GET {path} HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"
-        )
-        .expect("write");
-        let mut r = String::new();
-        s.read_to_string(&mut r).expect("read");
-        let (head, body) = r.split_once("\r\n\r\n").unwrap_or((&r, ""));
-        (head.to_string(), body.to_string())
-    };
+    let get = |path: &str| get(&live.url, path);
     let (head, body) = get("/");
     assert!(head.starts_with("HTTP/1.1 200"), "{head}");
     assert!(

@@ -64,7 +64,11 @@ function send(command) {
 }
 
 function connect() {
-  const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws`;
+  // The access token the page was opened with (required off the loopback
+  // address), passed on to the WebSocket.
+  const token = new URLSearchParams(location.search).get('token');
+  const query = token ? `?token=${encodeURIComponent(token)}` : '';
+  const url = `${location.protocol === 'https:' ? 'wss' : 'ws'}://${location.host}/ws${query}`;
   socket = new WebSocket(url);
   socket.onopen = () => { viewer.connected = true; $('status').textContent = 'live'; };
   socket.onclose = () => {
