@@ -12,8 +12,8 @@ pub struct Args {
     #[arg(long)]
     quick: bool,
     /// Timed runs per measurement, after one warm-up (at least 5).
-    #[arg(long, default_value_t = 5)]
-    runs: usize,
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(5..=1000))]
+    runs: u64,
 }
 
 fn si(x: f64) -> String {
@@ -102,7 +102,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     let opts = Options {
         quick: args.quick,
-        runs: args.runs.max(5),
+        runs: args.runs as usize,
     };
     println!(
         "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}",

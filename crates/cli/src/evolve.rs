@@ -17,7 +17,7 @@ use std::time::Instant;
 #[derive(clap::Args)]
 pub struct Args {
     /// Generations per lane (a resumed run can be given a new total).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     generations: Option<u64>,
     /// Independent lanes (lane k mutates by up to ±25 (k + 1) %).
     #[arg(long)]
@@ -35,7 +35,7 @@ pub struct Args {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
     /// Seconds between checkpoints (0: after every batch of generations).
-    #[arg(long, default_value_t = 5.0)]
+    #[arg(long, default_value_t = 5.0, value_parser = crate::non_negative_f64)]
     checkpoint_every: f64,
     /// Watch it live in the browser: every lane's current best hopping side
     /// by side. The view stays open after the run until Ctrl-C.

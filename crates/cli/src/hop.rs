@@ -1,7 +1,7 @@
 //! `animats hop [PARAMS]`: one roobot, one evaluation, reported.
 
 use crate::output::Trajectory;
-use crate::{positive_f64, Failure};
+use crate::Failure;
 use animats_creatures::roobot::evaluate::{evaluate_with, EvalSettings};
 use animats_creatures::roobot::gait::GaitLog;
 
@@ -16,7 +16,7 @@ pub struct Args {
     #[arg(long)]
     lane: Option<usize>,
     /// Longest evaluation, s.
-    #[arg(long, default_value_t = 20.0, value_parser = positive_f64)]
+    #[arg(long, default_value_t = 20.0, value_parser = crate::eval_seconds)]
     seconds: f64,
     /// Write the trajectory (`.csv` or `.jsonl`, as `animats simulate` does).
     #[arg(long, short)]

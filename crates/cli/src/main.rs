@@ -93,3 +93,35 @@ pub fn positive_f64(s: &str) -> Result<f64, String> {
         Err(format!("must be a positive finite number, got {s}"))
     }
 }
+
+/// Parses a number >= 0 and finite (for intervals where 0 means "always").
+pub fn non_negative_f64(s: &str) -> Result<f64, String> {
+    let x: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if x.is_finite() && x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(format!("must be a finite number >= 0, got {s}"))
+    }
+}
+
+/// The longest single evaluation `hop` runs, s (a simulated day).
+pub const MAX_EVAL_SECONDS: f64 = 86_400.0;
+
+/// Parses an evaluation's length: positive, at most [`MAX_EVAL_SECONDS`].
+pub fn eval_seconds(s: &str) -> Result<f64, String> {
+    let x = positive_f64(s)?;
+    if x <= MAX_EVAL_SECONDS {
+        Ok(x)
+    } else {
+        Err(format!(
+            "must be at most {MAX_EVAL_SECONDS} s (a simulated day), got {s}"
+        ))
+    }
+}
+
+/// Prints a scene's warnings on stderr (the run goes on).
+pub fn warn(scene: &std::path::Path, warnings: &[String]) {
+    for w in warnings {
+        eprintln!("warning: {}: {w}", scene.display());
+    }
+}

@@ -224,6 +224,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
 
     let mut stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    crate::warn(&args.scene, stage.warnings());
     let describe = stage.describe();
     let parts = Parts {
         kinds: describe.particles.iter().map(|p| p.kind.clone()).collect(),

@@ -45,6 +45,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         return realtime(args);
     }
     let mut scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    crate::warn(&args.scene, &scene.warnings);
     let dt = args.dt.unwrap_or(scene.dt);
     let duration = args.duration.unwrap_or(scene.duration);
     if let Some(kind) = args.integrator {
@@ -78,13 +79,18 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     for step in 1..=steps {
         if let Err(e) = scene.step(dt) {
-            let message = match e {
-                SimError::NonFinite { particle, time } => format!(
-                    "{}: the simulation went non-finite at t = {time} s (step {step} of {steps}): particle `{}` has a non-finite position or velocity; try a smaller --dt",
+            let message = match e.blame() {
+                Some((particle, time)) => format!(
+                    "{}: the simulation {} at t = {time} s (step {step} of {steps}): {}; try a smaller --dt",
                     args.scene.display(),
-                    scene.name(particle)
+                    if matches!(e, SimError::NonFinite { .. }) {
+                        "went non-finite"
+                    } else {
+                        "diverged"
+                    },
+                    e.what(scene.name(particle))
                 ),
-                other => format!("{}: {other}", args.scene.display()),
+                None => format!("{}: {e}", args.scene.display()),
             };
             let kept = trajectory.and_then(|t| t.abandon());
             let note = kept.map_or(String::new(), |p| {
@@ -149,6 +155,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
 fn realtime(args: Args) -> Result<(), Failure> {
     use std::time::Duration;
     let mut scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    crate::warn(&args.scene, &scene.warnings);
     if let Some(kind) = args.integrator {
         scene.world.set_integrator(kind);
     }

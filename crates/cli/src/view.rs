@@ -64,6 +64,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         )));
     }
     let stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    crate::warn(&args.scene, stage.warnings());
     let server = args.serving.bind(args.speed)?;
     let stop = Arc::new(AtomicBool::new(false));
     {

@@ -316,3 +316,28 @@ fn bad_outputs_and_checkpoints_are_refused_before_any_work() {
     let o = evolve(&["--resume", fresh.to_str().unwrap(), "--seed", "99"]);
     assert_eq!(o.status.code(), Some(2));
 }
+
+#[test]
+fn nonsense_counts_and_intervals_are_refused_with_a_plain_message() {
+    let dir = scratch("nonsense");
+    let out = dir.join("run");
+    let out = out.to_str().unwrap();
+    for args in [
+        vec!["evolve", "--generations", "0", "--out", out],
+        vec!["evolve", "--generations", "-3", "--out", out],
+        vec!["evolve", "--generations", "5", "--checkpoint-every", "nan", "--out", out],
+        vec!["evolve", "--generations", "5", "--checkpoint-every", "-1", "--out", out],
+        vec!["evolve", "--generations", "5", "--lanes", "0", "--out", out],
+        vec!["evolve", "--generations", "5", "--threads", "0", "--out", out],
+        vec!["hop", "--seconds", "1e300"],
+        vec!["hop", "--seconds", "0"],
+        vec!["bench", "chain-64", "--runs", "0"],
+    ] {
+        let o = animats(&args);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains("error"), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(!std::path::Path::new(out).join("log.csv").exists());
+}

@@ -306,3 +306,98 @@ fn a_blow_up_exits_3_naming_time_and_particle_and_leaves_no_complete_output() {
         .collect();
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
+
+/// A chain of ten 10 g beads on damped springs hanging from a nail, under
+/// symplectic Euler at 4 ms: stable at k = 300 N/m; at k = 600 N/m past its
+/// step limit it tangles at tens of m/s without ever going non-finite.
+fn chain(stiffness: f64) -> String {
+    let mut s = String::from(
+        "[world]\ndt = 0.004\nintegrator = \"symplectic\"\nduration = 20.0\n\n[floor]\n\n",
+    );
+    for i in 0..10 {
+        s += &format!(
+            "[[particle]]\nname = \"p{i}\"\nmass = 0.01\nposition = [{}, 0.5, 0.0]\nradius = 0.01\nfixed = {}\n\n",
+            0.05 * i as f64,
+            i == 0
+        );
+    }
+    for i in 0..9 {
+        s += &format!(
+            "[[spring]]\na = \"p{i}\"\nb = \"p{}\"\nstiffness = {stiffness}\ndamping = 0.2\n\n",
+            i + 1
+        );
+    }
+    s
+}
+
+#[test]
+fn a_run_that_diverges_without_going_non_finite_is_a_blow_up_too() {
+    let dir = scratch("diverge");
+    let fine = write(&dir, "fine.toml", &chain(300.0));
+    let o = animats(&["simulate", &fine]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o).1);
+    assert!(!text(&o).1.contains("warning"), "{}", text(&o).1);
+
+    let bad = write(&dir, "tangled.toml", &chain(600.0));
+    let out = dir.join("tangled.csv");
+    let o = animats(&["simulate", &bad, "--output", out.to_str().unwrap()]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(err.contains("diverged at t = "), "{err}");
+    assert!(err.contains("particle `p"), "{err}");
+    assert!(err.contains("times the"), "{err}");
+    assert!(!out.exists());
+    assert!(dir.join("tangled.csv.partial").exists());
+}
+
+#[test]
+fn suspicious_scenes_get_warnings_naming_what_and_still_run() {
+    let dir = scratch("warnings");
+    let scene = write(
+        &dir,
+        "odd.toml",
+        r#"
+[world]
+dt = 0.01
+duration = 0.1
+integrator = "rk4"
+
+[floor]
+
+[[particle]]
+name = "sunk"
+mass = 1.0
+position = [0.0, 0.05, 0.0]
+radius = 0.1
+
+[[particle]]
+name = "nail"
+mass = 1.0
+position = [0.0, 1.0, 0.0]
+radius = 0.01
+fixed = true
+velocity = [1.0, 0.0, 0.0]
+
+[[particle]]
+name = "bead"
+mass = 0.001
+position = [0.0, 0.9, 0.0]
+radius = 0.01
+
+[[spring]]
+a = "nail"
+b = "bead"
+stiffness = 1000.0
+"#,
+    );
+    let o = animats(&["simulate", &scene]);
+    let (_, err) = text(&o);
+    assert!(
+        err.contains("warning:") && err.contains("`sunk` starts 0.0500 m inside the floor"),
+        "{err}"
+    );
+    assert!(err.contains("`nail` is fixed, so its velocity"), "{err}");
+    // ω² ≤ 2 k / m = 2e6: ω ≈ 1414 rad/s, RK4 stable below 2.83 / ω = 2.0 ms.
+    assert!(err.contains("dt = 0.01 s is 5.0 times"), "{err}");
+    assert!(err.contains("`nail`–`bead`"), "{err}");
+}

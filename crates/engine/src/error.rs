@@ -48,8 +48,44 @@ pub enum SimError {
         /// The simulated time at the end of the step that went wrong, s.
         time: f64,
     },
+    /// The simulation stayed finite but ran away (see
+    /// [`DivergenceGuard`](crate::DivergenceGuard)): a blow-up all the same.
+    Diverged {
+        /// The particle with the most kinetic energy.
+        particle: ParticleId,
+        /// The simulated time it was noticed, s.
+        time: f64,
+        /// What ran away.
+        why: String,
+    },
     /// The step size was not a positive finite number.
     BadStep(f64),
+}
+
+impl SimError {
+    /// The particle to blame and the time, for a blow-up.
+    pub fn blame(&self) -> Option<(ParticleId, f64)> {
+        match self {
+            SimError::NonFinite { particle, time } | SimError::Diverged { particle, time, .. } => {
+                Some((*particle, *time))
+            }
+            SimError::BadStep(_) => None,
+        }
+    }
+
+    /// What went wrong with the particle named `name` (the blame without
+    /// the time): the words front ends put after "the simulation went ...".
+    pub fn what(&self, name: &str) -> String {
+        match self {
+            SimError::NonFinite { .. } => {
+                format!("particle `{name}` has a non-finite position or velocity")
+            }
+            SimError::Diverged { why, .. } => format!("particle `{name}` ran away: {why}"),
+            SimError::BadStep(dt) => {
+                format!("step size must be a positive finite number, got {dt}")
+            }
+        }
+    }
 }
 
 impl fmt::Display for SimError {
@@ -58,6 +94,11 @@ impl fmt::Display for SimError {
             SimError::NonFinite { particle, time } => write!(
                 f,
                 "the simulation went non-finite at t = {time} s: particle #{} has a non-finite position or velocity (try a smaller step)",
+                particle.index()
+            ),
+            SimError::Diverged { particle, time, why } => write!(
+                f,
+                "the simulation diverged at t = {time} s: particle #{} ran away: {why} (try a smaller step)",
                 particle.index()
             ),
             SimError::BadStep(dt) => write!(f, "step size must be a positive finite number, got {dt}"),

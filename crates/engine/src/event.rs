@@ -71,6 +71,11 @@ pub trait DiscreteEvent: Send + CloneEvent {
         false
     }
 
+    /// True if handling the event never adds energy (the floor's impacts).
+    fn is_passive(&self) -> bool {
+        self.conserves_energy()
+    }
+
     /// A short name for summaries.
     fn name(&self) -> &str {
         "event"

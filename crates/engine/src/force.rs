@@ -63,6 +63,13 @@ pub trait Force: Send + CloneForce {
         false
     }
 
+    /// True when the force can never add mechanical energy (conservative or
+    /// dissipative: springs, joints, drag in still fluid, the floor); a motor,
+    /// a constant push or a current is not.
+    fn is_passive(&self) -> bool {
+        self.is_conservative()
+    }
+
     /// When it is applied; see [`Stage`].
     fn stage(&self) -> Stage {
         Stage::Body

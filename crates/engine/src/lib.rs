@@ -24,6 +24,7 @@ pub mod events;
 pub mod force;
 pub mod force_set;
 pub mod forces;
+pub mod guard;
 pub mod integrators;
 pub mod particle;
 pub mod snapshot;
@@ -46,6 +47,7 @@ pub use forces::{
     spring::{Spring, SpringDef, SpringId},
     torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},
 };
+pub use guard::DivergenceGuard;
 pub use integrators::IntegratorKind;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
 pub use snapshot::Snapshot;

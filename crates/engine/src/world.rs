@@ -640,6 +640,14 @@ impl World {
         conservative
     }
 
+    /// True when nothing in the world can add mechanical energy (see
+    /// [`Force::is_passive`](crate::Force::is_passive)).
+    pub fn is_passive(&self) -> bool {
+        let mut passive = self.events.iter().all(|e| e.is_passive());
+        self.forces.for_each(|f| passive &= f.is_passive());
+        passive
+    }
+
     /// Total linear momentum of the moving particles, kg m/s.
     pub fn momentum(&self) -> DVec3 {
         let p = &self.particles;

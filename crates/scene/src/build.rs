@@ -549,8 +549,12 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         Some(m) => wat.positive("max_dt", m)?,
         None => dt,
     };
+    let guard = animats_engine::DivergenceGuard::new(&world, !actors.is_empty());
+    let warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
     Ok(Scene {
         world,
+        guard,
+        warnings,
         names: name_list,
         kinds,
         dt,
@@ -641,4 +645,76 @@ fn current(at: &At, c: &CurrentEntry, g: f64) -> Result<Current, SceneError> {
             })
         }
     })
+}
+
+/// Largest ω·h at which a lone undamped spring stays bounded under each
+/// explicit integrator: symplectic Euler 2, RK4 2√2 ≈ 2.83; explicit Euler
+/// and midpoint grow at any step, and get the symplectic bound as a guide.
+fn stable_omega_h(kind: animats_engine::IntegratorKind) -> f64 {
+    match kind {
+        animats_engine::IntegratorKind::Rk4 => 2.0 * std::f64::consts::SQRT_2,
+        _ => 2.0,
+    }
+}
+
+/// What is allowed but probably a mistake: see [`Scene::warnings`].
+fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: bool) -> Vec<String> {
+    let mut out = Vec::new();
+    let (p, s) = (world.particles(), world.state());
+    if floor {
+        for (i, name) in names.iter().enumerate() {
+            let depth = p.radius[i] - s.pos[i].y;
+            if depth > 1e-9 && !p.fixed[i] {
+                out.push(format!(
+                    "particle `{name}` starts {depth:.4} m inside the floor (its lowest point is below y = 0): the floor will push it out at once",
+                ));
+            }
+        }
+    }
+    for (k, entry) in def.particle.iter().enumerate() {
+        let q = entry.get_ref();
+        if q.fixed && q.velocity.iter().any(|v| *v != 0.0) {
+            out.push(format!(
+                "particle[{k}] `{}` is fixed, so its velocity {:?} is ignored",
+                q.name, q.velocity
+            ));
+        }
+    }
+    // The fastest spring mode is bounded (Gershgorin) by the largest
+    // ω² ≤ 2 Σ k / m over the springs meeting at one particle; a nail
+    // takes none. Name that particle's stiffest spring.
+    let n = world.len();
+    let mut load = vec![0.0f64; n];
+    let mut stiffest: Vec<Option<(f64, usize)>> = vec![None; n];
+    for (k, sp) in world.forces().springs.iter().enumerate() {
+        let (a, b) = sp.ends();
+        for i in [a.index(), b.index()] {
+            load[i] += sp.stiffness;
+            if stiffest[i].map_or(true, |(kk, _)| sp.stiffness > kk) {
+                stiffest[i] = Some((sp.stiffness, k));
+            }
+        }
+    }
+    let worst = (0..n)
+        .map(|i| (2.0 * load[i] * p.inv_mass[i], i))
+        .max_by(|x, y| x.0.total_cmp(&y.0));
+    if let Some((w2, i)) = worst.filter(|w| w.0 > 0.0) {
+        let omega = w2.sqrt();
+        let kind = world.integrator();
+        let limit = stable_omega_h(kind) / omega;
+        if let (true, Some((_, k))) = (dt > limit, stiffest[i]) {
+            let (a, b) = world.forces().springs.iter().nth(k).map_or((0, 0), |sp| {
+                let (a, b) = sp.ends();
+                (a.index(), b.index())
+            });
+            out.push(format!(
+                "dt = {dt} s is {:.1} times the step at which {kind} can stay stable with the springs at particle `{}` (ω up to {omega:.1} rad/s; stable below {limit:.3e} s; the stiffest is `{}`–`{}`): expect a blow-up",
+                dt / limit,
+                names[i],
+                names[a],
+                names[b]
+            ));
+        }
+    }
+    out
 }

@@ -29,7 +29,7 @@ pub mod source;
 
 pub use error::SceneError;
 
-use animats_engine::{ParticleId, SimError, StepReport, World};
+use animats_engine::{DivergenceGuard, ParticleId, SimError, StepReport, World};
 use source::Source;
 use std::path::Path;
 
@@ -52,7 +52,16 @@ pub struct Scene {
     /// Everything that acts once per step: creatures with their controllers,
     /// and environment processes (bubble columns).
     pub actors: Vec<Box<dyn animats_creatures::Actor>>,
+    /// Watches for a run that diverges without going non-finite.
+    pub guard: DivergenceGuard,
+    /// Things that are allowed but probably not meant (a particle that
+    /// starts inside the floor, a nail given a velocity, a step far past the
+    /// stiffest spring's stability limit): front ends print them.
+    pub warnings: Vec<String>,
 }
+
+/// Steps between the divergence guard's checks (it sums the energy).
+const GUARD_EVERY: u64 = 64;
 
 impl Scene {
     /// The particle called `name`.
@@ -69,11 +78,17 @@ impl Scene {
     }
 
     /// Advances the scene by `dt`: every actor acts, then the world steps.
+    /// A blow-up is an error: a non-finite state, or (checked every few
+    /// steps) a run-away that [`DivergenceGuard`] catches.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
         for a in &mut self.actors {
             a.act(&mut self.world, dt);
         }
-        self.world.step(dt)
+        let report = self.world.step(dt)?;
+        if self.world.stats().steps % GUARD_EVERY == 0 {
+            self.guard.check(&self.world)?;
+        }
+        Ok(report)
     }
 }
 

@@ -49,6 +49,11 @@ impl SceneStage {
         Ok(SceneStage { path, scene })
     }
 
+    /// The scene's warnings (see `animats_scene::Scene::warnings`).
+    pub fn warnings(&self) -> &[String] {
+        &self.scene.warnings
+    }
+
     fn food(&self) -> Option<usize> {
         self.scene.kinds.iter().position(|k| *k == "food")
     }

@@ -203,6 +203,10 @@ impl DiscreteEvent for FloorCollision {
         self.collisions.clear();
     }
 
+    fn is_passive(&self) -> bool {
+        true // an impact never adds energy (module documentation)
+    }
+
     fn name(&self) -> &str {
         "floor collision"
     }

@@ -64,6 +64,10 @@ impl DiscreteEvent for PlaneConstraint {
         true
     }
 
+    fn is_passive(&self) -> bool {
+        true // projecting onto the plane only removes velocity
+    }
+
     fn name(&self) -> &str {
         "plane constraint"
     }

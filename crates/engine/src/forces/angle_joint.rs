@@ -232,6 +232,10 @@ impl Force for AngleJoints {
         self.joints.iter().all(|j| j.damping == 0.0)
     }
 
+    fn is_passive(&self) -> bool {
+        true // damping only removes energy
+    }
+
     fn name(&self) -> &str {
         "angle joints"
     }

@@ -120,6 +120,10 @@ impl Force for FloorContact {
         Stage::Contact
     }
 
+    fn is_passive(&self) -> bool {
+        true // the normal reaction does no work; friction removes energy
+    }
+
     fn name(&self) -> &str {
         "floor contact"
     }

@@ -75,6 +75,12 @@ impl Force for FluidMedium {
         }
     }
 
+    fn is_passive(&self) -> bool {
+        // Drag in still fluid removes energy and buoyancy is conservative;
+        // a current pushes.
+        matches!(self.current, crate::forces::current::Current::Still)
+    }
+
     fn name(&self) -> &str {
         "fluid"
     }

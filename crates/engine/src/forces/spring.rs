@@ -177,6 +177,10 @@ impl Force for Springs {
         self.springs.iter().all(|s| s.damping == 0.0)
     }
 
+    fn is_passive(&self) -> bool {
+        true // damping only removes energy
+    }
+
     fn name(&self) -> &str {
         "springs"
     }
