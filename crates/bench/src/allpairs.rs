@@ -1,5 +1,5 @@
 //! `allpairs-1000`: all-pairs softened gravity among 1000 bodies
-//! (`WORKLOADS.md` §2), through the engine's built-in `NBodyGravity`, beside a
+//! (`docs/WORKLOADS.md`), through the engine's built-in `NBodyGravity`, beside a
 //! plain hand-written loop over every (i, j).
 
 use animats_engine::{DVec3, IntegratorKind, NBodyGravity, ParticleDef, Targets, World};

@@ -1,6 +1,6 @@
 //! # animats-bench
 //!
-//! The standard benchmark workloads (`shared/bench/WORKLOADS.md`), run through
+//! The standard benchmark workloads (`docs/WORKLOADS.md`), run through
 //! the engine's public API — the code users get — side by side with plain
 //! hand-written loops for the same work, so every row carries its ratio.
 //!

@@ -1,4 +1,4 @@
-//! The mass-spring workloads `cloth-N` and `chain-64` (`shared/bench/WORKLOADS.md` §1),
+//! The mass-spring workloads `cloth-N` and `chain-64` (`docs/WORKLOADS.md` §1),
 //! built through the engine's public API, and the plain hand-written
 //! structure-of-arrays loop they are compared with.
 

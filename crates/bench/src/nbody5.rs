@@ -1,5 +1,5 @@
 //! `nbody5`: the Computer Language Benchmarks Game's n-body
-//! (`WORKLOADS.md` §2), run through the engine with the tutorial's user-defined
+//! (`docs/WORKLOADS.md`), run through the engine with the tutorial's user-defined
 //! force (`examples/nbody/gravity.rs`), beside the reference scalar `advance`.
 
 use animats_engine::{DVec3, IntegratorKind, ParticleDef, World};

@@ -1,5 +1,5 @@
 //! The engine, driven through its public API, reproduces the reference final
-//! states published with the standard workloads (`shared/bench/WORKLOADS.md`):
+//! states published with the standard workloads (`docs/WORKLOADS.md`):
 //! an end-to-end check of springs, gravity, the floor event and two
 //! integrators against independent implementations.
 

@@ -6,7 +6,8 @@ use animats_bench::{Options, Row, WORKLOADS};
 /// Arguments of `animats bench`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// Workloads to run (default: all of chain-64, cloth-32, cloth-128, nbody5, allpairs-1000).
+    /// Workloads to run (default: all of chain-64, cloth-32, cloth-128,
+    /// nbody5, allpairs-1000, hopper, seaworld, stability).
     workloads: Vec<String>,
     /// Shorter n-body runs (5M and 20 steps instead of 50M and 100).
     #[arg(long)]

@@ -1,7 +1,8 @@
 //! # animats-engine
 //!
-//! The particle dynamics engine of animats, after Kobus (2001), *Animats from
-//! the physics up*, §2.3 and §3.1: point masses (spheres), the forces that act
+//! The particle dynamics engine of animats, after Paul Urban, *Autonomous
+//! Dynamically Simulated Creatures for Virtual Environments* (Rhodes
+//! University, 2001), §2.3 and §3.1: point masses (spheres), the forces that act
 //! on them, discrete events such as collisions with the floor, and
 //! integrators that advance them in time.
 //!

@@ -1,7 +1,7 @@
 //! Parameter files for the roobot's hopping FSM: TOML with
 //! `params = [14 numbers]`, one comment line per parameter naming it.
 //! `animats evolve` also writes `best.toml` in this format, with the best
-//! lane's set on top and every lane's in `[[lane]]` tables.
+//! lane's set on top and every lane's in `[[lane_best]]` tables.
 //!
 //! ```toml
 //! # Roobot hopping-FSM parameters (thesis Table 4).

@@ -7,8 +7,10 @@
 //! - `fsm.rs`: the energy-driven behaviour FSM.
 //!
 //! Sensors: a food sensor at each dome mass and a depth sensor. Actuators:
-//! the pulse force (±5 N per dome mass) and one steering force per dome mass
-//! (±0.5 N), all along the dome's normal, which is recomputed every step.
+//! the pulse force per dome mass (±4.5 times the submerged weight the mass
+//! carries; Appendix B's ±5 N with the scene key `pulse_force`) and one
+//! steering force per dome mass (a tenth of the pulse's, as Appendix B's
+//! ±0.5 N against ±5 N), all along the dome's normal, recomputed every step.
 
 pub mod body;
 pub mod fsm;

@@ -3,12 +3,12 @@
 //!
 //! With θ the angle of the vector from `base` to `tip` from the vertical,
 //! positive when the tip leans forward, the level is `0.5 + gain θ`, clamped
-//! to [0, 1]. With gain π/2, level 0.5 is upright and the full range is
-//! ±1/π rad (±18.2°): this is what Appendix B's `0.5 + (legangle/2.0*Math.PI)`
-//! computes (Java reads it as `(legangle/2)·π`). The evident intent was
-//! `legangle/(2π)`, but the thesis's evolution ran with the former and its
-//! parameters only make sense under it (Table 6's evolved target angle 0.8156
-//! is 11.5° with gain π/2 and would be 113° with 1/(2π)). See docs/ROOBOT.md.
+//! to [0, 1]. The roobot uses gain 1/(2π) (`BodyConstants::leg_angle_gain`):
+//! full scale ±π. Appendix B's `0.5 + (legangle/2.0*Math.PI)` is read by Java
+//! as gain π/2 (full scale ±18.2°); the evident intent is `legangle/(2π)`,
+//! and with our body only that reading reproduces the thesis's behaviour,
+//! though Table 6's evolved values (0.8156: 11.5° under π/2, 113° under
+//! 1/(2π)) fit the slip. docs/ROOBOT.md gives the measurements.
 
 use crate::sensor::{unit, Sensor};
 use animats_engine::{DVec3, ParticleId, World};
