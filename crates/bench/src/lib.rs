@@ -9,6 +9,8 @@
 //! each run starts from a freshly built initial state and only the step loop
 //! is timed. Correctness checks are computed after the timed region.
 
+#![warn(missing_docs)]
+
 pub mod allpairs;
 pub mod hopper;
 pub mod mass_spring;

@@ -11,11 +11,14 @@
 //! - [`controller::Controller`] and [`controller::Actor`];
 //! - [`roobot`]: the hopping monopod and its FSM.
 
+#![warn(missing_docs)]
+
 pub mod actuator;
 pub mod actuators;
 pub mod controller;
 pub mod jellyfish;
 pub mod quadruped;
+pub mod random;
 pub mod roobot;
 pub mod seaworld;
 pub mod sensor;

@@ -184,7 +184,10 @@ fn hip_motor_acts_only_in_flight_and_ankle_only_in_stance() {
     }
     // And each motor does act in its own phase.
     let on = |phase: char, down: bool, i: usize| table.get(&(phase, down)).map_or(0, |r| r[i]);
-    assert!(on('F', false, 1) > 10, "the hip never swung the leg in flight");
+    assert!(
+        on('F', false, 1) > 10,
+        "the hip never swung the leg in flight"
+    );
     assert!(on('S', true, 2) > 10, "the ankle never acted in stance");
 }
 

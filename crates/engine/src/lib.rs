@@ -19,6 +19,8 @@
 //! No I/O, no threads, no global state: a world is a plain value, so many can
 //! run side by side (one per evolving individual).
 
+#![warn(missing_docs)]
+
 pub mod error;
 pub mod event;
 pub mod events;

@@ -289,7 +289,12 @@ fn a_nail_holds_a_hanging_bob_at_the_static_extension() {
         w.set_gravity(DVec3::new(0.0, -g, 0.0));
         let x = DVec3::new(0.1, 1.0, 0.3);
         let nail = w
-            .add_particle(ParticleDef::new(1.0).at(x).with_velocity(DVec3::ONE).fixed())
+            .add_particle(
+                ParticleDef::new(1.0)
+                    .at(x)
+                    .with_velocity(DVec3::ONE)
+                    .fixed(),
+            )
             .unwrap();
         let bob = w
             .add_particle(ParticleDef::new(m).at(x - DVec3::new(0.0, 0.5, 0.0)))

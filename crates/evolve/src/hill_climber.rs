@@ -10,7 +10,7 @@
 //! more boldly. The first candidate asked is the starting set itself.
 
 use crate::optimiser::Optimiser;
-use crate::random::Stream;
+use animats_creatures::random::Random;
 
 /// Hill climbing with the thesis's per-lane mutation size.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,7 +45,7 @@ impl HillClimber {
 }
 
 impl Optimiser for HillClimber {
-    fn ask(&mut self, rng: &mut Stream) -> Vec<f64> {
+    fn ask(&mut self, rng: &mut Random) -> Vec<f64> {
         let mut child = self.best.clone();
         if !self.started {
             self.started = true;

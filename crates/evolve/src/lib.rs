@@ -9,12 +9,13 @@
 //!   is Appendix B's selection-and-mutation scheme.
 //! - [`run::State`]: a run's lanes and log; `advance` moves it on.
 //! - [`checkpoint`]: save and load a run.
-//! - [`random::Stream`]: one random stream per (seed, lane, generation).
+//! - [`random::Random`]: one random stream per (seed, lane, generation).
+
+#![warn(missing_docs)]
 
 pub mod checkpoint;
 pub mod hill_climber;
 pub mod optimiser;
-pub mod random;
 pub mod run;
 
 pub use run::{Config, Lane, LogRow, State};

@@ -9,7 +9,7 @@
 
 use crate::hill_climber::HillClimber;
 use crate::optimiser::Optimiser;
-use crate::random::Stream;
+use animats_creatures::random::Random;
 use animats_creatures::roobot::evaluate::{evaluate, EvalSettings, Evaluation};
 use animats_creatures::roobot::{HopParams, PARAM_COUNT};
 use rayon::prelude::*;
@@ -268,7 +268,7 @@ fn advance_lane(
     let mut rows = Vec::new();
     for _ in 0..n {
         let generation = lane.generation + 1;
-        let mut rng = Stream::new(config.seed, lane.lane, generation);
+        let mut rng = Random::for_evaluation(config.seed, lane.lane, generation);
         let candidate = climber.ask(&mut rng);
         let mut params = HopParams::INITIAL;
         params.0.copy_from_slice(&candidate);

@@ -1,9 +1,9 @@
 //! The evolver: Appendix B's scheme, reproducibility, checkpoints, and the
 //! thesis's result (§5.4) in a smaller run.
 
+use animats_creatures::random::Random;
 use animats_evolve::hill_climber::HillClimber;
 use animats_evolve::optimiser::Optimiser;
-use animats_evolve::random::Stream;
 use animats_evolve::{checkpoint, Config, State};
 use std::path::PathBuf;
 
@@ -33,7 +33,7 @@ fn mutation_follows_appendix_b() {
         let bound = 0.25 * (lane as f64 + 1.0);
         let start = vec![1.0; 14];
         let mut c = HillClimber::new(start.clone(), lane);
-        let mut rng = Stream::new(9, lane, 0);
+        let mut rng = Random::for_evaluation(9, lane, 0);
         assert_eq!(
             c.ask(&mut rng),
             start,

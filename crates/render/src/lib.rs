@@ -11,6 +11,8 @@
 //! - `png_file.rs`, `gif_file.rs`, `video.rs`: PNG and GIF with the `png`
 //!   and `gif` crates; MP4 through `ffmpeg` when it is installed.
 
+#![warn(missing_docs)]
+
 pub mod camera;
 pub mod gif_file;
 pub mod image;

@@ -482,8 +482,13 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         let base = DVec3::new(position.x, 0.0, position.z);
         room(&at, "bubbles", c.bubbles, &world)?;
         let first = world.len();
-        let column = BubbleColumn::build(&mut world, &c, base, Random::new(seed, 1000 + k as u64))
-            .map_err(|e| at.model(e))?;
+        let column = BubbleColumn::build(
+            &mut world,
+            &c,
+            base,
+            Random::for_entry(seed, 1000 + k as u64),
+        )
+        .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.bubbles).map(|i| format!("{name}.{i}")).collect();
         namer.add(&at, first, &parts, |_| "bubble")?;
         actors.push(Box::new(column));
@@ -505,8 +510,12 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         };
         room(&at, "count", c.count, &world)?;
         let first = world.len();
-        rocks::scatter(&mut world, &c, &mut Random::new(seed, 2000 + k as u64))
-            .map_err(|e| at.model(e))?;
+        rocks::scatter(
+            &mut world,
+            &c,
+            &mut Random::for_entry(seed, 2000 + k as u64),
+        )
+        .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
         namer.add(&at, first, &parts, |_| "rock")?;
     }

@@ -21,6 +21,8 @@
 //! # Ok::<(), animats_scene::SceneError>(())
 //! ```
 
+#![warn(missing_docs)]
+
 pub mod build;
 pub mod def;
 pub mod error;

@@ -13,6 +13,8 @@
 //! - `access.rs`: the access token required off the loopback address;
 //! - `web/`: the page (`index.html`, `app.js`) and three.js.
 
+#![warn(missing_docs)]
+
 pub mod access;
 pub mod exhibition;
 pub mod protocol;

@@ -14,7 +14,7 @@
 //! at a few tens of cm/s, like a real bubble of a few millimetres.
 
 use crate::controller::Actor;
-use crate::seaworld::random::Random;
+use crate::random::Random;
 use animats_engine::{DVec3, ModelError, ParticleDef, ParticleId, World};
 use std::f64::consts::PI;
 

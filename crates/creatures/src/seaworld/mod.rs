@@ -3,11 +3,10 @@
 //! the same `ReefWater` currents (the engine's `Current::Reef`).
 
 pub mod bubble_column;
-pub mod random;
 pub mod rocks;
 pub mod seaweed;
 
+pub use crate::random::Random;
 pub use bubble_column::{BubbleColumn, BubbleConstants};
-pub use random::Random;
 pub use rocks::RocksConstants;
 pub use seaweed::{Seaweed, SeaweedConstants};

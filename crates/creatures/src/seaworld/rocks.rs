@@ -4,7 +4,7 @@
 //! friction 0.9, kinetic 0.7, restitution 0.4, dropped from x, z in
 //! [−0.5, 0.5] and y in [0.2, 1.2].
 
-use crate::seaworld::random::Random;
+use crate::random::Random;
 use animats_engine::{DVec3, ModelError, ParticleDef, ParticleId, World};
 
 /// How to scatter rocks.
