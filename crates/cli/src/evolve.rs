@@ -75,7 +75,8 @@ fn writable(dir: &Path) -> Result<(), Failure> {
 /// Writes log.csv, best.toml, fitness.png and the checkpoint.
 fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     let io = Failure::Other;
-    checkpoint::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes()).map_err(io)?;
+    animats_files::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes())
+        .map_err(io)?;
     let lanes: Vec<LaneBest> = state
         .lanes
         .iter()
@@ -97,7 +98,7 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
         state.config.lanes,
         state.generation()
     );
-    checkpoint::write_atomically(
+    animats_files::write_atomically(
         &dir.join("best.toml"),
         format_best(&lanes, &comment).as_bytes(),
     )
@@ -119,7 +120,7 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
             size: (900, 600),
         };
         let png = step_plot_png(&plot).map_err(io)?;
-        checkpoint::write_atomically(&dir.join("fitness.png"), &png).map_err(io)?;
+        animats_files::write_atomically(&dir.join("fitness.png"), &png).map_err(io)?;
     }
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
 }

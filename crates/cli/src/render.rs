@@ -325,9 +325,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     };
     match bytes {
         // Through a temporary file: no partial picture under the final name.
-        Some(b) => {
-            animats_evolve::checkpoint::write_atomically(&args.out, &b).map_err(Failure::Other)?
-        }
+        Some(b) => animats_files::write_atomically(&args.out, &b).map_err(Failure::Other)?,
         None => {
             let partial = args.out.with_extension("mp4.partial");
             let encoded = encode_mp4(&frames, args.fps, &partial);

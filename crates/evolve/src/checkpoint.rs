@@ -8,7 +8,6 @@
 
 use crate::run::State;
 use serde::{Deserialize, Serialize};
-use std::io::Write;
 use std::path::Path;
 
 const FORMAT: &str = "animats-evolve-checkpoint";
@@ -37,26 +36,7 @@ pub fn save(path: &Path, state: &State) -> Result<(), String> {
         checksum: format!("{:016x}", fnv1a(body.as_bytes())),
     };
     let header = serde_json::to_string(&header).map_err(|e| e.to_string())?;
-    write_atomically(path, format!("{header}\n{body}\n").as_bytes())
-}
-
-/// Writes `bytes` to `path` through a temporary file in the same directory.
-pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        format!("{}: cannot write: {e}", path.display())
-    })
+    animats_files::write_atomically(path, format!("{header}\n{body}\n").as_bytes())
 }
 
 /// Reads a checkpoint, refusing anything that is not an intact one.
