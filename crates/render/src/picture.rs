@@ -16,19 +16,10 @@ pub fn hex(c: u32) -> Colour {
     ) / 255.0
 }
 
-/// The colour of a particle of kind `kind` (see `animats_scene::Scene::kinds`).
+/// The colour of a particle of kind `kind` (see `animats_scene::Scene::kinds`),
+/// from the palette the live view uses too (`animats_view::palette`).
 pub fn kind_colour(kind: &str) -> Colour {
-    hex(match kind {
-        "food" => 0xffd34d,
-        "roobot" => 0xe07b39,
-        "dome" => 0xf4a6c8,
-        "tentacle" => 0xe58fb5,
-        "seaweed" => 0x3f9a4a,
-        "bubble" => 0xe8f4ff,
-        "rock" => 0x7d7468,
-        "quadruped" => 0xb5835a,
-        _ => 0x6fa8dc,
-    })
+    hex(animats_view::palette::colour_of(kind))
 }
 
 /// A solid sphere.
@@ -201,6 +192,6 @@ fn bell(d: &DomeParts, at: &impl Fn(usize) -> DVec3, size: f64) -> Option<Bell> 
         axis,
         radius: radius * (1.08 - 0.28 * s),
         height: radius * (0.75 + 0.45 * s),
-        colour: hex(0xf7b6d2),
+        colour: hex(animats_view::palette::colour_of("bell")),
     })
 }

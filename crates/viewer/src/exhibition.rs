@@ -8,11 +8,11 @@
 //! then. The evolution publishes its bests through a [`Showcase`].
 
 use crate::protocol::{CreatureState, Describe, Part};
-use crate::stage::{framing, Stage};
 use animats_creatures::roobot::evaluate::{evaluation_world, EvalSettings};
 use animats_creatures::roobot::{HopParams, Roobot};
 use animats_creatures::Actor;
 use animats_engine::{DVec3, World};
+use animats_view::{framing, Stage};
 use std::sync::{Arc, Mutex, PoisonError};
 
 /// Sideways distance between lanes, m.
@@ -162,6 +162,7 @@ impl Stage for Exhibition {
             food: None,
             target,
             distance: distance.max(3.0),
+            palette: animats_view::palette::PALETTE.into_iter().collect(),
         }
     }
 

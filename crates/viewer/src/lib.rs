@@ -6,8 +6,8 @@
 //! display rate while a thread of its own runs the simulation.
 //!
 //! - `protocol.rs`: the JSON messages;
-//! - `stage.rs`: what is run and drawn (a scene file, or an evolution's
-//!   exhibition in `exhibition.rs`);
+//! - `animats-view` (a crate below this one and the renderer): what is run
+//!   and drawn; `exhibition.rs`: an evolution's exhibition stage;
 //! - `runner.rs`: the simulation thread, pacing and commands;
 //! - `server.rs`: routes, the WebSocket, and the bounds on hostile clients;
 //! - `access.rs`: the access token required off the loopback address;
@@ -20,10 +20,10 @@ pub mod exhibition;
 pub mod protocol;
 pub mod runner;
 pub mod server;
-pub mod stage;
+pub use animats_view::stage;
 
+pub use animats_view::{SceneStage, Stage};
 pub use exhibition::Exhibition;
-pub use stage::{SceneStage, Stage};
 
 pub use runner::Summary;
 use runner::{Outlets, Runner};

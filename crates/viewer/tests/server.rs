@@ -344,6 +344,10 @@ async fn off_the_loopback_address_the_page_and_socket_need_the_token() {
     let mut ws = connect(&format!("{}?token={token}", live.url)).await;
     let scene = next(&mut ws).await.expect("the scene");
     assert_eq!(scene["type"], "scene");
+    // The page draws with the renderer's palette, which the scene carries.
+    for (kind, colour) in animats_view::palette::PALETTE {
+        assert_eq!(scene["palette"][kind], colour, "{kind}");
+    }
     // On the loopback address there is none.
     let (_local, none) = Live::on("127.0.0.1", 1);
     assert!(none.is_none());

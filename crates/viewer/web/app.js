@@ -3,11 +3,9 @@
 import * as THREE from 'three';
 import { OrbitControls } from '/vendor/OrbitControls.js';
 
-const COLOURS = {
-  particle: 0x6fa8dc, food: 0xffd34d, roobot: 0xe07b39, dome: 0xf4a6c8,
-  tentacle: 0xe58fb5, seaweed: 0x3f9a4a, bubble: 0xe8f4ff, rock: 0x7d7468,
-  quadruped: 0xb5835a,
-};
+// Colours by kind of part: the server sends its palette (the renderer's
+// too) with every scene; one grey until then.
+let COLOURS = { particle: 0x888888 };
 const WATER = 0x0d3b5c;
 const AIR = 0xbfd4e6;
 
@@ -80,6 +78,7 @@ function connect() {
     let msg;
     try { msg = JSON.parse(event.data); } catch { return; }
     if (msg.type === 'scene') {
+      if (msg.palette) COLOURS = msg.palette;
       viewer.scene = msg;
       build(msg);
     } else if (msg.type === 'frame') {
@@ -176,7 +175,7 @@ function build(desc) {
   // Jellyfish domes: translucent bells over their dome masses.
   const domes = desc.domes.map((d) => {
     const mesh = new THREE.Mesh(bell, new THREE.MeshStandardMaterial({
-      color: 0xf7b6d2, transparent: true, opacity: 0.45, side: THREE.DoubleSide, roughness: 0.3,
+      color: COLOURS.bell, transparent: true, opacity: 0.45, side: THREE.DoubleSide, roughness: 0.3,
       emissive: 0x301020,
     }));
     mesh.frustumCulled = false;

@@ -1,7 +1,7 @@
-//! What the viewer shows: a [`Stage`] advances a world and describes it.
+//! What is shown: a [`Stage`] advances a world and describes it.
 //! [`SceneStage`] plays a scene file.
 
-use crate::protocol::{CreatureState, Describe, Dome, Part};
+use crate::model::{CreatureState, Describe, Dome, Part};
 use animats_engine::DVec3;
 use animats_scene::Scene;
 use std::path::PathBuf;
@@ -138,6 +138,7 @@ impl Stage for SceneStage {
             food: self.food(),
             target,
             distance,
+            palette: crate::palette::PALETTE.into_iter().collect(),
         }
     }
 
