@@ -120,8 +120,8 @@ impl Exhibition {
     }
 
     fn finished(&self, lane: &Lane) -> bool {
-        lane.roobot.fallen(&lane.world)
-            || lane.roobot.body.leg_length(&lane.world) >= self.settings.constants.leg_limit
+        animats_creatures::roobot::evaluate::ended(&lane.world, &lane.roobot, &self.settings)
+            .is_some()
             || lane.world.time() >= self.settings.seconds - 0.5 * self.settings.dt
     }
 }

@@ -118,6 +118,20 @@ pub fn evaluation_world(
     Ok((world, roobot))
 }
 
+/// Why an evaluation must end now, before the next step: the hip (or any
+/// part but the foot) touches the floor, or the leg is past its length
+/// limit. The timeout is the caller's step count. The one place this rule
+/// is written: evaluations and the live exhibition both use it.
+pub fn ended(world: &World, roobot: &Roobot, settings: &EvalSettings) -> Option<Ending> {
+    if roobot.fallen(world) {
+        Some(Ending::Fell)
+    } else if roobot.body.leg_length(world) >= settings.constants.leg_limit {
+        Some(Ending::LegLimit)
+    } else {
+        None
+    }
+}
+
 /// Evaluates `params`; `observe` is called with the world after every step
 /// (and once before the first), for trajectories and tests.
 pub fn evaluate_with(
@@ -130,17 +144,12 @@ pub fn evaluate_with(
     let hip = roobot.body.hip;
     let x0 = world.position(hip).dot(forward);
     let steps = (settings.seconds / settings.dt).round() as u64;
-    let limit = settings.constants.leg_limit;
     let mut up = 0u64;
     let mut ending = Ending::Timeout;
     observe(&world, &roobot);
     for _ in 0..steps {
-        if roobot.fallen(&world) {
-            ending = Ending::Fell;
-            break;
-        }
-        if roobot.body.leg_length(&world) >= limit {
-            ending = Ending::LegLimit;
+        if let Some(end) = ended(&world, &roobot, settings) {
+            ending = end;
             break;
         }
         roobot.act(&mut world, settings.dt);
