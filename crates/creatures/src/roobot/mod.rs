@@ -2,7 +2,7 @@
 //!
 //! - `body.rs`: the masses, springs, joints and motors, and their constants.
 //! - `fsm.rs`: the four-state hopping controller.
-//! - `params.rs`: its 14 parameters.
+//! - `params.rs`: its 14 parameters; `params_file.rs`: their files (`params/`, `best.toml`).
 //! - `evaluate.rs`: one fitness evaluation, as the thesis's `HopEvolver` runs it.
 //! - `gait.rs`: stance durations and foot slide, for reports.
 //!
@@ -15,6 +15,7 @@ pub mod evaluate;
 pub mod fsm;
 pub mod gait;
 pub mod params;
+pub mod params_file;
 
 use crate::actuator::Actuator;
 use crate::actuators::{JointTorque, SpringRestLength};
