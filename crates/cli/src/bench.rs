@@ -64,10 +64,12 @@ fn print_row(r: &Row) {
         base
     );
     for c in &r.checks {
-        let verdict = match c.passed() {
-            Some(true) => "ok".to_string(),
-            Some(false) => "MISMATCH".to_string(),
-            None => "info".to_string(),
+        let verdict = match (c.passed(), c.target_met()) {
+            (Some(true), _) => "ok".to_string(),
+            (Some(false), _) => "MISMATCH".to_string(),
+            (None, Some(true)) => "target met".to_string(),
+            (None, Some(false)) => "target MISSED (reported, not a failure)".to_string(),
+            (None, None) => "info".to_string(),
         };
         use animats_bench::Bound;
         let against = match c.bound {
@@ -77,6 +79,7 @@ fn print_row(r: &Row) {
             } => format!("expected {expected:>+.10e} ± {tolerance:.1e}"),
             Bound::AtLeast(min) => format!("at least {min}"),
             Bound::AtMost(max) => format!("at most {max}"),
+            Bound::Target(min) => format!("goal at least {min}"),
             Bound::Info => String::new(),
         };
         println!(
