@@ -28,6 +28,11 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         min: timing.min / EVALS_PER_RUN as f64,
         max: timing.max / EVALS_PER_RUN as f64,
         runs: timing.runs,
+        times: timing
+            .times
+            .iter()
+            .map(|t| t / EVALS_PER_RUN as f64)
+            .collect(),
     };
     let e = last.ok_or("the evolved gait could not be evaluated")?;
     let steps = (settings.seconds / settings.dt).round() as usize;
@@ -40,7 +45,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         dt: settings.dt,
         evaluations: 4,
         pairs: 0,
-        engine: per_eval,
+        engine: per_eval.clone(),
         baseline: None,
         checks: vec![
             Check::new("time upright", e.time_up, 20.0, 0.0),

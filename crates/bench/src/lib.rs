@@ -52,7 +52,7 @@ impl Default for Options {
 }
 
 /// Median, minimum and maximum of a set of timed runs, s.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Timing {
     /// Median, s.
     pub median: f64,
@@ -62,11 +62,14 @@ pub struct Timing {
     pub max: f64,
     /// Number of runs.
     pub runs: usize,
+    /// Every timed run, s, in the order they ran.
+    pub times: Vec<f64>,
 }
 
 impl Timing {
     /// Summarises run times (s).
-    pub fn from_runs(mut times: Vec<f64>) -> Timing {
+    pub fn from_runs(runs: Vec<f64>) -> Timing {
+        let mut times = runs.clone();
         times.sort_by(f64::total_cmp);
         let n = times.len();
         let median = if n % 2 == 1 {
@@ -79,6 +82,7 @@ impl Timing {
             min: times[0],
             max: times[n - 1],
             runs: n,
+            times: runs,
         }
     }
 }

@@ -126,7 +126,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         dt: 0.01,
         evaluations: 4,
         pairs: 0,
-        engine: one,
+        engine: one.clone(),
         baseline: None,
         checks: vec![Check::info("simulated s per wall s", seconds / one.median)],
     };

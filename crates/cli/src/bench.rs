@@ -15,6 +15,78 @@ pub struct Args {
     /// Timed runs per measurement, after one warm-up (at least 5).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u64).range(5..=1000))]
     runs: u64,
+    /// Print one JSON object per measurement (every timed run, the checks,
+    /// the machine and the date) instead of the table, for keeping results
+    /// per machine.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The machine, for `--json`: CPU model (Linux's /proc/cpuinfo), cores, OS.
+fn machine() -> serde_json::Value {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    serde_json::json!({ "cpu": cpu, "cores": cores, "os": std::env::consts::OS, "arch": std::env::consts::ARCH })
+}
+
+/// Today's UTC date, YYYY-MM-DD (civil from days since 1970, Hinnant's algorithm).
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs()) as i64;
+    let z = secs.div_euclid(86_400) + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = doy - (153 * mp + 2) / 5 + 1;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 };
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    format!("{y:04}-{m:02}-{d:02}")
+}
+
+/// One measurement as a JSON object.
+fn json_row(r: &Row, quick: bool, machine: &serde_json::Value, date: &str) -> serde_json::Value {
+    use animats_bench::Bound;
+    let timing = |t: &animats_bench::Timing| serde_json::json!({ "median_s": t.median, "min_s": t.min, "max_s": t.max, "runs_s": t.times });
+    let checks: Vec<serde_json::Value> = r
+        .checks
+        .iter()
+        .map(|c| {
+            let (kind, bound) = match c.bound {
+                Bound::Near { expected, tolerance } => ("near", serde_json::json!({ "expected": expected, "tolerance": tolerance })),
+                Bound::AtLeast(min) => ("at_least", serde_json::json!({ "min": min })),
+                Bound::AtMost(max) => ("at_most", serde_json::json!({ "max": max })),
+                Bound::Target(min) => ("target", serde_json::json!({ "min": min })),
+                Bound::Info => ("info", serde_json::Value::Null),
+            };
+            serde_json::json!({ "name": c.name, "value": c.value, "kind": kind, "bound": bound, "passed": c.passed(), "target_met": c.target_met() })
+        })
+        .collect();
+    serde_json::json!({
+        "workload": r.workload,
+        "variant": r.variant,
+        "particles": r.particles,
+        "springs": r.springs,
+        "steps": r.steps,
+        "dt": r.dt,
+        "quick": quick,
+        "engine": timing(&r.engine),
+        "baseline": r.baseline.as_ref().map(|(name, t)| serde_json::json!({ "name": name, "timing": timing(t) })),
+        "sim_s_per_wall_s": r.sim_per_wall(),
+        "checks": checks,
+        "machine": machine,
+        "date": date,
+    })
 }
 
 fn si(x: f64) -> String {
@@ -108,16 +180,23 @@ pub fn run(args: Args) -> Result<(), Failure> {
         quick: args.quick,
         runs: args.runs as usize,
     };
-    println!(
+    let (machine, date) = (machine(), today());
+    if !args.json {
+        println!(
         "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}",
         opts.runs,
         if opts.quick { " (quick)" } else { "" }
     );
+    }
     let mut failed = 0;
     for n in &names {
         let rows = animats_bench::run(n, opts).map_err(Failure::Input)?;
         for r in &rows {
-            print_row(r);
+            if args.json {
+                println!("{}", json_row(r, opts.quick, &machine, &date));
+            } else {
+                print_row(r);
+            }
             failed += r
                 .checks
                 .iter()

@@ -1,0 +1,40 @@
+//! `animats bench --json`: one object per measurement, with every run.
+
+mod common;
+use common::{animats, text};
+
+#[test]
+fn json_has_every_run_the_checks_the_machine_and_the_date() {
+    let o = animats(&["bench", "chain-64", "--json"]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let rows: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    let variants: Vec<&str> = rows
+        .iter()
+        .map(|r| r["variant"].as_str().unwrap())
+        .collect();
+    assert_eq!(variants, ["symplectic", "rk4"]);
+    for r in &rows {
+        assert_eq!(r["workload"], "chain-64");
+        let runs = r["engine"]["runs_s"].as_array().unwrap();
+        assert_eq!(runs.len(), 5);
+        let median = r["engine"]["median_s"].as_f64().unwrap();
+        let mut sorted: Vec<f64> = runs.iter().map(|t| t.as_f64().unwrap()).collect();
+        sorted.sort_by(f64::total_cmp);
+        assert_eq!(median, sorted[2], "the median is the middle run");
+        assert_eq!(
+            r["baseline"]["timing"]["runs_s"].as_array().unwrap().len(),
+            5
+        );
+        let checks = r["checks"].as_array().unwrap();
+        assert!(checks
+            .iter()
+            .any(|c| c["name"] == "com_y" && c["passed"] == true));
+        assert!(r["machine"]["cores"].as_u64().unwrap() >= 1);
+        let date = r["date"].as_str().unwrap();
+        assert!(date.len() == 10 && date.starts_with("20"), "{date}");
+    }
+}
