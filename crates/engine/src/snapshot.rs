@@ -49,10 +49,10 @@ pub struct Snapshot {
     pub gravity: Option<[f64; 3]>,
 }
 
-fn mismatch(field: &'static str, what: &str, got: usize, want: usize) -> ModelError {
+fn mismatch(field: &'static str, got: usize, want: usize) -> ModelError {
     ModelError::new(
         field,
-        format!("the snapshot has {got} {what}, this world {want}: it is of another world"),
+        format!("the snapshot has {got} {field}, this world {want}: it is of another world"),
     )
 }
 
@@ -127,7 +127,7 @@ impl World {
             ),
         ] {
             if got != want {
-                return Err(mismatch(field, field, got, want));
+                return Err(mismatch(field, got, want));
             }
         }
         if s.gravity.is_some() != f.gravity.is_some() {

@@ -71,8 +71,8 @@ pub struct FloorDef {
     pub envelope: f64,
     /// Sliding slower than this is held by static friction, m/s.
     pub static_speed: f64,
-    /// Impacts slower than this do not bounce, and normal speeds below it count
-    /// as resting, m/s.
+    /// Impacts slower than this (at the plane) do not bounce, and a sphere on
+    /// the plane moving down slower than this can rest, m/s.
     pub rest_speed: f64,
     /// How close to the plane a sphere must be to rest on it, m.
     pub contact_tolerance: f64,

@@ -59,6 +59,10 @@ pub struct FloorCollision {
     /// The particles that collide with the floor.
     pub targets: Targets,
     hits: Vec<Hit>,
+    /// The step of the last check's trial, s, and the integrator's
+    /// free-flight shift: the same for every hit.
+    step: f64,
+    shift: f64,
     collisions: Vec<Collision>,
 }
 
@@ -68,10 +72,6 @@ struct Hit {
     index: u32,
     /// The trial's mean acceleration along the normal, m/s².
     accel: f64,
-    /// The step the trial belongs to, s.
-    step: f64,
-    /// The integrator's free-flight shift.
-    shift: f64,
 }
 
 impl Default for FloorCollision {
@@ -88,6 +88,8 @@ impl FloorCollision {
             rest_speed,
             targets,
             hits: Vec::new(),
+            step: 0.0,
+            shift: 0.0,
             collisions: Vec::new(),
         }
     }
@@ -113,6 +115,7 @@ impl FloorCollision {
 impl DiscreteEvent for FloorCollision {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.hits.clear();
+        (self.step, self.shift) = (ctx.step, ctx.flight_shift);
         let (pos, p) = (ctx.pos, ctx.particles);
         // The deepest penetration among the spheres below the plane.
         let mut deepest = 0.0f64;
@@ -121,8 +124,6 @@ impl DiscreteEvent for FloorCollision {
                 self.hits.push(Hit {
                     index: i as u32,
                     accel: (ctx.vel[i].y - ctx.start_vel[i].y) / ctx.h,
-                    step: ctx.step,
-                    shift: ctx.flight_shift,
                 });
                 deepest = deepest.min(gap);
             }
@@ -175,7 +176,7 @@ impl DiscreteEvent for FloorCollision {
             // smaller: it keeps the ½ a² h² that each step of flight gains
             // out of the next bounce, without which a bounce never ends.
             let e = particles.restitution[i];
-            let shift = hit.shift * a * hit.step;
+            let shift = self.shift * a * self.step;
             let w = vy + shift;
             let w_at_plane = (w * w + 2.0 * a * depth).max(0.0).sqrt();
             let rebound = (e * at_plane).min(e * w_at_plane - shift);
@@ -186,7 +187,7 @@ impl DiscreteEvent for FloorCollision {
             } else {
                 f64::INFINITY
             };
-            vel[i].y = if at_plane < self.rest_speed || flight <= hit.step {
+            vel[i].y = if at_plane < self.rest_speed || flight <= self.step {
                 0.0
             } else {
                 rebound
