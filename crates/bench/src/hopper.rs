@@ -71,7 +71,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let stable = state
         .lanes
         .iter()
-        .filter(|l| l.best_time_up >= 20.0)
+        .filter(|l| l.best.as_ref().is_some_and(|b| b.time >= 20.0))
         .count();
     let mut checks = vec![Check::info("lanes hopping 20 s", stable as f64)];
     if !quick {

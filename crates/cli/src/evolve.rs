@@ -1,13 +1,18 @@
-//! `animats evolve`: the thesis's evolution of hopping gaits, in parallel
-//! lanes, with a progress bar, checkpoints, and Ctrl-C to stop cleanly.
+//! `animats evolve [SCENE]`: the thesis's evolution of hopping gaits (no
+//! scene), or of a scene's `[evolve]` controller, in parallel lanes with
+//! the hill climber, a GA or CMA-ES; a progress bar (a line every few
+//! seconds when stderr is not a terminal), checkpoints, and Ctrl-C to stop
+//! cleanly.
 
 use crate::Failure;
-use animats_evolve::{checkpoint, Config, State};
+use animats_evolve::{checkpoint, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
+use animats_scene::evaluate::SceneProblem;
 use animats_scene::params::{format_best, LaneBest};
 use animats_viewer::exhibition::Showcase;
 use animats_viewer::Exhibition;
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -16,10 +21,20 @@ use std::time::Instant;
 /// Arguments of `animats evolve`.
 #[derive(clap::Args)]
 pub struct Args {
+    /// A scene file with an `[evolve]` table; without one, the roobot.
+    scene: Option<PathBuf>,
+    /// hill-climber (the thesis's), ga or cma-es.
+    #[arg(long, value_parser = OptimiserKind::parse)]
+    optimiser: Option<OptimiserKind>,
+    /// Candidates per generation per lane (default: hill-climber 1, ga 32,
+    /// cma-es 4 + 3 ln n).
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
+    population: Option<u64>,
     /// Generations per lane (a resumed run can be given a new total).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     generations: Option<u64>,
-    /// Independent lanes (lane k mutates by up to ±25 (k + 1) %).
+    /// Independent lanes (default 6 for the roobot, 1 for a scene; the hill
+    /// climber's lane k mutates by up to ±25 (k + 1) %).
     #[arg(long)]
     lanes: Option<usize>,
     /// Seed of every random choice.
@@ -46,7 +61,10 @@ pub struct Args {
 }
 
 const CHECKPOINT: &str = "checkpoint.json";
-/// Generations each lane advances between progress updates and Ctrl-C checks.
+/// Seconds between progress lines when stderr is not a terminal.
+const PROGRESS_EVERY: f64 = 5.0;
+/// Generations each roobot lane advances between progress updates and
+/// Ctrl-C checks (a scene's lanes advance one generation at a time).
 const BATCH: u64 = 10;
 
 fn input(m: impl Into<String>) -> Failure {
@@ -77,37 +95,27 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     let io = Failure::Other;
     animats_files::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes())
         .map_err(io)?;
-    let lanes: Vec<LaneBest> = state
-        .lanes
-        .iter()
-        .filter_map(|l| {
-            let mut params = animats_creatures::roobot::HopParams::INITIAL;
-            params.0.copy_from_slice(&l.best);
-            l.best_fitness.map(|fitness| LaneBest {
-                lane: l.lane,
-                params,
-                fitness,
-                time_up: l.best_time_up,
-                distance: l.best_distance,
-            })
-        })
-        .collect();
-    let comment = format!(
-        "Best roobot hopping parameters of `animats evolve` (seed {}, {} lanes, generation {}).\nLoad the best with `animats hop best.toml`, lane K's with `--lane K`.",
-        state.config.seed,
-        state.config.lanes,
-        state.generation()
-    );
-    animats_files::write_atomically(
-        &dir.join("best.toml"),
-        format_best(&lanes, &comment).as_bytes(),
-    )
-    .map_err(io)?;
+    let best = match &state.config.problem {
+        ProblemSpec::Roobot { .. } => Some(roobot_best(state)),
+        ProblemSpec::Scene { file, text } => scene_best(state, file, text)?,
+    };
+    if let Some(best) = best {
+        animats_files::write_atomically(&dir.join("best.toml"), best.as_bytes()).map_err(io)?;
+    }
     if with_plot {
+        let y_label = if state.config.problem.is_roobot() {
+            "best fitness (time upright + 50 × distance)"
+        } else {
+            "best fitness"
+        };
         let plot = Plot {
-            title: format!("Best fitness per lane (seed {})", state.config.seed),
+            title: format!(
+                "Best fitness per lane ({}, seed {})",
+                state.config.optimiser.name(),
+                state.config.seed
+            ),
             x_label: "generation".into(),
-            y_label: "best fitness (time upright + 50 × distance)".into(),
+            y_label: y_label.into(),
             series: state
                 .fitness_curves()
                 .into_iter()
@@ -125,13 +133,67 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
 }
 
+/// The roobot's best.toml: every lane's best parameters.
+fn roobot_best(state: &State) -> String {
+    let lanes: Vec<LaneBest> = state
+        .lanes
+        .iter()
+        .filter_map(|l| {
+            let b = l.best.as_ref()?;
+            let mut params = animats_creatures::roobot::HopParams::INITIAL;
+            params.0.copy_from_slice(&b.genome);
+            Some(LaneBest {
+                lane: l.lane,
+                params,
+                fitness: b.fitness,
+                time_up: b.time,
+                distance: b.distance,
+            })
+        })
+        .collect();
+    let comment = format!(
+        "Best roobot hopping parameters of `animats evolve` (seed {}, {} lanes, generation {}).\nLoad the best with `animats hop best.toml`, lane K's with `--lane K`.",
+        state.config.seed,
+        state.config.lanes,
+        state.generation()
+    );
+    format_best(&lanes, &comment)
+}
+
+/// A scene's best.toml: the whole scene with the best lane's genome in it.
+fn scene_best(state: &State, file: &str, text: &str) -> Result<Option<String>, Failure> {
+    let Some(lane) = state.best_lane() else {
+        return Ok(None);
+    };
+    let Some(best) = &lane.best else {
+        return Ok(None);
+    };
+    let problem = SceneProblem::parse(text, file).map_err(|e| Failure::Input(e.to_string()))?;
+    let comment = format!(
+        "{file} with the best controller of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nlane {}, fitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate best.toml`; watch it with `animats view best.toml`.",
+        state.config.optimiser.name(),
+        state.config.seed,
+        state.config.lanes,
+        state.generation(),
+        lane.lane,
+        best.fitness,
+        best.distance,
+        best.time,
+        best.ended
+    );
+    problem
+        .best_toml(&best.genome, &comment)
+        .map(Some)
+        .map_err(Failure::Other)
+}
+
 /// Shows every lane's best so far to the viewer.
 fn publish(showcase: &Showcase, state: &State) {
     for l in &state.lanes {
-        if let Some(fitness) = l.best_fitness {
+        if let Some(b) = &l.best {
             let mut params = animats_creatures::roobot::HopParams::INITIAL;
-            params.0.copy_from_slice(&l.best);
-            showcase.set_best(l.lane, params, fitness);
+            params.0.copy_from_slice(&b.genome);
+            showcase.set_best(l.lane, params, b.fitness);
         }
     }
     showcase.set_generation(state.generation(), state.config.generations);
@@ -144,10 +206,16 @@ pub fn run(args: Args) -> Result<(), Failure> {
             let state = checkpoint::load(&dir.join(CHECKPOINT)).map_err(input)?;
             if args.lanes.is_some_and(|l| l != state.config.lanes)
                 || args.seed.is_some_and(|s| s != state.config.seed)
+                || args.optimiser.is_some_and(|o| o != state.config.optimiser)
+                || args
+                    .population
+                    .is_some_and(|p| Some(p as usize) != state.config.population)
+                || args.scene.is_some()
             {
                 return Err(input(format!(
-                    "{}: a resumed run keeps its lanes ({}) and seed ({}); leave --lanes and --seed out",
+                    "{}: a resumed run keeps its scene, optimiser ({}), population, lanes ({}) and seed ({}); give only --resume and --generations",
                     dir.display(),
+                    state.config.optimiser.name(),
                     state.config.lanes,
                     state.config.seed
                 )));
@@ -174,13 +242,32 @@ pub fn run(args: Args) -> Result<(), Failure> {
                     dir.display()
                 )));
             }
-            writable(&dir)?;
-            let config = Config::thesis(
-                args.lanes.unwrap_or(6),
+            let mut config = Config::thesis(
+                args.lanes
+                    .unwrap_or(if args.scene.is_some() { 1 } else { 6 }),
                 args.generations.unwrap_or(100),
                 args.seed.unwrap_or(1),
             );
-            (dir, State::new(config).map_err(input)?)
+            if let Some(path) = &args.scene {
+                // Refused here, before any output exists, if it does not parse.
+                let problem = SceneProblem::load(path).map_err(|e| input(e.to_string()))?;
+                config.problem = ProblemSpec::Scene {
+                    file: problem.file().to_string(),
+                    text: animats_scene::read(path).map_err(|e| input(e.to_string()))?,
+                };
+                if args.view {
+                    return Err(input(
+                        "--view shows the roobot's lanes only; evolve the scene without it and watch DIR/best.toml with `animats view`",
+                    ));
+                }
+            }
+            if let Some(o) = args.optimiser {
+                config.optimiser = o;
+            }
+            config.population = args.population.map(|p| p as usize);
+            let state = State::new(config).map_err(input)?;
+            writable(&dir)?;
+            (dir, state)
         }
     };
 
@@ -213,7 +300,14 @@ pub fn run(args: Args) -> Result<(), Failure> {
     };
 
     let total = state.config.generations;
-    let bar = ProgressBar::new(total);
+    // A terminal gets a bar; a log file a line every few seconds.
+    let lines = !std::io::stderr().is_terminal();
+    let mut last_line = Instant::now();
+    let bar = if lines {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total)
+    };
     bar.set_style(
         ProgressStyle::with_template("{elapsed_precise} [{bar:32}] {pos}/{len} generations  {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar())
@@ -229,7 +323,12 @@ pub fn run(args: Args) -> Result<(), Failure> {
             interrupted = true;
             break;
         }
-        pool.install(|| state.advance(BATCH))
+        let batch = if state.config.problem.is_roobot() {
+            BATCH
+        } else {
+            1
+        };
+        pool.install(|| state.advance(batch))
             .map_err(Failure::Other)?;
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
@@ -237,10 +336,19 @@ pub fn run(args: Args) -> Result<(), Failure> {
             publish(showcase, &state);
         }
         bar.set_position(state.generation());
-        bar.set_message(format!(
+        let message = format!(
             "{rate:.0} evals/s, best fitness {:.1}",
             state.best_fitness().unwrap_or(f64::NAN)
-        ));
+        );
+        if lines && (last_line.elapsed().as_secs_f64() >= PROGRESS_EVERY || state.done()) {
+            eprintln!(
+                "generation {} of {total}: {} evaluations, {message}",
+                state.generation(),
+                state.evaluations
+            );
+            last_line = Instant::now();
+        }
+        bar.set_message(message);
         if last_save.elapsed().as_secs_f64() >= args.checkpoint_every {
             save(&dir, &state, false)?;
             last_save = Instant::now();
@@ -259,13 +367,16 @@ pub fn run(args: Args) -> Result<(), Failure> {
         state.config.seed,
         evals as f64 / wall.max(1e-9)
     );
+    let time_name = if state.config.problem.is_roobot() {
+        "upright"
+    } else {
+        "time"
+    };
     for l in &state.lanes {
+        let Some(b) = &l.best else { continue };
         println!(
-            "  lane {}: best fitness {:>8.2}  upright {:>6.3} s  distance {:>7.3} m",
-            l.lane,
-            l.best_fitness.unwrap_or(f64::NAN),
-            l.best_time_up,
-            l.best_distance
+            "  lane {}: best fitness {:>8.2}  {time_name} {:>6.3} s  distance {:>7.3} m  ({})",
+            l.lane, b.fitness, b.time, b.distance, b.ended
         );
     }
     println!(

@@ -6,6 +6,7 @@
 //! 130 interrupted by Ctrl-C (after saving), 1 anything else.
 
 mod bench;
+mod evaluate;
 mod evolve;
 mod hop;
 mod output;
@@ -31,8 +32,11 @@ enum Command {
     Simulate(simulate::Args),
     /// Simulate one hopping roobot with a parameter set and report its fitness.
     Hop(hop::Args),
-    /// Evolve hopping gaits with the thesis's evolver, lanes in parallel.
+    /// Evolve hopping gaits (no scene) or a scene's [evolve] controller,
+    /// with the hill climber, a GA or CMA-ES, lanes in parallel.
     Evolve(evolve::Args),
+    /// Run a scene's [evolve] evaluation once and print its fitness.
+    Evaluate(evaluate::Args),
     /// Run the standard benchmark workloads beside hand-written baselines.
     Bench(bench::Args),
     /// Run a scene live and watch it in the browser (3D, with controls).
@@ -59,6 +63,7 @@ fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(args),
         Command::Hop(args) => hop::run(args),
         Command::Evolve(args) => evolve::run(args),
+        Command::Evaluate(args) => evaluate::run(args),
         Command::Bench(args) => bench::run(args),
         Command::View(args) => view::run(args),
         Command::Render(args) => render::run(args),

@@ -45,6 +45,21 @@ impl<T: Actuated> Actuator<T> {
         }
     }
 
+    /// An actuator over [min, max] that starts at `level` (clamped to
+    /// [0, 1]) and drives the parameter there now; `reset` returns to it.
+    pub fn with_level(target: T, min: f64, max: f64, level: f64, world: &mut World) -> Self {
+        let level = crate::sensor::unit(level);
+        let mut a = Actuator {
+            target,
+            min,
+            max,
+            initial_level: level,
+            level,
+        };
+        a.reapply(world);
+        a
+    }
+
     /// Sets the level (clamped to [0, 1]) and drives the parameter.
     pub fn set_level(&mut self, world: &mut World, level: f64) {
         self.level = crate::sensor::unit(level);

@@ -8,6 +8,8 @@
 //! - [`sensor::Sensor`], one sensor per file in [`sensors`];
 //! - [`actuator::Actuator`] over an [`actuator::Actuated`] parameter, one per
 //!   file in [`actuators`];
+//! - [`brain::Brain`] (sensor levels in, actuator levels out) and the
+//!   kinds a scene declares in [`brains`], wired by [`nervous_system`];
 //! - [`controller::Controller`] and [`controller::Actor`];
 //! - [`roobot`]: the hopping monopod and its FSM.
 
@@ -15,8 +17,11 @@
 
 pub mod actuator;
 pub mod actuators;
+pub mod brain;
+pub mod brains;
 pub mod controller;
 pub mod jellyfish;
+pub mod nervous_system;
 pub mod quadruped;
 pub mod random;
 pub mod roobot;
@@ -24,4 +29,6 @@ pub mod seaworld;
 pub mod sensor;
 pub mod sensors;
 
+pub use brain::Brain;
 pub use controller::{Actor, Controller, Status};
+pub use nervous_system::NervousSystem;

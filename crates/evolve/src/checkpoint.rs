@@ -11,7 +11,8 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 const FORMAT: &str = "animats-evolve-checkpoint";
-const VERSION: u32 = 1;
+/// 2: optimisers' whole state and a full per-generation log (issue 10).
+const VERSION: u32 = 2;
 
 #[derive(Serialize, Deserialize)]
 struct Header {

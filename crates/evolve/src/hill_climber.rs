@@ -8,69 +8,119 @@
 //! `floor(n u)` (repeats allowed) and adds `p × 0.5 (lane + 1) (u - 0.5)`, so
 //! lane k changes a parameter by up to ±25 (k + 1) %: later lanes explore
 //! more boldly. The first candidate asked is the starting set itself.
+//!
+//! Two extensions, both off in the thesis's set-up: with bounds (a scene's
+//! genome, whose genes may be 0, where a relative change never moves), a
+//! mutation adds `w × 0.1 (lane + 1) (u − 0.5)` for a gene whose bounds are
+//! `w` wide and clamps into them; with a population λ > 1 each generation
+//! asks λ children of the best and keeps the best of them if it beats it,
+//! a (1+λ) scheme.
 
-use crate::optimiser::Optimiser;
-use animats_creatures::random::Random;
+use crate::optimiser::{check_told, BestSoFar, Bounds, Optimiser, Random, Setup};
+use serde::{Deserialize, Serialize};
 
 /// Hill climbing with the thesis's per-lane mutation size.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct HillClimber {
-    best: Vec<f64>,
-    best_fitness: f64,
+    seed: u64,
+    lane: usize,
+    best: BestSoFar,
+    start: Vec<f64>,
     /// Relative mutation scale: `0.5 (lane + 1)`.
     pub scale: f64,
-    started: bool,
+    bounds: Option<Bounds>,
+    population: usize,
+    generation: u64,
+    pending: Vec<Vec<f64>>,
 }
 
 impl HillClimber {
-    /// A climber starting from `start` for lane `lane` (0-based).
-    pub fn new(start: Vec<f64>, lane: usize) -> Self {
+    /// The thesis's climber from `start` for lane `lane` (0-based), drawing
+    /// from the streams of `seed`.
+    pub fn new(start: Vec<f64>, lane: usize, seed: u64) -> Self {
         HillClimber {
-            best: start,
-            best_fitness: f64::NEG_INFINITY,
+            seed,
+            lane,
+            best: BestSoFar::default(),
+            start,
             scale: 0.5 * (lane as f64 + 1.0),
-            started: false,
+            bounds: None,
+            population: 1,
+            generation: 0,
+            pending: Vec::new(),
         }
     }
 
-    /// Continues from a known best (a resumed run).
-    pub fn resume(best: Vec<f64>, best_fitness: f64, lane: usize) -> Self {
+    /// From a [`Setup`] (bounds and population as given).
+    pub fn from_setup(s: &Setup) -> Self {
         HillClimber {
-            best,
-            best_fitness,
-            scale: 0.5 * (lane as f64 + 1.0),
-            started: true,
+            bounds: s.bounds.clone(),
+            population: s.population.unwrap_or(1),
+            ..HillClimber::new(s.start.clone(), s.lane, s.seed)
         }
     }
-}
 
-impl Optimiser for HillClimber {
-    fn ask(&mut self, rng: &mut Random) -> Vec<f64> {
-        let mut child = self.best.clone();
-        if !self.started {
-            self.started = true;
-            return child;
-        }
+    /// One child of `parent`: Appendix B's mutation (see the module).
+    pub fn mutate(&self, parent: &[f64], rng: &mut Random) -> Vec<f64> {
+        let mut child = parent.to_vec();
         let n = child.len();
         let mutations = 1 + (3.0 * rng.uniform()).round() as usize;
         for _ in 0..mutations {
             let i = ((n as f64 * rng.uniform()) as usize).min(n - 1);
-            child[i] += child[i] * self.scale * (rng.uniform() - 0.5);
+            match &self.bounds {
+                None => child[i] += child[i] * self.scale * (rng.uniform() - 0.5),
+                Some(b) => {
+                    child[i] += b.width(i) * 0.2 * self.scale * (rng.uniform() - 0.5);
+                    child[i] = child[i].clamp(b.lo[i], b.hi[i]);
+                }
+            }
         }
         child
     }
+}
 
-    fn tell(&mut self, candidate: &[f64], fitness: f64) -> bool {
-        if fitness > self.best_fitness {
-            self.best = candidate.to_vec();
-            self.best_fitness = fitness;
-            true
-        } else {
-            false
+impl Optimiser for HillClimber {
+    fn ask(&mut self) -> Vec<Vec<f64>> {
+        let generation = self.generation + 1;
+        let mut rng = Random::for_evaluation(self.seed, self.lane, generation);
+        let parent = match self.best.get() {
+            Some((b, _)) => b.to_vec(),
+            None => self.start.clone(),
+        };
+        let mut out = Vec::with_capacity(self.population);
+        if self.generation == 0 {
+            out.push(parent.clone());
         }
+        while out.len() < self.population {
+            out.push(self.mutate(&parent, &mut rng));
+        }
+        self.pending = out.clone();
+        out
     }
 
-    fn best(&self) -> (&[f64], f64) {
-        (&self.best, self.best_fitness)
+    fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
+        check_told(self.pending.len(), fitness.len())?;
+        // The best child replaces the parent only if strictly better.
+        let mut top: Option<(usize, f64)> = None;
+        for (i, &f) in fitness.iter().enumerate() {
+            let f = crate::optimiser::sane(f);
+            if top.map_or(true, |(_, t)| f > t) {
+                top = Some((i, f));
+            }
+        }
+        if let Some((i, f)) = top {
+            self.best.offer(&self.pending[i], f);
+        }
+        self.pending.clear();
+        self.generation += 1;
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.get()
+    }
+
+    fn generation(&self) -> u64 {
+        self.generation
     }
 }

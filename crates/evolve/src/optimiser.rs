@@ -1,15 +1,293 @@
-//! The optimiser interface: ask for a candidate, tell its fitness. Hill
-//! climbing (the thesis's scheme) implements it; other strategies (a GA,
-//! CMA-ES) plug into the same evaluation code.
+//! The optimiser interface: ask for a whole population, tell its fitness.
+//! One evaluation loop ([`crate::run`]) serves every strategy: the thesis's
+//! hill climber, a GA and CMA-ES. All maximise.
+//!
+//! An optimiser draws its random numbers from [`Random::for_evaluation`]
+//! (seed, lane, generation): it stores no generator state, so a checkpoint
+//! taken between generations resumes to the identical run.
 
-use animats_creatures::random::Random;
+use crate::cma_es::CmaEs;
+use crate::ga::Ga;
+use crate::hill_climber::HillClimber;
+use serde::{Deserialize, Serialize};
 
-/// An ask/tell optimiser over real parameter vectors, maximising fitness.
+pub use animats_creatures::random::Random;
+
+/// An ask/tell optimiser over real vectors, maximising fitness.
 pub trait Optimiser {
-    /// The next candidate to evaluate, drawn with `rng`.
-    fn ask(&mut self, rng: &mut Random) -> Vec<f64>;
-    /// The fitness of the last candidate; returns true if it became the best.
-    fn tell(&mut self, candidate: &[f64], fitness: f64) -> bool;
+    /// The next generation's candidates (at least one).
+    fn ask(&mut self) -> Vec<Vec<f64>>;
+    /// The fitness of each candidate of the last `ask`, in order. A
+    /// non-finite fitness counts as the worst possible.
+    fn tell(&mut self, fitness: &[f64]) -> Result<(), String>;
     /// The best candidate so far and its fitness.
-    fn best(&self) -> (&[f64], f64);
+    fn best(&self) -> Option<(&[f64], f64)>;
+    /// Generations told so far.
+    fn generation(&self) -> u64;
+}
+
+/// Box bounds on a genome: `lo[i] <= x[i] <= hi[i]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bounds {
+    /// Lower bounds.
+    pub lo: Vec<f64>,
+    /// Upper bounds.
+    pub hi: Vec<f64>,
+}
+
+impl Bounds {
+    /// Checks the bounds: finite, `lo < hi`, one pair per dimension.
+    pub fn validate(&self, dim: usize) -> Result<(), String> {
+        if self.lo.len() != dim || self.hi.len() != dim {
+            return Err(format!("bounds: expected {dim} pairs"));
+        }
+        for (i, (l, h)) in self.lo.iter().zip(&self.hi).enumerate() {
+            if !(l.is_finite() && h.is_finite() && l < h) {
+                return Err(format!("bounds of gene {i}: [{l}, {h}] is not an interval"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The width of dimension `i`.
+    pub fn width(&self, i: usize) -> f64 {
+        self.hi[i] - self.lo[i]
+    }
+
+    /// Moves `x` into the box.
+    pub fn clamp(&self, x: &mut [f64]) {
+        for (i, v) in x.iter_mut().enumerate() {
+            *v = v.clamp(self.lo[i], self.hi[i]);
+        }
+    }
+}
+
+/// Which optimiser, as named on the command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OptimiserKind {
+    /// The thesis's hill climber (§3.2.1.6): (1+λ), λ = 1 by default.
+    HillClimber,
+    /// A generational GA: tournaments, uniform crossover, Gaussian mutation, elitism.
+    Ga,
+    /// Hansen's CMA-ES, (μ/μ_w, λ).
+    CmaEs,
+}
+
+impl OptimiserKind {
+    /// All kinds, in the order they are documented.
+    pub const ALL: [OptimiserKind; 3] = [
+        OptimiserKind::HillClimber,
+        OptimiserKind::Ga,
+        OptimiserKind::CmaEs,
+    ];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            OptimiserKind::HillClimber => "hill-climber",
+            OptimiserKind::Ga => "ga",
+            OptimiserKind::CmaEs => "cma-es",
+        }
+    }
+
+    /// Parses a command-line name.
+    pub fn parse(s: &str) -> Result<OptimiserKind, String> {
+        OptimiserKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown optimiser `{s}`: use hill-climber, ga or cma-es"))
+    }
+
+    /// The population a generation asks for by default in `dim` dimensions.
+    pub fn default_population(self, dim: usize) -> usize {
+        match self {
+            OptimiserKind::HillClimber => 1,
+            OptimiserKind::Ga => 32,
+            OptimiserKind::CmaEs => cma_default_lambda(dim),
+        }
+    }
+}
+
+/// Hansen's default population, `4 + floor(3 ln n)`.
+pub fn cma_default_lambda(dim: usize) -> usize {
+    4 + (3.0 * (dim.max(1) as f64).ln()).floor() as usize
+}
+
+/// What an optimiser starts from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setup {
+    /// The strategy.
+    pub kind: OptimiserKind,
+    /// The starting genome (the hill climber's first candidate, the GA's
+    /// first individual, CMA-ES's initial mean).
+    pub start: Vec<f64>,
+    /// Bounds; without them the hill climber mutates relatively (the
+    /// thesis's scheme) and CMA-ES samples freely.
+    pub bounds: Option<Bounds>,
+    /// Candidates per generation; `None`: the kind's default.
+    pub population: Option<usize>,
+    /// The run's seed.
+    pub seed: u64,
+    /// This lane, 0-based (the hill climber's mutation size grows with it).
+    pub lane: usize,
+    /// CMA-ES's initial step size: in units of the bounds' widths when
+    /// bounded (default 0.3), absolute otherwise (default 0.3).
+    pub sigma: Option<f64>,
+}
+
+impl Setup {
+    /// Checks the setup, naming the offending part.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.start.is_empty() {
+            return Err("the genome is empty: nothing to evolve".into());
+        }
+        if !self.start.iter().all(|x| x.is_finite()) {
+            return Err("start: every gene must be finite".into());
+        }
+        if let Some(b) = &self.bounds {
+            b.validate(self.start.len())?;
+        }
+        if let Some(p) = self.population {
+            let least = if self.kind == OptimiserKind::HillClimber {
+                1
+            } else {
+                2
+            };
+            if p < least || p > 100_000 {
+                return Err(format!(
+                    "population: must be between {least} and 100000 for {}, got {p}",
+                    self.kind.name()
+                ));
+            }
+        }
+        if let Some(s) = self.sigma {
+            if !(s.is_finite() && s > 0.0) {
+                return Err(format!("sigma: must be > 0, got {s}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Any of the built-in optimisers: what a run and its checkpoint hold.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum AnyOptimiser {
+    /// See [`HillClimber`].
+    HillClimber(HillClimber),
+    /// See [`Ga`].
+    Ga(Ga),
+    /// See [`CmaEs`].
+    CmaEs(CmaEs),
+}
+
+impl AnyOptimiser {
+    /// A fresh optimiser.
+    pub fn new(setup: &Setup) -> Result<AnyOptimiser, String> {
+        setup.validate()?;
+        Ok(match setup.kind {
+            OptimiserKind::HillClimber => AnyOptimiser::HillClimber(HillClimber::from_setup(setup)),
+            OptimiserKind::Ga => AnyOptimiser::Ga(Ga::new(setup)),
+            OptimiserKind::CmaEs => AnyOptimiser::CmaEs(CmaEs::new(setup)),
+        })
+    }
+
+    /// Which kind this is.
+    pub fn kind(&self) -> OptimiserKind {
+        match self {
+            AnyOptimiser::HillClimber(_) => OptimiserKind::HillClimber,
+            AnyOptimiser::Ga(_) => OptimiserKind::Ga,
+            AnyOptimiser::CmaEs(_) => OptimiserKind::CmaEs,
+        }
+    }
+
+    fn inner(&self) -> &dyn Optimiser {
+        match self {
+            AnyOptimiser::HillClimber(o) => o,
+            AnyOptimiser::Ga(o) => o,
+            AnyOptimiser::CmaEs(o) => o,
+        }
+    }
+
+    fn inner_mut(&mut self) -> &mut dyn Optimiser {
+        match self {
+            AnyOptimiser::HillClimber(o) => o,
+            AnyOptimiser::Ga(o) => o,
+            AnyOptimiser::CmaEs(o) => o,
+        }
+    }
+}
+
+impl Optimiser for AnyOptimiser {
+    fn ask(&mut self) -> Vec<Vec<f64>> {
+        self.inner_mut().ask()
+    }
+    fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
+        self.inner_mut().tell(fitness)
+    }
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.inner().best()
+    }
+    fn generation(&self) -> u64 {
+        self.inner().generation()
+    }
+}
+
+/// A standard normal deviate (Box–Muller with libm, so the same bits on
+/// every platform).
+pub fn gaussian(rng: &mut Random) -> f64 {
+    let u1 = 1.0 - rng.uniform(); // (0, 1]
+    let u2 = rng.uniform();
+    (-2.0 * libm::log(u1)).sqrt() * libm::cos(std::f64::consts::TAU * u2)
+}
+
+/// Fitness with NaN mapped to −∞, so that it always sorts last.
+pub fn sane(f: f64) -> f64 {
+    if f.is_nan() {
+        f64::NEG_INFINITY
+    } else {
+        f
+    }
+}
+
+/// Keeps track of the best candidate told so far (ties keep the earlier).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+pub struct BestSoFar {
+    /// The genome.
+    pub genome: Vec<f64>,
+    /// Its fitness; `None` before anything finite was told.
+    pub fitness: Option<f64>,
+}
+
+impl BestSoFar {
+    /// Offers a candidate; true if it became the best.
+    pub fn offer(&mut self, genome: &[f64], fitness: f64) -> bool {
+        let f = sane(fitness);
+        if f > self.fitness.unwrap_or(f64::NEG_INFINITY) {
+            self.genome = genome.to_vec();
+            self.fitness = Some(f);
+            true
+        } else {
+            false
+        }
+    }
+
+    /// As the trait's `best`.
+    pub fn get(&self) -> Option<(&[f64], f64)> {
+        self.fitness.map(|f| (self.genome.as_slice(), f))
+    }
+}
+
+/// Checks a `tell` against the population asked.
+pub fn check_told(asked: usize, told: usize) -> Result<(), String> {
+    if asked == 0 {
+        Err("tell without ask: ask for a population first".into())
+    } else if asked != told {
+        Err(format!(
+            "told {told} fitness values for a population of {asked}"
+        ))
+    } else {
+        Ok(())
+    }
 }

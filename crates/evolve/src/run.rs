@@ -1,21 +1,72 @@
-//! An evolution run: independent lanes, each a hill climber over the roobot's
-//! 14 hopping parameters, advanced generation by generation, in parallel.
+//! An evolution run: independent lanes, each with its own optimiser over one
+//! problem (the roobot's 14 hopping parameters, or a scene's controller),
+//! advanced generation by generation.
 //!
-//! A generation is one evaluation per lane (generation 1 evaluates the
-//! starting parameters themselves, as in Table 6). Every improvement is
-//! logged. Lanes advance in chunks; within a chunk each lane runs on its own
-//! (in parallel), and its log rows are merged in (generation, lane) order, so
-//! the log is the same whatever the number of threads.
+//! A generation asks each lane's optimiser for its population and evaluates
+//! it in parallel (lanes in parallel too, on the current rayon pool). The
+//! thesis's hill climber asks one candidate (generation 1 evaluates the
+//! starting parameters themselves, as in Table 6). Every evaluation is a pure
+//! function of its genome and every optimiser draws from streams named by
+//! (seed, lane, generation), so the log, the best and the checkpoint are the
+//! same bits whatever the number of threads.
 
-use crate::hill_climber::HillClimber;
-use crate::optimiser::Optimiser;
-use animats_creatures::random::Random;
-use animats_creatures::roobot::evaluate::{evaluate, EvalSettings, Evaluation};
+use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
+use crate::problem::{Outcome, Problem, RoobotProblem, SceneEvolution};
+use animats_creatures::roobot::evaluate::EvalSettings;
 use animats_creatures::roobot::{HopParams, PARAM_COUNT};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// What a run was asked to do; fixed for its lifetime (a resumed run keeps it).
+/// What is evolved.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum ProblemSpec {
+    /// The roobot's hopping gait.
+    Roobot {
+        /// Starting parameters of every lane.
+        start: Vec<f64>,
+        /// Longest evaluation, s.
+        seconds: f64,
+        /// Integration step, s.
+        dt: f64,
+    },
+    /// A scene's `[evolve]` controller. The text is kept, so a resumed run
+    /// evaluates the scene it started with even if the file has changed.
+    Scene {
+        /// The scene file, as named (for messages and relative paths).
+        file: String,
+        /// Its text.
+        text: String,
+    },
+}
+
+impl ProblemSpec {
+    /// Builds the problem.
+    pub fn build(&self) -> Result<Box<dyn Problem>, String> {
+        match self {
+            ProblemSpec::Roobot { start, seconds, dt } => Ok(Box::new(RoobotProblem {
+                start: start.clone(),
+                settings: EvalSettings {
+                    seconds: *seconds,
+                    dt: *dt,
+                    ..EvalSettings::default()
+                },
+            })),
+            ProblemSpec::Scene { file, text } => Ok(Box::new(SceneEvolution(
+                animats_scene::evaluate::SceneProblem::parse(text, file)
+                    .map_err(|e| e.to_string())?,
+            ))),
+        }
+    }
+
+    /// True for the roobot.
+    pub fn is_roobot(&self) -> bool {
+        matches!(self, ProblemSpec::Roobot { .. })
+    }
+}
+
+/// What a run was asked to do; fixed for its lifetime (a resumed run keeps
+/// it, but for the number of generations).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// Independent lanes.
@@ -24,25 +75,29 @@ pub struct Config {
     pub generations: u64,
     /// Seed of every random stream.
     pub seed: u64,
-    /// Starting parameters of every lane.
-    pub start: Vec<f64>,
-    /// Longest evaluation, s.
-    pub seconds: f64,
-    /// Integration step, s.
-    pub dt: f64,
+    /// The strategy of every lane.
+    pub optimiser: OptimiserKind,
+    /// Candidates per generation; `None`: the optimiser's default.
+    pub population: Option<usize>,
+    /// What is evolved.
+    pub problem: ProblemSpec,
 }
 
 impl Config {
-    /// The thesis's experiment: `lanes` lanes from Appendix B's initial
-    /// parameters, 20 s evaluations at 8 ms.
+    /// The thesis's experiment: `lanes` hill-climbing lanes from Appendix
+    /// B's initial parameters, 20 s evaluations at 8 ms.
     pub fn thesis(lanes: usize, generations: u64, seed: u64) -> Config {
         Config {
             lanes,
             generations,
             seed,
-            start: HopParams::INITIAL.0.to_vec(),
-            seconds: 20.0,
-            dt: 0.008,
+            optimiser: OptimiserKind::HillClimber,
+            population: None,
+            problem: ProblemSpec::Roobot {
+                start: HopParams::INITIAL.0.to_vec(),
+                seconds: 20.0,
+                dt: 0.008,
+            },
         }
     }
 
@@ -54,41 +109,86 @@ impl Config {
                 self.lanes
             ));
         }
-        if self.start.len() != PARAM_COUNT || !self.start.iter().all(|p| p.is_finite()) {
-            return Err(format!("start: must be {PARAM_COUNT} finite numbers"));
-        }
-        let positive = |x: f64| x > 0.0 && x.is_finite();
-        if !positive(self.seconds) || !positive(self.dt) {
-            return Err("seconds and dt must be positive".into());
+        if let ProblemSpec::Roobot { start, seconds, dt } = &self.problem {
+            if start.len() != PARAM_COUNT || !start.iter().all(|p| p.is_finite()) {
+                return Err(format!("start: must be {PARAM_COUNT} finite numbers"));
+            }
+            let positive = |x: f64| x > 0.0 && x.is_finite();
+            if !positive(*seconds) || !positive(*dt) {
+                return Err("seconds and dt must be positive".into());
+            }
         }
         Ok(())
     }
 
-    /// The evaluation settings this run uses.
+    /// The roobot's evaluation settings (the thesis's for a scene run).
     pub fn settings(&self) -> EvalSettings {
-        EvalSettings {
-            seconds: self.seconds,
-            dt: self.dt,
-            ..EvalSettings::default()
+        match &self.problem {
+            ProblemSpec::Roobot { seconds, dt, .. } => EvalSettings {
+                seconds: *seconds,
+                dt: *dt,
+                ..EvalSettings::default()
+            },
+            ProblemSpec::Scene { .. } => EvalSettings::default(),
+        }
+    }
+
+    /// The optimiser of lane `lane` for `problem`.
+    pub fn setup(&self, problem: &dyn Problem, lane: usize) -> Setup {
+        let bounds = if self.optimiser == OptimiserKind::HillClimber && problem.relative_mutation()
+        {
+            None
+        } else {
+            problem.bounds()
+        };
+        Setup {
+            kind: self.optimiser,
+            start: problem.start(),
+            bounds,
+            population: self.population,
+            seed: self.seed,
+            lane,
+            sigma: None,
         }
     }
 }
 
-/// One improvement: a row of `log.csv` (the shape of the thesis's Table 6).
+/// One lane's generation: a row of the full log.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LogRow {
     /// Lane, 0-based.
     pub lane: usize,
     /// Generation, 1-based.
     pub generation: u64,
-    /// Fitness: time_up + 50 × distance.
+    /// Evaluations this lane has done, this generation's included.
+    pub evaluations: u64,
+    /// The generation's best fitness.
     pub fitness: f64,
-    /// Time upright, s.
-    pub time_up: f64,
-    /// Forward distance, m.
+    /// The lane's best fitness so far.
+    pub best_fitness: f64,
+    /// Time survived by the generation's best, s.
+    pub time: f64,
+    /// Its distance, m.
     pub distance: f64,
-    /// The 14 parameters.
-    pub params: Vec<f64>,
+    /// Why its evaluation ended.
+    pub ended: String,
+    /// The new best genome, when this generation improved on the lane's best.
+    pub improved: Option<Vec<f64>>,
+}
+
+/// The best a lane has found.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Best {
+    /// The genome.
+    pub genome: Vec<f64>,
+    /// Its fitness.
+    pub fitness: f64,
+    /// Time survived, s (the roobot's time upright).
+    pub time: f64,
+    /// Distance, m.
+    pub distance: f64,
+    /// Why its evaluation ended.
+    pub ended: String,
 }
 
 /// Where one lane stands.
@@ -98,14 +198,12 @@ pub struct Lane {
     pub lane: usize,
     /// Generations completed.
     pub generation: u64,
-    /// Best parameters so far.
-    pub best: Vec<f64>,
-    /// Their fitness (−∞ before the first evaluation, stored as null).
-    pub best_fitness: Option<f64>,
-    /// Their evaluation.
-    pub best_time_up: f64,
-    /// Their forward distance, m.
-    pub best_distance: f64,
+    /// Evaluations done.
+    pub evaluations: u64,
+    /// Its optimiser's whole state.
+    pub optimiser: AnyOptimiser,
+    /// The best so far (`None` before the first generation).
+    pub best: Option<Best>,
 }
 
 /// Everything needed to continue a run: what a checkpoint stores.
@@ -115,7 +213,7 @@ pub struct State {
     pub config: Config,
     /// Each lane.
     pub lanes: Vec<Lane>,
-    /// Every improvement so far, in (generation, lane) order.
+    /// One row per lane per generation, in (generation, lane) order.
     pub log: Vec<LogRow>,
     /// Evaluations done so far.
     pub evaluations: u64,
@@ -125,16 +223,18 @@ impl State {
     /// A fresh run.
     pub fn new(config: Config) -> Result<State, String> {
         config.validate()?;
+        let problem = config.problem.build()?;
         let lanes = (0..config.lanes)
-            .map(|lane| Lane {
-                lane,
-                generation: 0,
-                best: config.start.clone(),
-                best_fitness: None,
-                best_time_up: 0.0,
-                best_distance: 0.0,
+            .map(|lane| {
+                Ok(Lane {
+                    lane,
+                    generation: 0,
+                    evaluations: 0,
+                    optimiser: AnyOptimiser::new(&config.setup(problem.as_ref(), lane))?,
+                    best: None,
+                })
             })
-            .collect();
+            .collect::<Result<_, String>>()?;
         Ok(State {
             config,
             lanes,
@@ -154,20 +254,18 @@ impl State {
             ));
         }
         for (i, l) in self.lanes.iter().enumerate() {
-            if l.lane != i || l.best.len() != PARAM_COUNT || !l.best.iter().all(|p| p.is_finite()) {
+            if l.lane != i || l.optimiser.kind() != self.config.optimiser {
                 return Err(format!("lane {i} is malformed"));
             }
-            if l.generation > 0 && l.best_fitness.is_none() {
-                return Err(format!("lane {i} has generations but no fitness"));
+            if l.generation != l.optimiser.generation() {
+                return Err(format!("lane {i}: its optimiser is at another generation"));
+            }
+            if l.generation > 0 && l.best.is_none() {
+                return Err(format!("lane {i} has generations but no best"));
             }
         }
-        for r in &self.log {
-            if r.lane >= self.lanes.len() || r.params.len() != PARAM_COUNT {
-                return Err(format!(
-                    "log row for lane {} generation {} is malformed",
-                    r.lane, r.generation
-                ));
-            }
+        if self.log.iter().any(|r| r.lane >= self.lanes.len()) {
+            return Err("a log row names a lane that does not exist".into());
         }
         Ok(())
     }
@@ -186,65 +284,92 @@ impl State {
     pub fn best_fitness(&self) -> Option<f64> {
         self.lanes
             .iter()
-            .filter_map(|l| l.best_fitness)
+            .filter_map(|l| l.best.as_ref().map(|b| b.fitness))
             .max_by(f64::total_cmp)
     }
 
+    /// The lane holding the best fitness (the first of equals).
+    pub fn best_lane(&self) -> Option<&Lane> {
+        let mut top: Option<(&Lane, f64)> = None;
+        for l in &self.lanes {
+            if let Some(b) = &l.best {
+                if top.map_or(true, |(_, f)| b.fitness > f) {
+                    top = Some((l, b.fitness));
+                }
+            }
+        }
+        top.map(|(l, _)| l)
+    }
+
     /// Advances every lane by up to `generations` generations (not past the
-    /// configured total), lanes in parallel on the current rayon pool.
+    /// configured total); lanes and each generation's evaluations in
+    /// parallel on the current rayon pool.
     pub fn advance(&mut self, generations: u64) -> Result<(), String> {
-        let config = self.config.clone();
-        let settings = config.settings();
-        let target = config.generations;
-        let results: Vec<Result<(Vec<LogRow>, u64), String>> = self
+        let problem = self.config.problem.build()?;
+        let target = self.config.generations;
+        let results: Vec<Result<Vec<LogRow>, String>> = self
             .lanes
             .par_iter_mut()
             .map(|lane| {
-                advance_lane(
-                    lane,
-                    &config,
-                    &settings,
-                    generations.min(target.saturating_sub(lane.generation)),
-                )
+                let n = generations.min(target.saturating_sub(lane.generation));
+                advance_lane(lane, problem.as_ref(), n)
             })
             .collect();
         let mut rows = Vec::new();
         for r in results {
-            let (lane_rows, evaluations) = r?;
-            rows.extend(lane_rows);
-            self.evaluations += evaluations;
+            rows.extend(r?);
         }
+        self.evaluations = self.lanes.iter().map(|l| l.evaluations).sum();
         rows.sort_by_key(|r| (r.generation, r.lane));
         self.log.extend(rows);
         Ok(())
     }
 
-    /// `log.csv`: a header, then one row per improvement, numbers in their
-    /// shortest round-trip form.
+    /// `log.csv`. For the roobot, the thesis's Table 6 shape as always: one
+    /// row per improvement with its 14 parameters. For a scene, one row per
+    /// lane per generation. Numbers in their shortest round-trip form.
     pub fn log_csv(&self) -> String {
-        let mut out = String::from("lane,generation,fitness,time_up,distance");
-        for i in 0..PARAM_COUNT {
-            out.push_str(&format!(",p{i}"));
-        }
-        out.push('\n');
         let mut b = ryu::Buffer::new();
-        for r in &self.log {
-            out.push_str(&format!("{},{}", r.lane, r.generation));
-            for x in [r.fitness, r.time_up, r.distance].iter().chain(&r.params) {
-                out.push(',');
-                out.push_str(b.format(*x));
+        let mut out = String::new();
+        if self.config.problem.is_roobot() {
+            out.push_str("lane,generation,fitness,time_up,distance");
+            for i in 0..PARAM_COUNT {
+                out.push_str(&format!(",p{i}"));
             }
             out.push('\n');
+            for r in &self.log {
+                let Some(params) = &r.improved else { continue };
+                out.push_str(&format!("{},{}", r.lane, r.generation));
+                for x in [r.fitness, r.time, r.distance].iter().chain(params) {
+                    out.push(',');
+                    out.push_str(b.format(*x));
+                }
+                out.push('\n');
+            }
+        } else {
+            out.push_str("lane,generation,evaluations,fitness,best_fitness,time,distance,ended\n");
+            for r in &self.log {
+                out.push_str(&format!("{},{},{}", r.lane, r.generation, r.evaluations));
+                for x in [r.fitness, r.best_fitness, r.time, r.distance] {
+                    out.push(',');
+                    out.push_str(b.format(x));
+                }
+                out.push(',');
+                out.push_str(&r.ended);
+                out.push('\n');
+            }
         }
         out
     }
 
-    /// Best fitness of each lane after each generation 1..=n (a step function
-    /// of the log), for plots.
+    /// Best fitness of each lane after each generation (a step function of
+    /// the log), for plots.
     pub fn fitness_curves(&self) -> Vec<Vec<(u64, f64)>> {
         let mut curves = vec![Vec::new(); self.lanes.len()];
         for r in &self.log {
-            curves[r.lane].push((r.generation, r.fitness));
+            if r.improved.is_some() {
+                curves[r.lane].push((r.generation, r.best_fitness));
+            }
         }
         for (curve, lane) in curves.iter_mut().zip(&self.lanes) {
             if let (Some(&(_, f)), true) = (curve.last(), lane.generation > 0) {
@@ -255,39 +380,48 @@ impl State {
     }
 }
 
-fn advance_lane(
-    lane: &mut Lane,
-    config: &Config,
-    settings: &EvalSettings,
-    n: u64,
-) -> Result<(Vec<LogRow>, u64), String> {
-    let mut climber = match lane.best_fitness {
-        Some(f) => HillClimber::resume(lane.best.clone(), f, lane.lane),
-        None => HillClimber::new(lane.best.clone(), lane.lane),
-    };
-    let mut rows = Vec::new();
+fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
+    let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {
-        let generation = lane.generation + 1;
-        let mut rng = Random::for_evaluation(config.seed, lane.lane, generation);
-        let candidate = climber.ask(&mut rng);
-        let mut params = HopParams::INITIAL;
-        params.0.copy_from_slice(&candidate);
-        let e: Evaluation = evaluate(params, settings).map_err(|e| e.to_string())?;
-        if climber.tell(&candidate, e.fitness) {
-            lane.best = candidate.clone();
-            lane.best_fitness = Some(e.fitness);
-            lane.best_time_up = e.time_up;
-            lane.best_distance = e.distance;
-            rows.push(LogRow {
-                lane: lane.lane,
-                generation,
-                fitness: e.fitness,
-                time_up: e.time_up,
-                distance: e.distance,
-                params: candidate,
+        let population = lane.optimiser.ask();
+        let outcomes: Vec<Outcome> = population
+            .par_iter()
+            .map(|g| problem.evaluate(g))
+            .collect::<Result<_, _>>()?;
+        let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
+        lane.optimiser.tell(&fitness)?;
+        lane.generation += 1;
+        lane.evaluations += population.len() as u64;
+        // The generation's best (the first of equals).
+        let mut top = 0;
+        for (i, f) in fitness.iter().enumerate() {
+            if crate::optimiser::sane(*f) > crate::optimiser::sane(fitness[top]) {
+                top = i;
+            }
+        }
+        let o = &outcomes[top];
+        let f = crate::optimiser::sane(o.fitness);
+        let improved = lane.best.as_ref().map_or(true, |b| f > b.fitness);
+        if improved {
+            lane.best = Some(Best {
+                genome: population[top].clone(),
+                fitness: f,
+                time: o.time,
+                distance: o.distance,
+                ended: o.ended.clone(),
             });
         }
-        lane.generation = generation;
+        rows.push(LogRow {
+            lane: lane.lane,
+            generation: lane.generation,
+            evaluations: lane.evaluations,
+            fitness: o.fitness,
+            best_fitness: lane.best.as_ref().map_or(o.fitness, |b| b.fitness),
+            time: o.time,
+            distance: o.distance,
+            ended: o.ended.clone(),
+            improved: improved.then(|| population[top].clone()),
+        });
     }
-    Ok((rows, n))
+    Ok(rows)
 }

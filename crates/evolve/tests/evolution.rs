@@ -32,17 +32,17 @@ fn mutation_follows_appendix_b() {
     for lane in [0usize, 3] {
         let bound = 0.25 * (lane as f64 + 1.0);
         let start = vec![1.0; 14];
-        let mut c = HillClimber::new(start.clone(), lane);
-        let mut rng = Random::for_evaluation(9, lane, 0);
+        let mut c = HillClimber::new(start.clone(), lane, 9);
         assert_eq!(
-            c.ask(&mut rng),
-            start,
+            c.ask(),
+            vec![start.clone()],
             "the first candidate is the start itself"
         );
-        c.tell(&start, 1.0);
+        c.tell(&[1.0]).unwrap();
+        let mut rng = Random::for_evaluation(9, lane, 0);
         let (mut singles, mut within, mut largest) = (0, 0, 0.0f64);
         for _ in 0..n {
-            let child = c.ask(&mut rng);
+            let child = c.mutate(&start, &mut rng);
             let changed = child.iter().filter(|x| **x != 1.0).count();
             assert!((1..=4).contains(&changed));
             if lane == 0 {
@@ -173,8 +173,16 @@ fn corrupt_checkpoints_are_refused() {
 fn stable_hopping_evolves_within_100_generations_in_most_lanes() {
     for seed in 1..=3 {
         let s = run(Config::thesis(6, 100, seed), 2, 25);
-        let stable = s.lanes.iter().filter(|l| l.best_time_up >= 20.0).count();
-        let best: Vec<f64> = s.lanes.iter().map(|l| l.best_fitness.unwrap()).collect();
+        let stable = s
+            .lanes
+            .iter()
+            .filter(|l| l.best.as_ref().unwrap().time >= 20.0)
+            .count();
+        let best: Vec<f64> = s
+            .lanes
+            .iter()
+            .map(|l| l.best.as_ref().unwrap().fitness)
+            .collect();
         println!("seed {seed}: {stable}/6 lanes stable, best {best:.1?}");
         assert!(
             stable >= 4,
@@ -185,7 +193,7 @@ fn stable_hopping_evolves_within_100_generations_in_most_lanes() {
             .log
             .iter()
             .filter(|r| r.generation == 1)
-            .all(|r| r.time_up < 20.0));
+            .all(|r| r.time < 20.0));
     }
 }
 
@@ -196,12 +204,20 @@ fn fitness_keeps_rising_after_stable_hopping_is_found() {
     while !s.done() {
         p.install(|| s.advance(25)).unwrap();
     }
-    let at_100: Vec<f64> = s.lanes.iter().map(|l| l.best_fitness.unwrap()).collect();
+    let at_100: Vec<f64> = s
+        .lanes
+        .iter()
+        .map(|l| l.best.as_ref().unwrap().fitness)
+        .collect();
     s.config.generations = 300;
     while !s.done() {
         p.install(|| s.advance(25)).unwrap();
     }
-    let at_300: Vec<f64> = s.lanes.iter().map(|l| l.best_fitness.unwrap()).collect();
+    let at_300: Vec<f64> = s
+        .lanes
+        .iter()
+        .map(|l| l.best.as_ref().unwrap().fitness)
+        .collect();
     let higher = at_100.iter().zip(&at_300).filter(|(a, b)| b > a).count();
     assert!(
         higher >= 5,

@@ -51,14 +51,14 @@ fn room(at: &At, field: &str, count: usize, world: &World) -> Result<(), SceneEr
 }
 
 /// Where an entry came from, for error messages.
-struct At<'s> {
+pub(crate) struct At<'s> {
     src: &'s Source<'s>,
     entry: String,
     line: usize,
 }
 
 impl At<'_> {
-    fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
+    pub(crate) fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
         SceneError {
             file: self.src.file.to_string(),
             line: Some(self.line),
@@ -68,11 +68,11 @@ impl At<'_> {
         }
     }
 
-    fn model(&self, e: ModelError) -> SceneError {
+    pub(crate) fn model(&self, e: ModelError) -> SceneError {
         self.err(&e.field, e.reason)
     }
 
-    fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+    pub(crate) fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         if x.is_finite() {
             Ok(x)
         } else {
@@ -80,7 +80,7 @@ impl At<'_> {
         }
     }
 
-    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+    pub(crate) fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         self.finite(field, x)?;
         if x > 0.0 {
             Ok(x)
@@ -89,7 +89,7 @@ impl At<'_> {
         }
     }
 
-    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<DVec3, SceneError> {
+    pub(crate) fn vec3(&self, field: &str, v: [f64; 3]) -> Result<DVec3, SceneError> {
         if v.iter().all(|x| x.is_finite()) {
             Ok(DVec3::from_array(v))
         } else {
@@ -98,7 +98,11 @@ impl At<'_> {
     }
 }
 
-fn at<'s, T>(src: &'s Source<'s>, entry: impl Into<String>, spanned: &Spanned<T>) -> At<'s> {
+pub(crate) fn at<'s, T>(
+    src: &'s Source<'s>,
+    entry: impl Into<String>,
+    spanned: &Spanned<T>,
+) -> At<'s> {
     At {
         src,
         entry: entry.into(),
@@ -107,12 +111,12 @@ fn at<'s, T>(src: &'s Source<'s>, entry: impl Into<String>, spanned: &Spanned<T>
 }
 
 /// Resolves particle names to handles.
-struct Names {
-    ids: HashMap<String, ParticleId>,
+pub(crate) struct Names {
+    pub(crate) ids: HashMap<String, ParticleId>,
 }
 
 impl Names {
-    fn one(&self, at: &At, field: &str, name: &str) -> Result<ParticleId, SceneError> {
+    pub(crate) fn one(&self, at: &At, field: &str, name: &str) -> Result<ParticleId, SceneError> {
         self.ids
             .get(name)
             .copied()
@@ -132,7 +136,7 @@ impl Names {
 }
 
 /// A particle name: non-empty, and safe to write unquoted in CSV and JSON.
-fn check_name(at: &At, name: &str) -> Result<(), SceneError> {
+pub(crate) fn check_name(at: &At, name: &str) -> Result<(), SceneError> {
     let ok = !name.is_empty()
         && name
             .chars()
@@ -272,6 +276,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         world.add_fluid(fluid).map_err(|e| at.model(e))?;
     }
 
+    let mut handles = crate::nervous::Handles::default();
+
     // [[spring]]
     for (k, entry) in def.spring.iter().enumerate() {
         let s = entry.get_ref();
@@ -283,7 +289,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             damping: s.damping,
             rest_length: s.rest_length,
         };
-        world.add_spring(sdef).map_err(|e| at.model(e))?;
+        let id = world.add_spring(sdef).map_err(|e| at.model(e))?;
+        crate::nervous::insert(&mut handles.springs, &at, "spring", &s.name, id)?;
     }
 
     // [[angle_joint]]
@@ -298,7 +305,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             damping: j.damping,
             rest_angle: j.rest_angle,
         };
-        world.add_angle_joint(jdef).map_err(|e| at.model(e))?;
+        let id = world.add_angle_joint(jdef).map_err(|e| at.model(e))?;
+        crate::nervous::insert(&mut handles.angle_joints, &at, "angle joint", &j.name, id)?;
     }
 
     // [[torque_joint]]
@@ -311,7 +319,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             axis: DVec3::from_array(j.axis),
             torque: j.torque,
         };
-        world.add_torque_joint(jdef).map_err(|e| at.model(e))?;
+        let id = world.add_torque_joint(jdef).map_err(|e| at.model(e))?;
+        crate::nervous::insert(&mut handles.torque_joints, &at, "torque joint", &j.name, id)?;
     }
 
     // [[constant_force]]
@@ -323,9 +332,16 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             Targets::Only(ids) => ids,
         };
         let force = at.vec3("force", c.force)?;
-        world
+        let id = world
             .add_constant_force(ids, force)
             .map_err(|e| at.model(e))?;
+        crate::nervous::insert(
+            &mut handles.constant_forces,
+            &at,
+            "constant force",
+            &c.name,
+            (id, force),
+        )?;
     }
 
     // [[nbody]]
@@ -554,11 +570,24 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         actors.push(Box::new(quad));
     }
 
+    let nervous = crate::nervous::build(def, src, &names, &handles, &mut world)?;
+    let evolve = match &def.evolve {
+        Some(entry) => Some(crate::evaluate::EvolveSpec::build(
+            &at(src, "evolve", entry),
+            entry.get_ref(),
+            &names,
+            &nervous,
+            &world,
+        )?),
+        None => None,
+    };
+
     let max_dt = match wd.max_dt {
         Some(m) => wat.positive("max_dt", m)?,
         None => dt,
     };
-    let guard = animats_engine::DivergenceGuard::new(&world, !actors.is_empty());
+    let guard =
+        animats_engine::DivergenceGuard::new(&world, !actors.is_empty() || !nervous.is_empty());
     let warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
     Ok(Scene {
         world,
@@ -570,6 +599,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         max_dt,
         duration,
         actors,
+        nervous,
+        evolve,
     })
 }
 

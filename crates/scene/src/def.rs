@@ -59,6 +59,18 @@ pub struct SceneDef {
     /// `[[quadruped]]` entries: the thesis's three failed quadrupeds.
     #[serde(default)]
     pub quadruped: Vec<Spanned<QuadrupedEntry>>,
+    /// `[[actuator]]` entries: levels in [0, 1] onto a named spring, joint or force.
+    #[serde(default)]
+    pub actuator: Vec<Spanned<ActuatorEntry>>,
+    /// `[[sensor]]` entries: readings mapped onto [0, 1].
+    #[serde(default)]
+    pub sensor: Vec<Spanned<SensorEntry>>,
+    /// `[[controller]]` entries: brains from sensors to actuators.
+    #[serde(default)]
+    pub controller: Vec<Spanned<ControllerEntry>>,
+    /// `[evolve]`: the controller evolution tunes and how a run is scored.
+    #[serde(default)]
+    pub evolve: Option<Spanned<EvolveEntry>>,
 }
 
 /// Integration method names as written in files.
@@ -263,6 +275,8 @@ pub enum CurrentEntry {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
     /// One end (a particle name).
     pub a: String,
     /// The other end.
@@ -280,6 +294,8 @@ pub struct SpringEntry {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AngleJointEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
     /// End of the first arm.
     pub a: String,
     /// Where the arms meet.
@@ -299,6 +315,8 @@ pub struct AngleJointEntry {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TorqueJointEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
     /// The mass turned.
     pub end: String,
     /// The mass it turns about.
@@ -319,6 +337,8 @@ fn default_axis() -> [f64; 3] {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ConstantForceEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
     /// Default: all particles.
     pub particles: Option<Vec<String>>,
     /// N, on each.
@@ -503,4 +523,162 @@ pub struct QuadrupedEntry {
 
 fn default_demo() -> f64 {
     2.0
+}
+
+/// `[[actuator]]`: a level in [0, 1] mapped linearly onto [min, max] of one
+/// target's parameter (thesis §2.3.2.3).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ActuatorEntry {
+    /// Unique among actuators.
+    pub name: String,
+    /// A named spring: its rest length, m.
+    pub spring: Option<String>,
+    /// A named angle joint: its rest angle, rad.
+    pub angle_joint: Option<String>,
+    /// A named torque joint: its torque, N m.
+    pub torque_joint: Option<String>,
+    /// A named constant force: a scale on its force vector.
+    pub constant_force: Option<String>,
+    /// The value at level 0.
+    pub min: f64,
+    /// The value at level 1.
+    pub max: f64,
+    /// The initial level, default 0.5.
+    #[serde(default = "default_level")]
+    pub level: f64,
+}
+
+fn default_level() -> f64 {
+    0.5
+}
+
+/// `[[sensor]]`: a reading mapped linearly from [min, max] onto [0, 1].
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SensorEntry {
+    /// Unique among sensors.
+    pub name: String,
+    /// `height`, `speed`, `touch`, `length`, `angle` or `tilt`.
+    pub kind: String,
+    /// The particle of `height`, `speed` and `touch`.
+    pub particle: Option<String>,
+    /// `speed`: the direction, default `[1, 0, 0]`.
+    pub axis: Option<[f64; 3]>,
+    /// `length`, `angle`, `tilt`: the first particle.
+    pub a: Option<String>,
+    /// `length`, `angle`, `tilt`: the second particle.
+    pub b: Option<String>,
+    /// `angle`: the vertex.
+    pub joint: Option<String>,
+    /// The reading at level 0; default 0.
+    pub min: Option<f64>,
+    /// The reading at level 1; default 1 (π for `angle` and `tilt`).
+    pub max: Option<f64>,
+}
+
+/// `[[controller]]`: a brain. Which keys apply depends on `kind`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControllerEntry {
+    /// Unique among controllers.
+    pub name: String,
+    /// `oscillator`, `neural` or `fsm`.
+    pub kind: String,
+    /// Sensors read, by name (`neural`, `fsm`).
+    #[serde(default)]
+    pub inputs: Vec<String>,
+    /// Actuators driven, by name.
+    pub outputs: Vec<String>,
+    /// `oscillator`: Hz.
+    pub frequency: Option<f64>,
+    /// `oscillator`: one per output.
+    pub amplitude: Option<Vec<f64>>,
+    /// `oscillator`: rad, one per output.
+    pub phase: Option<Vec<f64>>,
+    /// `oscillator`: one per output.
+    pub offset: Option<Vec<f64>>,
+    /// `neural`: hidden layer sizes, default none.
+    pub hidden: Option<Vec<usize>>,
+    /// `neural`: frequency of the clock inputs, Hz.
+    pub clock: Option<f64>,
+    /// `neural`: every weight and bias, layer by layer.
+    pub weights: Option<Vec<f64>>,
+    /// `neural`: seed of the default random weights, default 1.
+    pub seed: Option<u64>,
+    /// `fsm`: the state it starts in; default the first.
+    pub initial: Option<String>,
+    /// `fsm`: its states.
+    pub state: Option<Vec<StateEntry>>,
+}
+
+/// `[[controller.state]]` of an FSM.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StateEntry {
+    /// Unique within the controller.
+    pub name: String,
+    /// The level of each output in this state.
+    pub levels: Vec<f64>,
+    /// Level units per second the outputs move towards `levels`; default: at once.
+    pub rate: Option<f64>,
+    /// Ways out, checked in order.
+    #[serde(default)]
+    pub transition: Vec<TransitionEntry>,
+}
+
+/// `[[controller.state.transition]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransitionEntry {
+    /// The state it leads to.
+    pub to: String,
+    /// An input sensor whose level is compared.
+    pub sensor: Option<String>,
+    /// Fires when the sensor's level is above this.
+    pub above: Option<f64>,
+    /// Fires when the sensor's level is below this.
+    pub below: Option<f64>,
+    /// Fires only after this long in the state, s.
+    pub after: Option<f64>,
+}
+
+/// `[evolve]`: what `animats evolve SCENE` tunes and how an evaluation
+/// (`animats evaluate SCENE`) is scored:
+/// `fitness = time_weight × time survived + distance_weight × distance`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvolveEntry {
+    /// The controller whose parameters form the genome.
+    pub controller: String,
+    /// Seconds per evaluation; default 20.
+    #[serde(default = "default_eval_duration")]
+    pub duration: f64,
+    /// Whose centre of mass travels; default all particles.
+    pub particles: Option<Vec<String>>,
+    /// The direction that counts; default `[1, 0, 0]`.
+    #[serde(default = "default_x")]
+    pub axis: [f64; 3],
+    /// Default 50.
+    #[serde(default = "default_distance_weight")]
+    pub distance_weight: f64,
+    /// Default 1.
+    #[serde(default = "default_time_weight")]
+    pub time_weight: f64,
+    /// The evaluation ends when any of these touches the floor; default none.
+    #[serde(default)]
+    pub fail_on_touch: Vec<String>,
+}
+
+fn default_eval_duration() -> f64 {
+    20.0
+}
+fn default_x() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+fn default_distance_weight() -> f64 {
+    50.0
+}
+fn default_time_weight() -> f64 {
+    1.0
 }

@@ -26,6 +26,8 @@
 pub mod build;
 pub mod def;
 pub mod error;
+pub mod evaluate;
+pub(crate) mod nervous;
 pub mod params;
 pub mod source;
 
@@ -54,6 +56,11 @@ pub struct Scene {
     /// Everything that acts once per step: creatures with their controllers,
     /// and environment processes (bubble columns).
     pub actors: Vec<Box<dyn animats_creatures::Actor>>,
+    /// The sensors, actuators and controllers the scene declares; they act
+    /// before the other actors every step.
+    pub nervous: animats_creatures::NervousSystem,
+    /// The scene's `[evolve]` table, resolved.
+    pub evolve: Option<evaluate::EvolveSpec>,
     /// Watches for a run that diverges without going non-finite.
     pub guard: DivergenceGuard,
     /// Things that are allowed but probably not meant (a particle that
@@ -83,6 +90,7 @@ impl Scene {
     /// A blow-up is an error: a non-finite state, or (checked every few
     /// steps) a run-away that [`DivergenceGuard`] catches.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        self.nervous.act(&mut self.world, dt);
         for a in &mut self.actors {
             a.act(&mut self.world, dt);
         }
@@ -101,6 +109,13 @@ pub const MAX_FILE_BYTES: u64 = 64 << 20;
 /// Reads and builds the scene file at `path`.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let file = path.display().to_string();
+    let text = read(path)?;
+    parse(&text, &file)
+}
+
+/// Reads a scene file's text, refusing one past [`MAX_FILE_BYTES`].
+pub fn read(path: &Path) -> Result<String, SceneError> {
+    let file = path.display().to_string();
     let size = std::fs::metadata(path)
         .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))?
         .len();
@@ -110,9 +125,8 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
             format!("the scene file is {size} bytes, more than the limit of {MAX_FILE_BYTES}"),
         ));
     }
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))?;
-    parse(&text, &file)
+    std::fs::read_to_string(path)
+        .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))
 }
 
 /// Parses and builds a scene from its text; `file` names it in errors.

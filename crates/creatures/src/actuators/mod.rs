@@ -1,9 +1,52 @@
-//! The physical parameters an actuator can drive, one per file.
+//! The physical parameters an actuator can drive, one per file, and
+//! [`AnyActuator`], the actuators a scene file declares.
 
 pub mod force_magnitude;
+pub mod force_scale;
+pub mod joint_rest_angle;
 pub mod joint_torque;
 pub mod spring_rest_length;
 
 pub use force_magnitude::ForceMagnitude;
+pub use force_scale::ForceScale;
+pub use joint_rest_angle::JointRestAngle;
 pub use joint_torque::JointTorque;
 pub use spring_rest_length::SpringRestLength;
+
+use crate::actuator::Actuator;
+use animats_engine::World;
+
+/// An actuator over any of the parameters a scene's `[[actuator]]` can name.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AnyActuator {
+    /// `spring = "..."`: its rest length, m.
+    Spring(Actuator<SpringRestLength>),
+    /// `angle_joint = "..."`: its rest angle, rad.
+    AngleJoint(Actuator<JointRestAngle>),
+    /// `torque_joint = "..."`: its torque, N m.
+    TorqueJoint(Actuator<JointTorque>),
+    /// `constant_force = "..."`: a scale on its vector.
+    ConstantForce(Actuator<ForceScale>),
+}
+
+impl AnyActuator {
+    /// Sets the level (clamped to [0, 1]) and drives the parameter.
+    pub fn set_level(&mut self, world: &mut World, level: f64) {
+        match self {
+            AnyActuator::Spring(a) => a.set_level(world, level),
+            AnyActuator::AngleJoint(a) => a.set_level(world, level),
+            AnyActuator::TorqueJoint(a) => a.set_level(world, level),
+            AnyActuator::ConstantForce(a) => a.set_level(world, level),
+        }
+    }
+
+    /// The current level.
+    pub fn level(&self) -> f64 {
+        match self {
+            AnyActuator::Spring(a) => a.level(),
+            AnyActuator::AngleJoint(a) => a.level(),
+            AnyActuator::TorqueJoint(a) => a.level(),
+            AnyActuator::ConstantForce(a) => a.level(),
+        }
+    }
+}

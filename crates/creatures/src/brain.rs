@@ -1,0 +1,67 @@
+//! The brain of a creature (thesis §2.3.2.4): sensor levels in, actuator
+//! levels out, once per step. Every controller kind implements [`Brain`]:
+//! the scene file's oscillator, neural network and FSM (`brains/`), and the
+//! thesis's own roobot and jellyfish FSMs.
+//!
+//! A brain that can be evolved exposes its parameters as a *genome*: a flat
+//! vector of numbers with bounds, in an order its file documents.
+
+/// Sensor levels in, actuator levels out.
+pub trait Brain: Send {
+    /// The kind's name (`oscillator`, `neural`, `fsm`...).
+    fn kind(&self) -> &'static str;
+
+    /// Decides the step starting at time `t` (s) of length `dt`: reads
+    /// `inputs` (levels in [0, 1], in the order the brain was wired) and
+    /// writes `outputs` (levels; the caller clamps them to [0, 1]).
+    fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]);
+
+    /// The current state's name, for brains that have states.
+    fn state(&self) -> Option<&str> {
+        None
+    }
+
+    /// The evolvable parameters (empty if none).
+    fn genome(&self) -> Vec<f64> {
+        Vec::new()
+    }
+
+    /// Sets the evolvable parameters; the error says what is wrong.
+    fn set_genome(&mut self, genome: &[f64]) -> Result<(), String> {
+        if genome.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "a {} brain has no evolvable parameters",
+                self.kind()
+            ))
+        }
+    }
+
+    /// Bounds of each gene, `(lo, hi)`, always containing the current value.
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        Vec::new()
+    }
+
+    /// Returns to the state it started in (time, FSM state).
+    fn reset(&mut self) {}
+}
+
+/// Checks a genome's length against the brain's.
+pub fn check_genome(kind: &str, expected: usize, genome: &[f64]) -> Result<(), String> {
+    if genome.len() != expected {
+        return Err(format!(
+            "a genome for this {kind} controller has {expected} numbers, got {}",
+            genome.len()
+        ));
+    }
+    if let Some(i) = genome.iter().position(|x| !x.is_finite()) {
+        return Err(format!("gene {i} is not finite: {}", genome[i]));
+    }
+    Ok(())
+}
+
+/// `(lo, hi)` widened to contain `x`.
+pub fn around(x: f64, lo: f64, hi: f64) -> (f64, f64) {
+    (lo.min(x), hi.max(x))
+}

@@ -1,0 +1,122 @@
+//! A feed-forward neural network: tanh hidden layers, logistic outputs in
+//! [0, 1].
+//!
+//! Inputs are the sensor levels mapped from [0, 1] onto [−1, 1] (`2x − 1`,
+//! so that a level of 0.5 is no signal), then, with a clock of frequency
+//! `f`, `sin 2πft` and `cos 2πft`. Each layer computes
+//! `y_j = act(b_j + Σ_i w_ji x_i)`.
+//!
+//! Genome (the scene's `weights`): layer by layer from the inputs, for each
+//! layer its weights row by row (`w_j0, w_j1, ...` for neuron j), then its
+//! biases. Bounds: [−10, 10] each, widened to contain the value given.
+
+use crate::brain::{around, check_genome, Brain};
+use crate::random::Random;
+use std::f64::consts::TAU;
+
+/// A multilayer perceptron.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Neural {
+    /// Layer sizes, inputs (clock included) first, outputs last.
+    pub sizes: Vec<usize>,
+    /// Clock frequency, Hz, if the clock is on.
+    pub clock: Option<f64>,
+    /// Every weight and bias (see the module for the order).
+    pub weights: Vec<f64>,
+    scratch: (Vec<f64>, Vec<f64>),
+}
+
+impl Neural {
+    /// A network with `inputs` sensor inputs, `hidden` layers and `outputs`
+    /// outputs; the weights are zero (see [`Neural::randomise`]).
+    pub fn new(inputs: usize, hidden: &[usize], outputs: usize, clock: Option<f64>) -> Neural {
+        let mut sizes = vec![inputs + if clock.is_some() { 2 } else { 0 }];
+        sizes.extend(hidden);
+        sizes.push(outputs);
+        let n = Neural::weight_count(&sizes);
+        Neural {
+            sizes,
+            clock,
+            weights: vec![0.0; n],
+            scratch: (Vec::new(), Vec::new()),
+        }
+    }
+
+    /// Weights and biases of a network with these layer sizes.
+    pub fn weight_count(sizes: &[usize]) -> usize {
+        sizes.windows(2).map(|w| w[1] * (w[0] + 1)).sum()
+    }
+
+    /// Small random weights from `seed`: uniform in ±1/√(fan-in), biases 0.
+    pub fn randomise(&mut self, seed: u64) {
+        let mut rng = Random::for_entry(seed, 0x6e65_7572);
+        let mut k = 0;
+        for w in self.sizes.windows(2) {
+            let scale = 1.0 / (w[0].max(1) as f64).sqrt();
+            for _ in 0..w[1] * w[0] {
+                self.weights[k] = scale * (2.0 * rng.uniform() - 1.0);
+                k += 1;
+            }
+            for _ in 0..w[1] {
+                self.weights[k] = 0.0;
+                k += 1;
+            }
+        }
+    }
+}
+
+impl Brain for Neural {
+    fn kind(&self) -> &'static str {
+        "neural"
+    }
+
+    fn think(&mut self, t: f64, _dt: f64, inputs: &[f64], outputs: &mut [f64]) {
+        let (x, y) = &mut self.scratch;
+        x.clear();
+        x.extend(inputs.iter().map(|v| 2.0 * v - 1.0));
+        if let Some(f) = self.clock {
+            let w = TAU * f * t;
+            x.push(libm::sin(w));
+            x.push(libm::cos(w));
+        }
+        let layers = self.sizes.len() - 1;
+        let mut k = 0;
+        for (l, s) in self.sizes.windows(2).enumerate() {
+            let (n_in, n_out) = (s[0], s[1]);
+            let biases = k + n_out * n_in;
+            y.clear();
+            for j in 0..n_out {
+                let row = &self.weights[k + j * n_in..k + (j + 1) * n_in];
+                let mut a = self.weights[biases + j];
+                for (w, xi) in row.iter().zip(x.iter()) {
+                    a += w * xi;
+                }
+                y.push(if l + 1 == layers {
+                    1.0 / (1.0 + libm::exp(-a))
+                } else {
+                    libm::tanh(a)
+                });
+            }
+            k = biases + n_out;
+            std::mem::swap(x, y);
+        }
+        outputs.copy_from_slice(&x[..outputs.len()]);
+    }
+
+    fn genome(&self) -> Vec<f64> {
+        self.weights.clone()
+    }
+
+    fn set_genome(&mut self, g: &[f64]) -> Result<(), String> {
+        check_genome("neural", self.weights.len(), g)?;
+        self.weights.copy_from_slice(g);
+        Ok(())
+    }
+
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.weights
+            .iter()
+            .map(|&w| around(w, -10.0, 10.0))
+            .collect()
+    }
+}

@@ -1,0 +1,70 @@
+//! A central pattern generator: one sine per output at a shared frequency,
+//! `level_i = offset_i + amplitude_i sin(2π f t + phase_i)`, clamped to
+//! [0, 1] by the caller. Blind: it reads no sensors.
+//!
+//! Genome: `[f, amplitude_0..n, phase_0..n, offset_0..n]`. Bounds:
+//! f in [0, 5] Hz, amplitudes and offsets in [0, 1], phases in [−π, π],
+//! each widened to contain the value the scene gives.
+
+use crate::brain::{around, check_genome, Brain};
+use std::f64::consts::{PI, TAU};
+
+/// Sines at one frequency.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Oscillator {
+    /// Hz.
+    pub frequency: f64,
+    /// Per output.
+    pub amplitude: Vec<f64>,
+    /// Per output, rad.
+    pub phase: Vec<f64>,
+    /// Per output.
+    pub offset: Vec<f64>,
+}
+
+impl Oscillator {
+    /// Outputs driven.
+    pub fn outputs(&self) -> usize {
+        self.amplitude.len()
+    }
+}
+
+impl Brain for Oscillator {
+    fn kind(&self) -> &'static str {
+        "oscillator"
+    }
+
+    fn think(&mut self, t: f64, _dt: f64, _inputs: &[f64], outputs: &mut [f64]) {
+        let w = TAU * self.frequency * t;
+        for (i, out) in outputs.iter_mut().enumerate() {
+            // libm: the same bits on every platform (reproducible evolution).
+            *out = self.offset[i] + self.amplitude[i] * libm::sin(w + self.phase[i]);
+        }
+    }
+
+    fn genome(&self) -> Vec<f64> {
+        let mut g = vec![self.frequency];
+        g.extend(&self.amplitude);
+        g.extend(&self.phase);
+        g.extend(&self.offset);
+        g
+    }
+
+    fn set_genome(&mut self, g: &[f64]) -> Result<(), String> {
+        let n = self.outputs();
+        check_genome("oscillator", 1 + 3 * n, g)?;
+        self.frequency = g[0];
+        self.amplitude.copy_from_slice(&g[1..1 + n]);
+        self.phase.copy_from_slice(&g[1 + n..1 + 2 * n]);
+        self.offset.copy_from_slice(&g[1 + 2 * n..]);
+        Ok(())
+    }
+
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        let mut b = vec![around(self.frequency, 0.0, 5.0)];
+        b.extend(self.amplitude.iter().map(|&a| around(a, 0.0, 1.0)));
+        b.extend(self.phase.iter().map(|&p| around(p, -PI, PI)));
+        b.extend(self.offset.iter().map(|&o| around(o, 0.0, 1.0)));
+        b
+    }
+}

@@ -1,0 +1,350 @@
+//! CMA-ES (Hansen's (μ/μ_w, λ) evolution strategy with cumulative step-size
+//! adaptation, rank-one and rank-μ updates), written from Hansen's tutorial
+//! "The CMA Evolution Strategy: A Tutorial" (2016), as `purecma` does it:
+//! default λ = 4 + ⌊3 ln n⌋, μ = ⌊λ/2⌋, log-linear positive weights, and the
+//! eigendecomposition of C refreshed every `λ / (c1 + cμ) / n / 10`
+//! evaluations (cyclic Jacobi: small, exact and deterministic).
+//!
+//! It minimises internally; [`Optimiser`] maximises, so fitness is negated.
+//!
+//! **Bounds**, when given, are handled in the unit box: the strategy works
+//! on `y` with `genome = lo + (hi − lo) y`, starts at the start genome with
+//! step size σ₀ (default 0.3) in those units, evaluates the candidate
+//! repaired into the box, and ranks it by its value plus a penalty
+//! `γ ‖y − repair(y)‖²`, with γ the inter-quartile range of the
+//! generation's values (at least 1e-9 × max(1, |median|)), so that a
+//! candidate outside the box ranks below an equal one inside.
+
+use crate::optimiser::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use serde::{Deserialize, Serialize};
+
+/// CMA-ES's whole state (what a checkpoint stores).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CmaEs {
+    seed: u64,
+    lane: usize,
+    n: usize,
+    lambda: usize,
+    weights: Vec<f64>,
+    mueff: f64,
+    cc: f64,
+    cs: f64,
+    c1: f64,
+    cmu: f64,
+    damps: f64,
+    chi_n: f64,
+    bounds: Option<Bounds>,
+    /// Mean, in the strategy's coordinates.
+    mean: Vec<f64>,
+    /// Step size.
+    pub sigma: f64,
+    /// Covariance, row-major n × n.
+    c: Vec<f64>,
+    /// Eigenvectors of C (columns), row-major.
+    b: Vec<f64>,
+    /// Square roots of C's eigenvalues.
+    d: Vec<f64>,
+    pc: Vec<f64>,
+    ps: Vec<f64>,
+    counteval: u64,
+    eigeneval: u64,
+    generation: u64,
+    pending: Vec<Vec<f64>>,
+    best: BestSoFar,
+}
+
+impl CmaEs {
+    /// A fresh strategy from a setup.
+    pub fn new(s: &Setup) -> CmaEs {
+        let n = s.start.len();
+        let nf = n as f64;
+        let lambda = s
+            .population
+            .unwrap_or_else(|| crate::optimiser::cma_default_lambda(n))
+            .max(2);
+        let mu = lambda / 2;
+        let raw: Vec<f64> = (0..mu)
+            .map(|i| libm::log((lambda as f64 + 1.0) / 2.0) - libm::log(i as f64 + 1.0))
+            .collect();
+        let sum: f64 = raw.iter().sum();
+        let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
+        let mueff = 1.0 / weights.iter().map(|w| w * w).sum::<f64>();
+        let cc = (4.0 + mueff / nf) / (nf + 4.0 + 2.0 * mueff / nf);
+        let cs = (mueff + 2.0) / (nf + mueff + 5.0);
+        let c1 = 2.0 / ((nf + 1.3).powi(2) + mueff);
+        let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0).powi(2) + mueff));
+        let damps = 1.0 + 2.0 * (((mueff - 1.0) / (nf + 1.0)).sqrt() - 1.0).max(0.0) + cs;
+        let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
+        let mean = match &s.bounds {
+            Some(bd) => s
+                .start
+                .iter()
+                .enumerate()
+                .map(|(i, x)| (x - bd.lo[i]) / bd.width(i))
+                .collect(),
+            None => s.start.clone(),
+        };
+        let mut eye = vec![0.0; n * n];
+        for i in 0..n {
+            eye[i * n + i] = 1.0;
+        }
+        CmaEs {
+            seed: s.seed,
+            lane: s.lane,
+            n,
+            lambda,
+            weights,
+            mueff,
+            cc,
+            cs,
+            c1,
+            cmu,
+            damps,
+            chi_n,
+            bounds: s.bounds.clone(),
+            mean,
+            sigma: s.sigma.unwrap_or(0.3),
+            c: eye.clone(),
+            b: eye,
+            d: vec![1.0; n],
+            pc: vec![0.0; n],
+            ps: vec![0.0; n],
+            counteval: 0,
+            eigeneval: 0,
+            generation: 0,
+            pending: Vec::new(),
+            best: BestSoFar::default(),
+        }
+    }
+
+    /// Candidates per generation.
+    pub fn lambda(&self) -> usize {
+        self.lambda
+    }
+
+    /// The current mean, as a genome.
+    pub fn mean(&self) -> Vec<f64> {
+        self.to_genome(&self.mean)
+    }
+
+    fn to_genome(&self, y: &[f64]) -> Vec<f64> {
+        match &self.bounds {
+            Some(bd) => y
+                .iter()
+                .enumerate()
+                .map(|(i, v)| bd.lo[i] + bd.width(i) * v.clamp(0.0, 1.0))
+                .collect(),
+            None => y.to_vec(),
+        }
+    }
+
+    fn outside(&self, y: &[f64]) -> f64 {
+        match &self.bounds {
+            Some(_) => y.iter().map(|v| (v - v.clamp(0.0, 1.0)).powi(2)).sum(),
+            None => 0.0,
+        }
+    }
+
+    fn refresh_eigen(&mut self) {
+        let n = self.n;
+        // Keep C exactly symmetric before decomposing it.
+        for i in 0..n {
+            for j in 0..i {
+                let v = 0.5 * (self.c[i * n + j] + self.c[j * n + i]);
+                self.c[i * n + j] = v;
+                self.c[j * n + i] = v;
+            }
+        }
+        let (values, vectors) = jacobi_eigen(&self.c, n);
+        self.d = values.iter().map(|v| v.max(1e-300).sqrt()).collect();
+        self.b = vectors;
+    }
+}
+
+impl Optimiser for CmaEs {
+    fn ask(&mut self) -> Vec<Vec<f64>> {
+        let n = self.n;
+        let generation = self.generation + 1;
+        let mut rng = Random::for_evaluation(self.seed, self.lane, generation);
+        let mut out = Vec::with_capacity(self.lambda);
+        self.pending.clear();
+        for _ in 0..self.lambda {
+            let z: Vec<f64> = (0..n).map(|_| gaussian(&mut rng)).collect();
+            let y: Vec<f64> = (0..n)
+                .map(|i| {
+                    let mut s = 0.0;
+                    for (j, zj) in z.iter().enumerate() {
+                        s += self.b[i * n + j] * self.d[j] * zj;
+                    }
+                    self.mean[i] + self.sigma * s
+                })
+                .collect();
+            out.push(self.to_genome(&y));
+            self.pending.push(y);
+        }
+        out
+    }
+
+    fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
+        check_told(self.pending.len(), fitness.len())?;
+        let n = self.n;
+        let lambda = self.lambda;
+        for (y, f) in self.pending.iter().zip(fitness) {
+            let g = self.to_genome(y);
+            self.best.offer(&g, *f);
+        }
+        // Values to minimise: −fitness (−∞ fitness → +∞, ranked last),
+        // plus the bound penalty.
+        let mut values: Vec<f64> = fitness.iter().map(|f| -sane(*f)).collect();
+        if self.bounds.is_some() {
+            let mut finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
+            finite.sort_by(f64::total_cmp);
+            let q = |p: f64| {
+                if finite.is_empty() {
+                    0.0
+                } else {
+                    finite[((finite.len() - 1) as f64 * p).round() as usize]
+                }
+            };
+            let gamma = (q(0.75) - q(0.25)).max(1e-9 * q(0.5).abs().max(1.0));
+            for (v, y) in values.iter_mut().zip(&self.pending) {
+                *v += gamma * self.outside(y);
+            }
+        }
+        let mut order: Vec<usize> = (0..lambda).collect();
+        order.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
+        self.counteval += lambda as u64;
+
+        let old = self.mean.clone();
+        let mut mean = vec![0.0; n];
+        for (w, &k) in self.weights.iter().zip(&order) {
+            for (m, y) in mean.iter_mut().zip(&self.pending[k]) {
+                *m += w * y;
+            }
+        }
+        self.mean = mean;
+        let yw: Vec<f64> = (0..n)
+            .map(|i| (self.mean[i] - old[i]) / self.sigma)
+            .collect();
+
+        // C^{-1/2} y_w = B D^{-1} Bᵀ y_w
+        let mut bt = vec![0.0; n];
+        for (j, v) in bt.iter_mut().enumerate() {
+            let mut s = 0.0;
+            for (i, y) in yw.iter().enumerate() {
+                s += self.b[i * n + j] * y;
+            }
+            *v = s / self.d[j];
+        }
+        let ks = (self.cs * (2.0 - self.cs) * self.mueff).sqrt();
+        for i in 0..n {
+            let mut s = 0.0;
+            for (j, v) in bt.iter().enumerate() {
+                s += self.b[i * n + j] * v;
+            }
+            self.ps[i] = (1.0 - self.cs) * self.ps[i] + ks * s;
+        }
+        let ps2: f64 = self.ps.iter().map(|v| v * v).sum();
+        let gens = self.counteval as f64 / lambda as f64;
+        let hsig = ps2 / n as f64 / (1.0 - (1.0 - self.cs).powf(2.0 * gens))
+            < 2.0 + 4.0 / (n as f64 + 1.0);
+        let hsig = if hsig { 1.0 } else { 0.0 };
+        let kc = (self.cc * (2.0 - self.cc) * self.mueff).sqrt();
+        for (p, y) in self.pc.iter_mut().zip(&yw) {
+            *p = (1.0 - self.cc) * *p + hsig * kc * y;
+        }
+        let (c1, cmu) = (self.c1, self.cmu);
+        let c1a = c1 * (1.0 - (1.0 - hsig * hsig) * self.cc * (2.0 - self.cc));
+        let steps: Vec<Vec<f64>> = order[..self.weights.len()]
+            .iter()
+            .map(|&k| {
+                self.pending[k]
+                    .iter()
+                    .zip(&old)
+                    .map(|(y, m)| (y - m) / self.sigma)
+                    .collect()
+            })
+            .collect();
+        for i in 0..n {
+            for j in 0..=i {
+                let mut rank_mu = 0.0;
+                for (w, s) in self.weights.iter().zip(&steps) {
+                    rank_mu += w * s[i] * s[j];
+                }
+                let v = (1.0 - c1a - cmu) * self.c[i * n + j]
+                    + c1 * self.pc[i] * self.pc[j]
+                    + cmu * rank_mu;
+                self.c[i * n + j] = v;
+                self.c[j * n + i] = v;
+            }
+        }
+        self.sigma *= libm::exp((self.cs / self.damps) * (ps2.sqrt() / self.chi_n - 1.0));
+        if (self.counteval - self.eigeneval) as f64 > lambda as f64 / (c1 + cmu) / n as f64 / 10.0 {
+            self.eigeneval = self.counteval;
+            self.refresh_eigen();
+        }
+        self.pending.clear();
+        self.generation += 1;
+        Ok(())
+    }
+
+    fn best(&self) -> Option<(&[f64], f64)> {
+        self.best.get()
+    }
+
+    fn generation(&self) -> u64 {
+        self.generation
+    }
+}
+
+/// Eigenvalues and eigenvectors (as the columns of a row-major matrix) of a
+/// symmetric `n × n` matrix, by cyclic Jacobi rotations.
+pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut a = m.to_vec();
+    let mut v = vec![0.0; n * n];
+    for i in 0..n {
+        v[i * n + i] = 1.0;
+    }
+    for _sweep in 0..100 {
+        let off: f64 = (0..n)
+            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i * n + j] * a[i * n + j])
+            .sum();
+        let diag: f64 = (0..n).map(|i| a[i * n + i] * a[i * n + i]).sum();
+        if off <= 1e-30 * diag || off == 0.0 {
+            break;
+        }
+        for p in 0..n {
+            for q in p + 1..n {
+                let apq = a[p * n + q];
+                if apq == 0.0 {
+                    continue;
+                }
+                let theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..n {
+                    let akp = a[k * n + p];
+                    let akq = a[k * n + q];
+                    a[k * n + p] = c * akp - s * akq;
+                    a[k * n + q] = s * akp + c * akq;
+                }
+                for k in 0..n {
+                    let apk = a[p * n + k];
+                    let aqk = a[q * n + k];
+                    a[p * n + k] = c * apk - s * aqk;
+                    a[q * n + k] = s * apk + c * aqk;
+                }
+                for k in 0..n {
+                    let vkp = v[k * n + p];
+                    let vkq = v[k * n + q];
+                    v[k * n + p] = c * vkp - s * vkq;
+                    v[k * n + q] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    ((0..n).map(|i| a[i * n + i]).collect(), v)
+}
