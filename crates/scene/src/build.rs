@@ -559,6 +559,17 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         )
         .map_err(|e| at.model(e))?;
         quad.demo = (demo_at >= 0.0).then_some(Demo { at: demo_at });
+        // Its leg springs by name, for actuators: `NAME.legI` (corner or
+        // knee to foot) and, for model 3, `NAME.legI.back` / `NAME.legI.side`
+        // (foot to the front–back and left–right neighbouring corners).
+        for (i, leg) in quad.legs.iter().enumerate() {
+            let named = |suffix: &str| Some(format!("{name}.leg{i}{suffix}"));
+            crate::nervous::insert(&mut handles.springs, &at, "spring", &named(""), leg.spring)?;
+            if let Some((back, side)) = leg.supports {
+                crate::nervous::insert(&mut handles.springs, &at, "spring", &named(".back"), back)?;
+                crate::nervous::insert(&mut handles.springs, &at, "spring", &named(".side"), side)?;
+            }
+        }
         let mut parts: Vec<String> = (0..4).map(|i| format!("{name}.corner{i}")).collect();
         for i in 0..4 {
             if model == Model::TwoSegment {

@@ -272,12 +272,14 @@ fn sensor(at: &At, s: &SensorEntry, names: &Names) -> Result<ScaledSensor, Scene
             &["a", "b"],
             PI,
         ),
-        other => return Err(at.err(
-            "kind",
-            format!(
+        other => {
+            return Err(at.err(
+                "kind",
+                format!(
                 "unknown sensor kind `{other}`: use height, speed, touch, length, angle or tilt"
             ),
-        )),
+            ))
+        }
     };
     for (key, present) in given {
         if present && !allowed.contains(&key) {

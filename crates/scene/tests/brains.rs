@@ -1,0 +1,387 @@
+//! Brains in scene files: actuators drive what they name, sensors read what
+//! they name, controllers act every step, every mistake is refused naming
+//! its entry and field, and `[evolve]` evaluations score what they say.
+
+use animats_scene::evaluate::{evaluate, Ended, SceneProblem};
+use std::f64::consts::{PI, TAU};
+
+/// Three beads in empty space (no floor, no gravity); a and b are joined by
+/// a spring that an oscillator drives.
+const PAIR: &str = r#"
+[world]
+dt = 0.001
+integrator = "symplectic"
+gravity = [0.0, 0.0, 0.0]
+
+[[particle]]
+name = "a"
+mass = 1.0
+position = [0.0, 1.0, 0.0]
+radius = 0.05
+[[particle]]
+name = "b"
+mass = 1.0
+position = [0.3, 1.0, 0.0]
+radius = 0.05
+[[particle]]
+name = "c"
+mass = 1.0
+position = [0.3, 1.4, 0.0]
+radius = 0.05
+
+[[spring]]
+name = "muscle"
+a = "a"
+b = "b"
+stiffness = 100.0
+damping = 0.5
+
+[[actuator]]
+name = "m"
+spring = "muscle"
+min = 0.2
+max = 0.4
+
+[[sensor]]
+name = "gap"
+kind = "length"
+a = "a"
+b = "b"
+min = 0.0
+max = 0.6
+[[sensor]]
+name = "bend"
+kind = "angle"
+a = "a"
+joint = "b"
+b = "c"
+[[sensor]]
+name = "lean"
+kind = "tilt"
+a = "b"
+b = "c"
+[[sensor]]
+name = "high"
+kind = "height"
+particle = "c"
+min = 1.0
+max = 2.0
+
+[[controller]]
+name = "osc"
+kind = "oscillator"
+outputs = ["m"]
+frequency = 2.0
+amplitude = [0.3]
+phase = [0.5]
+offset = [0.4]
+"#;
+
+#[test]
+fn an_oscillator_drives_its_spring_and_sensors_read_their_geometry() {
+    let mut s = animats_scene::parse(PAIR, "pair.toml").unwrap();
+    assert_eq!(s.nervous.actuators.len(), 1);
+    // The actuator starts at level 0.5: the rest length is 0.3 at once.
+    let rest = s.world.forces().springs.iter().next().unwrap().rest_length;
+    assert!((rest - 0.3).abs() < 1e-15, "{rest}");
+    let levels = s.nervous.sensor_levels(&s.world);
+    // gap 0.3 of [0, 0.6]; a right angle at b; c straight above b; c at 1.4 of [1, 2].
+    let expect = [0.5, 0.5, 0.0, 0.4];
+    for (l, e) in levels.iter().zip(expect) {
+        assert!((l - e).abs() < 1e-12, "{levels:?}");
+    }
+    for _ in 0..500 {
+        let t = s.world.time();
+        s.step(s.dt).unwrap();
+        // What the oscillator set for the step that started at t.
+        let level = (0.4 + 0.3 * (TAU * 2.0 * t + 0.5).sin()).clamp(0.0, 1.0);
+        let rest = s.world.forces().springs.iter().next().unwrap().rest_length;
+        assert!((rest - (0.2 + 0.2 * level)).abs() < 1e-12, "t {t}");
+    }
+    // The muscle moved the beads: the gap sensor follows the distance.
+    let d = s
+        .world
+        .position(s.particle("a").unwrap())
+        .distance(s.world.position(s.particle("b").unwrap()));
+    let gap = s.nervous.sensor_levels(&s.world)[0];
+    assert!((gap - d / 0.6).abs() < 1e-12);
+    assert!((d - 0.3).abs() > 1e-3, "the spring moved");
+    // An angle sensor reads [0, π] by default: b's angle now, over π.
+    let pos = |n: &str| s.world.position(s.particle(n).unwrap());
+    let (u, v) = (pos("a") - pos("b"), pos("c") - pos("b"));
+    let angle = (u.dot(v) / (u.length() * v.length())).acos();
+    assert!((s.nervous.sensor_levels(&s.world)[1] - angle / PI).abs() < 1e-9);
+}
+
+#[test]
+fn a_touch_sensor_reads_one_on_the_floor_and_zero_above_it() {
+    let text = r#"
+[world]
+dt = 0.001
+[floor]
+[[particle]]
+name = "ball"
+mass = 1.0
+position = [0.0, 0.3, 0.0]
+radius = 0.05
+restitution = 0.0
+[[sensor]]
+name = "t"
+kind = "touch"
+particle = "ball"
+"#;
+    let mut s = animats_scene::parse(text, "t.toml").unwrap();
+    let mut first = None;
+    for k in 0..1000 {
+        let level = s.nervous.sensor_levels(&s.world)[0];
+        if level == 1.0 && first.is_none() {
+            first = Some(k as f64 * s.dt);
+        }
+        if first.is_none() {
+            assert_eq!(level, 0.0);
+        }
+        s.step(s.dt).unwrap();
+    }
+    // Free fall of 0.25 m under 9.8 m/s²: sqrt(2 × 0.25 / 9.8) = 0.2259 s,
+    // seen within a step and the 1 mm tolerance.
+    let t = first.expect("the ball lands");
+    assert!((t - (0.5f64 / 9.8).sqrt()).abs() < 0.003, "touched at {t}");
+    assert_eq!(
+        s.nervous.sensor_levels(&s.world)[0],
+        1.0,
+        "resting is touching"
+    );
+}
+
+fn refused(text: &str) -> String {
+    match animats_scene::parse(text, "bad.toml") {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn mistakes_are_refused_naming_the_entry_and_field() {
+    let cases: &[(&str, &str, &str)] = &[
+        (
+            "spring = \"muscle\"",
+            "spring = \"nerve\"",
+            "actuator[0].spring: no spring named `nerve`",
+        ),
+        (
+            "spring = \"muscle\"",
+            "spring = \"muscle\"\nangle_joint = \"x\"",
+            "actuator[0]: give exactly one target",
+        ),
+        (
+            "min = 0.2\nmax = 0.4",
+            "min = 0.0\nmax = 0.4",
+            "actuator[0].min: a spring's rest length must stay > 0",
+        ),
+        (
+            "kind = \"length\"",
+            "kind = \"smell\"",
+            "sensor[0].kind: unknown sensor kind `smell`",
+        ),
+        (
+            "kind = \"height\"\nparticle = \"c\"",
+            "kind = \"height\"\nparticle = \"c\"\naxis = [1.0, 0.0, 0.0]",
+            "sensor[3].axis: a `height` sensor has no `axis`",
+        ),
+        (
+            "min = 1.0\nmax = 2.0",
+            "min = 1.0\nmax = 1.0",
+            "sensor[3].max: must differ from min",
+        ),
+        (
+            "amplitude = [0.3]",
+            "amplitude = [0.3, 0.1]",
+            "controller[0].amplitude: needs one number per output (1), got 2",
+        ),
+        (
+            "outputs = [\"m\"]",
+            "outputs = [\"n\"]",
+            "controller[0].outputs: no actuator named `n`",
+        ),
+        (
+            "kind = \"oscillator\"",
+            "kind = \"brainwave\"",
+            "controller[0].kind: unknown controller kind `brainwave`",
+        ),
+        (
+            "frequency = 2.0",
+            "frequency = 2.0\nhidden = [3]",
+            "controller[0].hidden: an `oscillator` controller has no `hidden`",
+        ),
+    ];
+    for (from, to, expected) in cases {
+        assert!(PAIR.contains(from), "{from}");
+        let e = refused(&PAIR.replacen(from, to, 1));
+        assert!(e.contains(expected), "expected `{expected}`, got `{e}`");
+        assert!(e.starts_with("bad.toml:"), "{e}");
+    }
+    // An actuator driven by two controllers.
+    let two = format!(
+        "{PAIR}\n[[controller]]\nname = \"again\"\nkind = \"oscillator\"\noutputs = [\"m\"]\n"
+    );
+    let e = refused(&two);
+    assert!(
+        e.contains("controller[1].outputs: actuator `m` is already driven by controller `osc`"),
+        "{e}"
+    );
+    // A neural network with the wrong number of weights says how many.
+    let net = PAIR.replacen(
+        "kind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 2.0\namplitude = [0.3]\nphase = [0.5]\noffset = [0.4]",
+        "kind = \"neural\"\ninputs = [\"gap\", \"bend\"]\noutputs = [\"m\"]\nhidden = [3]\nweights = [0.1, 0.2]",
+        1,
+    );
+    let e = refused(&net);
+    assert!(
+        e.contains("controller[0].weights: needs 13 finite numbers"),
+        "{e}"
+    );
+    // An FSM transition to a state that does not exist.
+    let fsm = PAIR.replacen(
+        "kind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 2.0\namplitude = [0.3]\nphase = [0.5]\noffset = [0.4]",
+        "kind = \"fsm\"\ninputs = [\"gap\"]\noutputs = [\"m\"]\n[[controller.state]]\nname = \"s\"\nlevels = [0.5]\n[[controller.state.transition]]\nto = \"nowhere\"\nafter = 1.0",
+        1,
+    );
+    let e = refused(&fsm);
+    assert!(
+        e.contains("controller[0].state[0].transition[0].to: no state named `nowhere`"),
+        "{e}"
+    );
+    // [evolve] naming a controller that does not exist.
+    let e = refused(&format!("{PAIR}\n[evolve]\ncontroller = \"gait\"\n"));
+    assert!(
+        e.contains("evolve.controller: no controller named `gait`"),
+        "{e}"
+    );
+    let e = refused(&format!(
+        "{PAIR}\n[evolve]\ncontroller = \"osc\"\nfail_on_touch = [\"z\"]\n"
+    ));
+    assert!(
+        e.contains("evolve.fail_on_touch: unknown particle `z`"),
+        "{e}"
+    );
+    // Springs with the same name.
+    let e = refused(&PAIR.replacen(
+        "[[actuator]]",
+        "[[spring]]\nname = \"muscle\"\na = \"b\"\nb = \"c\"\nstiffness = 1.0\n\n[[actuator]]",
+        1,
+    ));
+    assert!(
+        e.contains("spring[1].name: duplicate spring name `muscle`"),
+        "{e}"
+    );
+}
+
+/// A bead coasting at 0.5 m/s along x in empty space for 2 s, with an
+/// oscillator driving a spring to another bead far away (so that there is
+/// a controller to evolve).
+const COAST: &str = r#"
+[world]
+dt = 0.01
+integrator = "symplectic"
+gravity = [0.0, 0.0, 0.0]
+[[particle]]
+name = "bead"
+mass = 1.0
+position = [0.0, 1.0, 0.0]
+velocity = [0.5, 0.0, 0.0]
+radius = 0.05
+[[particle]]
+name = "p"
+mass = 1.0
+position = [0.0, 5.0, 0.0]
+radius = 0.05
+fixed = true
+[[particle]]
+name = "q"
+mass = 1.0
+position = [0.0, 5.2, 0.0]
+radius = 0.05
+fixed = true
+[[spring]]
+name = "s"
+a = "p"
+b = "q"
+stiffness = 10.0
+[[actuator]]
+name = "m"
+spring = "s"
+min = 0.1
+max = 0.3
+[[controller]]
+name = "osc"
+kind = "oscillator"
+outputs = ["m"]
+[evolve]
+controller = "osc"
+duration = 2.0
+particles = ["bead"]
+axis = [2.0, 0.0, 0.0]
+distance_weight = 10.0
+time_weight = 3.0
+"#;
+
+#[test]
+fn an_evaluation_scores_time_and_distance_along_the_axis() {
+    let s = animats_scene::parse(COAST, "coast.toml").unwrap();
+    let e = evaluate(s).unwrap();
+    assert_eq!(e.ended, Ended::Timeout);
+    assert_eq!(e.time, 2.0);
+    // Uniform motion: exactly 1 m (to rounding of 200 steps of 5 mm).
+    assert!((e.distance - 1.0).abs() < 1e-12, "{}", e.distance);
+    assert!((e.fitness - (3.0 * 2.0 + 10.0 * e.distance)).abs() < 1e-12);
+    // Backwards along a reversed axis.
+    let back = COAST.replace("axis = [2.0, 0.0, 0.0]", "axis = [-1.0, 0.0, 0.0]");
+    let e = evaluate(animats_scene::parse(&back, "b.toml").unwrap()).unwrap();
+    assert!((e.distance + 1.0).abs() < 1e-12);
+}
+
+#[test]
+fn touching_the_floor_ends_an_evaluation_at_the_time_it_happens() {
+    // The bead falls 1 m - 0.05 m from rest under g: lands at sqrt(2 × 0.95 / 9.8).
+    let text = COAST
+        .replace(
+            "gravity = [0.0, 0.0, 0.0]",
+            "gravity = [0.0, -9.8, 0.0]\ndt = 0.001",
+        )
+        .replace("dt = 0.01\n", "")
+        .replace("velocity = [0.5, 0.0, 0.0]", "")
+        .replace(
+            "time_weight = 3.0",
+            "time_weight = 3.0\nfail_on_touch = [\"bead\"]",
+        )
+        .replace("[world]", "[floor]\n[world]");
+    let e = evaluate(animats_scene::parse(&text, "fall.toml").unwrap()).unwrap();
+    assert_eq!(e.ended, Ended::Touch("bead".into()));
+    let expected = (2.0f64 * 0.949 / 9.8).sqrt();
+    assert!(
+        (e.time - expected).abs() < 0.002,
+        "{} vs {expected}",
+        e.time
+    );
+    assert_eq!(e.ended.to_string(), "touch bead");
+}
+
+#[test]
+fn a_genome_written_into_the_scene_reads_back_to_the_same_evaluation() {
+    let p = SceneProblem::parse(COAST, "coast.toml").unwrap();
+    assert_eq!(p.start(), [1.0, 0.25, 0.0, 0.5]);
+    let g = [1.7, 0.123456789, -0.987654321, 0.3];
+    let text = p.best_toml(&g, "a test\nof comments").unwrap();
+    assert!(text.starts_with("# a test\n# of comments\n"));
+    let q = SceneProblem::parse(&text, "best.toml").unwrap();
+    assert_eq!(q.start(), g, "{text}");
+    assert_eq!(
+        p.evaluate(&g).unwrap(),
+        evaluate(animats_scene::parse(&text, "best.toml").unwrap()).unwrap()
+    );
+    // Comments and other entries survive.
+    assert!(text.contains("name = \"bead\""));
+    // A scene without [evolve] is not a problem.
+    let e = SceneProblem::parse(PAIR, "pair.toml").unwrap_err();
+    assert!(e.to_string().contains("no [evolve] table"), "{e}");
+}
