@@ -3,6 +3,10 @@
 //! then each controller (in the order declared) turns its inputs' levels
 //! into its outputs' levels, and the actuators drive their parameters.
 //!
+//! An actuator may have a top speed (`rate`, levels per second): a
+//! controller's order then moves it at most `rate × dt` per step, as a
+//! muscle cannot change its length at once.
+//!
 //! Each actuator is driven by at most one controller; one that none drives
 //! stays at its level (which a program may set, [`NervousSystem::set_levels`]).
 
@@ -54,6 +58,9 @@ pub struct NervousSystem {
     pub sensors: Vec<(String, ScaledSensor)>,
     /// Named actuators, in the scene's order.
     pub actuators: Vec<(String, AnyActuator)>,
+    /// The most each actuator's level may change per second (`None`: no
+    /// limit), in the order of `actuators`.
+    pub rates: Vec<Option<f64>>,
     /// Controllers, in the scene's order.
     pub controllers: Vec<Wired>,
     levels: Vec<f64>,
@@ -114,7 +121,13 @@ impl NervousSystem {
             }
             c.brain.think(t, dt, &c.in_buf, &mut c.out_buf);
             for (&o, &l) in c.outputs.iter().zip(&c.out_buf) {
-                self.actuators[o].1.set_level(world, unit(l));
+                let a = &mut self.actuators[o].1;
+                let mut level = unit(l);
+                if let Some(Some(rate)) = self.rates.get(o) {
+                    let now = a.level();
+                    level = now + (level - now).clamp(-rate * dt, rate * dt);
+                }
+                a.set_level(world, level);
             }
         }
     }

@@ -18,9 +18,9 @@ fn the_oscillator_is_offset_plus_amplitude_times_sine() {
     for k in 0..200 {
         let t = k as f64 * 0.013;
         o.think(t, 0.013, &[], &mut out);
-        for i in 0..2 {
+        for (i, got) in out.iter().enumerate() {
             let expected = o.offset[i] + o.amplitude[i] * (TAU * 1.5 * t + o.phase[i]).sin();
-            assert!((out[i] - expected).abs() < 1e-14, "t {t} output {i}");
+            assert!((got - expected).abs() < 1e-14, "t {t} output {i}");
         }
     }
     let g = o.genome();

@@ -547,6 +547,9 @@ pub struct ActuatorEntry {
     /// The initial level, default 0.5.
     #[serde(default = "default_level")]
     pub level: f64,
+    /// The most the level may change per second (a muscle's top speed);
+    /// default: no limit.
+    pub rate: Option<f64>,
 }
 
 fn default_level() -> f64 {

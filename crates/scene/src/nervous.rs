@@ -77,7 +77,12 @@ pub(crate) fn build(
                 format!("duplicate actuator name `{}`", entry.get_ref().name),
             ));
         }
+        let rate = match entry.get_ref().rate {
+            Some(r) => Some(at.positive("rate", r)?),
+            None => None,
+        };
         ns.actuators.push((entry.get_ref().name.clone(), a));
+        ns.rates.push(rate);
     }
     for (k, entry) in def.sensor.iter().enumerate() {
         let at = at(src, format!("sensor[{k}]"), entry);

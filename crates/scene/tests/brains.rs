@@ -385,3 +385,63 @@ fn a_genome_written_into_the_scene_reads_back_to_the_same_evaluation() {
     let e = SceneProblem::parse(PAIR, "pair.toml").unwrap_err();
     assert!(e.to_string().contains("no [evolve] table"), "{e}");
 }
+
+#[test]
+fn an_actuator_with_a_rate_moves_its_level_no_faster() {
+    // The oscillator asks for level 0.4 + 0.3 sin(...) from t = 0, a jump
+    // from 0.5; with rate 2 per s the level moves at most 0.002 per 1 ms step.
+    let text = PAIR.replacen("max = 0.4\n", "max = 0.4\nrate = 2.0\n", 1);
+    let mut s = animats_scene::parse(&text, "rate.toml").unwrap();
+    let mut last = 0.5;
+    let mut limited = 0;
+    for _ in 0..400 {
+        let t = s.world.time();
+        s.step(s.dt).unwrap();
+        let level = s.nervous.actuator_levels()[0];
+        assert!(
+            (level - last).abs() <= 2.0 * s.dt + 1e-12,
+            "t {t}: {last} → {level}"
+        );
+        let asked = (0.4 + 0.3 * (TAU * 2.0 * t + 0.5).sin()).clamp(0.0, 1.0);
+        limited += ((asked - level).abs() > 1e-9) as usize;
+        last = level;
+    }
+    assert!(limited > 10, "the limit acted ({limited} steps)");
+    let e = refused(&PAIR.replacen("max = 0.4\n", "max = 0.4\nrate = -1.0\n", 1));
+    assert!(e.contains("actuator[0].rate: must be > 0"), "{e}");
+}
+
+/// The thesis's quadruped model 3 with its evolved brain (issue 10, item 1):
+/// its torso's centre travels at least half a body length (0.4 m) per
+/// second over 20 s, in the second half as in the whole, and the torso never
+/// touches the floor. The starting brain it was evolved from falls.
+#[test]
+fn the_thesis_quadruped_walks_with_its_evolved_brain() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
+    let walk =
+        animats_scene::load(std::path::Path::new(&format!("{dir}quadruped3_walk.toml"))).unwrap();
+    let spec = walk.evolve.clone().unwrap();
+    let mut halfway = None;
+    let e = animats_scene::evaluate::evaluate_with(walk, |s| {
+        if (s.world.time() - 10.0).abs() < 1e-9 {
+            halfway = Some(spec.centre(&s.world).x);
+        }
+    })
+    .unwrap();
+    let body = 0.4;
+    println!("quadruped3_walk: {e:?}");
+    assert_eq!(e.ended, Ended::Timeout, "the torso touched the floor");
+    assert_eq!(e.time, 20.0);
+    assert!(e.distance / 20.0 >= 0.5 * body, "{} m in 20 s", e.distance);
+    let x10 = halfway.expect("t = 10 s was seen");
+    assert!(x10 > 0.0);
+    assert!(
+        (e.distance - x10) / 10.0 >= 0.5 * body,
+        "the last 10 s: {} m",
+        e.distance - x10
+    );
+    let start =
+        animats_scene::load(std::path::Path::new(&format!("{dir}quadruped3_gait.toml"))).unwrap();
+    let e = evaluate(start).unwrap();
+    assert!(matches!(e.ended, Ended::Touch(_)), "{e:?}");
+}
