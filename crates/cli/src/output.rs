@@ -88,6 +88,30 @@ impl Trajectory {
 
     /// Records the state at time `t` (after `step` steps).
     pub fn record(&mut self, t: f64, step: u64, state: &State) -> Result<(), String> {
+        self.record_with(t, step, state, None)
+    }
+
+    /// Records a scene after `step` steps; in JSON lines, each controller's
+    /// state and levels beside the particles (see [`brains_json`]).
+    pub fn record_scene(&mut self, scene: &animats_scene::Scene, step: u64) -> Result<(), String> {
+        let extra = (self.format == Format::JsonLines)
+            .then(|| brains_json(scene))
+            .flatten();
+        self.record_with(
+            scene.world.time(),
+            step,
+            scene.world.state(),
+            extra.as_deref(),
+        )
+    }
+
+    fn record_with(
+        &mut self,
+        t: f64,
+        step: u64,
+        state: &State,
+        extra: Option<&str>,
+    ) -> Result<(), String> {
         self.frames += 1;
         let mut b = ryu::Buffer::new();
         let mut line = String::with_capacity(64 * state.len() + 32);
@@ -136,7 +160,11 @@ impl Trajectory {
                     }
                     line.push_str("]}");
                 }
-                line.push_str("]}\n");
+                line.push(']');
+                if let Some(extra) = extra {
+                    line.push_str(extra);
+                }
+                line.push_str("}\n");
             }
         }
         self.io(|o| o.write_all(line.as_bytes()))
@@ -183,4 +211,48 @@ impl Drop for Trajectory {
             let _ = std::fs::remove_file(&self.tmp);
         }
     }
+}
+
+/// The JSON-lines fields of a scene's brains, `,"controllers":[...],
+/// "sensors":{...},"actuators":{...}`, or `None` for a scene without any:
+/// each controller's name, kind, state (FSM state name, else null), the
+/// levels of its input sensors now and of the actuators it set for the step
+/// just taken; then every sensor's and actuator's level by name.
+pub fn brains_json(scene: &animats_scene::Scene) -> Option<String> {
+    let ns = &scene.nervous;
+    if ns.is_empty() {
+        return None;
+    }
+    let sensors = ns.sensor_levels(&scene.world);
+    let actuators = ns.actuator_levels();
+    let controllers: Vec<serde_json::Value> = ns
+        .controllers
+        .iter()
+        .map(|c| {
+            serde_json::json!({
+                "name": c.name,
+                "kind": c.brain.kind(),
+                "state": c.brain.state(),
+                "inputs": c.inputs.iter().map(|&i| sensors[i]).collect::<Vec<_>>(),
+                "outputs": c.outputs.iter().map(|&i| actuators[i]).collect::<Vec<_>>(),
+            })
+        })
+        .collect();
+    let named = |names: Vec<&String>, levels: &[f64]| {
+        serde_json::Value::Object(
+            names
+                .into_iter()
+                .zip(levels)
+                .map(|(n, l)| (n.clone(), serde_json::json!(l)))
+                .collect(),
+        )
+    };
+    let sensor_map = named(ns.sensors.iter().map(|(n, _)| n).collect(), &sensors);
+    let actuator_map = named(ns.actuators.iter().map(|(n, _)| n).collect(), &actuators);
+    Some(format!(
+        ",\"controllers\":{},\"sensors\":{},\"actuators\":{}",
+        serde_json::Value::Array(controllers),
+        sensor_map,
+        actuator_map
+    ))
 }

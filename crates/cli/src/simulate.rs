@@ -74,8 +74,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
 
     let start = Instant::now();
     if let Some(t) = trajectory.as_mut() {
-        t.record(scene.world.time(), 0, scene.world.state())
-            .map_err(write_err)?;
+        t.record_scene(&scene, 0).map_err(write_err)?;
     }
     for step in 1..=steps {
         if let Err(e) = scene.step(dt) {
@@ -100,8 +99,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         }
         if let Some(t) = trajectory.as_mut() {
             if step % args.every == 0 || step == steps {
-                t.record(scene.world.time(), step, scene.world.state())
-                    .map_err(write_err)?;
+                t.record_scene(&scene, step).map_err(write_err)?;
             }
         }
     }
