@@ -1,9 +1,13 @@
 //! CMA-ES (Hansen's (μ/μ_w, λ) evolution strategy with cumulative step-size
 //! adaptation, rank-one and rank-μ updates), written from Hansen's tutorial
-//! "The CMA Evolution Strategy: A Tutorial" (2016), as `purecma` does it:
-//! default λ = 4 + ⌊3 ln n⌋, μ = ⌊λ/2⌋, log-linear positive weights, and the
-//! eigendecomposition of C refreshed every `λ / (c1 + cμ) / n / 10`
-//! evaluations (cyclic Jacobi: small, exact and deterministic).
+//! "The CMA Evolution Strategy: A Tutorial" (2016, Table 1): default
+//! λ = 4 + ⌊3 ln n⌋, μ = ⌊λ/2⌋, log-linear weights, and *active* covariance
+//! adaptation as pycma does by default: the worse half of each generation
+//! gets negative weights (scaled as the tutorial's α⁻ terms say, and each
+//! of those steps rescaled to length √n in C's metric) that shrink C along
+//! directions that failed. The eigendecomposition of C is refreshed every
+//! `λ / (c1 + cμ) / n / 10` evaluations (cyclic Jacobi: small, exact and
+//! deterministic).
 //!
 //! It minimises internally; [`Optimiser`] maximises, so fitness is negated.
 //!
@@ -63,16 +67,39 @@ impl CmaEs {
             .unwrap_or_else(|| crate::optimiser::cma_default_lambda(n))
             .max(2);
         let mu = lambda / 2;
-        let raw: Vec<f64> = (0..mu)
+        let raw: Vec<f64> = (0..lambda)
             .map(|i| libm::log((lambda as f64 + 1.0) / 2.0) - libm::log(i as f64 + 1.0))
             .collect();
-        let sum: f64 = raw.iter().sum();
-        let weights: Vec<f64> = raw.iter().map(|w| w / sum).collect();
-        let mueff = 1.0 / weights.iter().map(|w| w * w).sum::<f64>();
+        let (pos, neg) = raw.split_at(mu);
+        let mu_eff =
+            |w: &[f64]| w.iter().sum::<f64>().powi(2) / w.iter().map(|x| x * x).sum::<f64>();
+        let mueff = mu_eff(pos);
         let cc = (4.0 + mueff / nf) / (nf + 4.0 + 2.0 * mueff / nf);
         let cs = (mueff + 2.0) / (nf + mueff + 5.0);
         let c1 = 2.0 / ((nf + 1.3).powi(2) + mueff);
         let cmu = (1.0 - c1).min(2.0 * (mueff - 2.0 + 1.0 / mueff) / ((nf + 2.0).powi(2) + mueff));
+        // Negative weights for the worse half (Table 1): the smallest of
+        // α_μ⁻, α_μeff⁻ and α_posdef⁻ over the sum of their magnitudes.
+        let pos_sum: f64 = pos.iter().sum();
+        let neg_sum: f64 = neg.iter().map(|w| w.abs()).sum();
+        let alpha = if neg.iter().any(|w| *w < 0.0) && cmu > 0.0 {
+            let mueff_neg = mu_eff(neg);
+            (1.0 + c1 / cmu)
+                .min(1.0 + 2.0 * mueff_neg / (mueff + 2.0))
+                .min((1.0 - c1 - cmu) / (nf * cmu))
+        } else {
+            0.0
+        };
+        let weights: Vec<f64> = raw
+            .iter()
+            .map(|&w| {
+                if w >= 0.0 {
+                    w / pos_sum
+                } else {
+                    alpha * w / neg_sum
+                }
+            })
+            .collect();
         let damps = 1.0 + 2.0 * (((mueff - 1.0) / (nf + 1.0)).sqrt() - 1.0).max(0.0) + cs;
         let chi_n = nf.sqrt() * (1.0 - 1.0 / (4.0 * nf) + 1.0 / (21.0 * nf * nf));
         let mean = match &s.bounds {
@@ -217,7 +244,8 @@ impl Optimiser for CmaEs {
 
         let old = self.mean.clone();
         let mut mean = vec![0.0; n];
-        for (w, &k) in self.weights.iter().zip(&order) {
+        // The mean moves by the positive weights only.
+        for (w, &k) in self.weights.iter().zip(&order).filter(|(w, _)| **w > 0.0) {
             for (m, y) in mean.iter_mut().zip(&self.pending[k]) {
                 *m += w * y;
             }
@@ -255,7 +283,7 @@ impl Optimiser for CmaEs {
         }
         let (c1, cmu) = (self.c1, self.cmu);
         let c1a = c1 * (1.0 - (1.0 - hsig * hsig) * self.cc * (2.0 - self.cc));
-        let steps: Vec<Vec<f64>> = order[..self.weights.len()]
+        let steps: Vec<Vec<f64>> = order
             .iter()
             .map(|&k| {
                 self.pending[k]
@@ -265,13 +293,36 @@ impl Optimiser for CmaEs {
                     .collect()
             })
             .collect();
+        // A negative weight's step is rescaled to length √n in C's metric
+        // (w° = w n / |C^{-1/2} y|²), so that C stays positive definite.
+        let scaled: Vec<f64> = self
+            .weights
+            .iter()
+            .zip(&steps)
+            .map(|(&w, y)| {
+                if w >= 0.0 {
+                    w
+                } else {
+                    let mut norm2 = 0.0;
+                    for j in 0..n {
+                        let mut s = 0.0;
+                        for (i, yi) in y.iter().enumerate() {
+                            s += self.b[i * n + j] * yi;
+                        }
+                        norm2 += (s / self.d[j]).powi(2);
+                    }
+                    w * n as f64 / norm2.max(1e-300)
+                }
+            })
+            .collect();
+        let weight_sum: f64 = self.weights.iter().sum();
         for i in 0..n {
             for j in 0..=i {
                 let mut rank_mu = 0.0;
-                for (w, s) in self.weights.iter().zip(&steps) {
+                for (w, s) in scaled.iter().zip(&steps) {
                     rank_mu += w * s[i] * s[j];
                 }
-                let v = (1.0 - c1a - cmu) * self.c[i * n + j]
+                let v = (1.0 - c1a - cmu * weight_sum) * self.c[i * n + j]
                     + c1 * self.pc[i] * self.pc[j]
                     + cmu * rank_mu;
                 self.c[i * n + j] = v;
