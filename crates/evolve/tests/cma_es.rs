@@ -10,6 +10,9 @@ use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 
 const N: usize = 10;
 
+/// A function to minimise.
+type Objective = fn(&[f64]) -> f64;
+
 fn sphere(x: &[f64]) -> f64 {
     x.iter().map(|v| v * v).sum()
 }
@@ -41,7 +44,7 @@ fn setup(x0: f64, seed: u64) -> Setup {
 
 /// Evaluations until the best value is <= 1e-8, counted in whole
 /// generations as pycma counts them; `None` if not within 100,000.
-fn evaluations(f: fn(&[f64]) -> f64, x0: f64, seed: u64) -> Option<u64> {
+fn evaluations(f: Objective, x0: f64, seed: u64) -> Option<u64> {
     let mut o = AnyOptimiser::new(&setup(x0, seed)).unwrap();
     let mut count = 0;
     while count < 100_000 {
@@ -71,7 +74,7 @@ fn median(mut v: Vec<u64>) -> f64 {
 fn cma_es_needs_at_most_one_and_a_half_times_pycmas_evaluations() {
     let reference: serde_json::Value =
         serde_json::from_str(include_str!("reference/pycma.json")).unwrap();
-    let cases: [(&str, fn(&[f64]) -> f64); 3] = [
+    let cases: [(&str, Objective); 3] = [
         ("sphere", sphere),
         ("ellipsoid", ellipsoid),
         ("rosenbrock", rosenbrock),
