@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod allpairs;
+pub mod brains;
 pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
@@ -22,13 +23,14 @@ use animats_engine::{DVec3, IntegratorKind};
 use std::time::Instant;
 
 /// The workloads, in the order they are run by default.
-pub const WORKLOADS: [&str; 8] = [
+pub const WORKLOADS: [&str; 9] = [
     "chain-64",
     "cloth-32",
     "cloth-128",
     "nbody5",
     "allpairs-1000",
     "hopper",
+    "brains",
     "seaworld",
     "stability",
 ];
@@ -305,6 +307,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "nbody5" => Ok(vec![run_nbody5(opts.quick, runs)]),
         "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
         "hopper" => hopper::run(opts.quick, runs),
+        "brains" => brains::run(opts.quick, runs),
         "seaworld" => seaworld::run(opts.quick, runs),
         "stability" => Ok(stability::run(Some(std::path::Path::new(
             "scenes/seaworld.toml",
