@@ -16,11 +16,15 @@ use std::time::Instant;
 /// Where the camera is.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraSpec {
-    /// The live view's starting framing, fixed.
+    /// The live view's starting framing, moved along with what the scene
+    /// follows (its `[evolve]` particles, `--follow NAME`, or its first
+    /// walker), fixed when it follows nothing.
     Auto,
-    /// That framing, moved along with the creatures (in whole checker
-    /// periods of the floor).
+    /// That framing, moved along with what the scene follows, or else with
+    /// the centre of its creatures (in whole checker periods of the floor).
     Follow,
+    /// The live view's starting framing, never moving.
+    Fixed,
     /// An eye and a target, m.
     At(DVec3, DVec3),
 }
@@ -43,10 +47,11 @@ impl FromStr for CameraSpec {
         match s {
             "auto" => Ok(CameraSpec::Auto),
             "follow" => Ok(CameraSpec::Follow),
+            "fixed" => Ok(CameraSpec::Fixed),
             _ => {
                 let (eye, target) = s
                     .split_once(':')
-                    .ok_or("expected auto, follow, or EYE:TARGET as x,y,z:x,y,z")?;
+                    .ok_or("expected auto, follow, fixed, or EYE:TARGET as x,y,z:x,y,z")?;
                 let (eye, target) = (vector(eye)?, vector(target)?);
                 if eye.distance(target) < 1e-9 {
                     return Err("the eye and the target are the same point".into());
@@ -78,11 +83,18 @@ pub struct Args {
     /// Frames per simulated second (GIF and MP4).
     #[arg(long, default_value_t = 25.0, value_parser = positive_f64)]
     fps: f64,
-    /// Camera: `auto` (the live view's framing), `follow` (that framing,
-    /// moving across the floor with the creatures, in steps of two floor
-    /// squares so the floor stands still) or `EYE:TARGET` as `x,y,z:x,y,z`, metres.
+    /// Camera: `auto` (the live view's framing, following the scene's
+    /// `[evolve]` particles, `--follow NAME` or its first walker, in steps
+    /// of two floor squares so the floor stands still), `follow` (the same,
+    /// or the centre of all creatures when the scene follows nothing),
+    /// `fixed` (the opening framing, still) or `EYE:TARGET` as
+    /// `x,y,z:x,y,z`, metres.
     #[arg(long, default_value = "auto")]
     camera: CameraSpec,
+    /// The particle or creature (`NAME` for `NAME.part`) the camera frames
+    /// and follows.
+    #[arg(long)]
+    follow: Option<String>,
     /// Vertical field of view, degrees.
     #[arg(long, default_value_t = 50.0, value_parser = fov)]
     fov: f64,
@@ -222,7 +234,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
 
-    let mut stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    let mut stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
+        .map_err(Failure::Input)?;
     crate::warn(&args.scene, stage.warnings());
     let describe = stage.describe();
     let parts = Parts {
@@ -245,6 +258,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
 
     let start = Instant::now();
     let dt = stage.dt();
+    // Where things are at t = 0, which the framing is for (the first frame
+    // drawn may be later: a PNG draws only the last).
+    let at_start = snapshot(&stage, &describe);
     let mut snapshots = Vec::with_capacity(times.len());
     for &t in &times {
         while stage.time() < t - 0.5 * dt {
@@ -259,15 +275,27 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
 
     let base = Camera::framing(DVec3::from_array(describe.target), describe.distance);
-    let start_centre = creatures_centre(&describe, &snapshots[0].positions);
+    let followed = stage.followed().to_vec();
+    let centre = |positions: &[DVec3]| -> DVec3 {
+        if followed.is_empty() {
+            creatures_centre(&describe, positions)
+        } else {
+            followed.iter().map(|&i| positions[i]).sum::<DVec3>() / followed.len() as f64
+        }
+    };
+    let start_centre = centre(&at_start.positions);
     let camera = |s: &Snapshot| -> Camera {
+        let follows = match &args.camera {
+            CameraSpec::Auto => !followed.is_empty(),
+            CameraSpec::Follow => true,
+            _ => false,
+        };
         let c = match &args.camera {
-            CameraSpec::Auto => base,
-            CameraSpec::Follow => {
+            CameraSpec::Auto | CameraSpec::Follow if follows => {
                 // In whole periods of the floor's checker: the floor looks
                 // the same in every frame, which also keeps GIFs small.
                 let period = 2.0 * parts.cell;
-                let moved = creatures_centre(&describe, &s.positions) - start_centre;
+                let moved = centre(&s.positions) - start_centre;
                 let shift = (DVec3::new(moved.x, 0.0, moved.z) / period).round() * period;
                 Camera {
                     eye: base.eye + shift,
@@ -280,6 +308,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
                 target: *target,
                 ..base
             },
+            _ => base,
         };
         Camera {
             fov_y: args.fov,

@@ -37,7 +37,7 @@ impl Serving {
         })
         .map_err(Failure::Input)?;
         let url = server.url().map_err(Failure::Other)?;
-        println!("animats view: watching at {url} (Ctrl-C to stop)");
+        println!("animats view: watching at {url} (paused until a tab connects; Ctrl-C to stop)");
         Ok(server)
     }
 }
@@ -53,6 +53,11 @@ pub struct Args {
     /// 0: flat out). The page can change it.
     #[arg(long, default_value_t = 1.0)]
     speed: f64,
+    /// The particle or creature (`NAME` for `NAME.part`) the camera frames
+    /// and follows; default the scene's `[evolve]` particles, or its first
+    /// roobot or quadruped.
+    #[arg(long)]
+    follow: Option<String>,
 }
 
 /// Runs the command: serves until Ctrl-C.
@@ -63,7 +68,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
             args.speed
         )));
     }
-    let stage = SceneStage::load(args.scene.clone()).map_err(Failure::Input)?;
+    let stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
+        .map_err(Failure::Input)?;
     crate::warn(&args.scene, stage.warnings());
     let server = args.serving.bind(args.speed)?;
     let stop = Arc::new(AtomicBool::new(false));

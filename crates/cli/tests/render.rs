@@ -296,3 +296,82 @@ fn an_mp4_comes_from_ffmpeg_when_it_is_installed() {
         );
     }
 }
+
+/// Pixels that are the roobot's orange (palette 0xe07b39, shaded): far
+/// redder than the green-grey floor and the pale sky.
+fn orange_pixels(img: &Image) -> usize {
+    img.rgb
+        .chunks(3)
+        .filter(|p| {
+            let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+            r > g + 40 && r > b + 70
+        })
+        .count()
+}
+
+/// A hopping roobot leaves a fixed framing within two seconds; by default
+/// the camera follows the first walker (or a scene's [evolve] particles, or
+/// the creature `--follow` names), so the last frame still shows it.
+#[test]
+fn walkers_stay_in_the_picture_by_default() {
+    let dir = scratch("render-follow");
+    let (followed, fixed) = (dir.join("followed.png"), dir.join("fixed.png"));
+    let args = |out: &std::path::Path, camera: &str| {
+        run_ok(&[
+            "render",
+            "scenes/roobot.toml",
+            "--seconds",
+            "6",
+            "--width",
+            "240",
+            "--height",
+            "160",
+            "--camera",
+            camera,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        orange_pixels(&decode_png(out))
+    };
+    let (seen, gone) = (args(&followed, "auto"), args(&fixed, "fixed"));
+    assert!(seen > 150, "the followed roobot covers {seen} pixels");
+    assert!(
+        gone < 10,
+        "the fixed camera still sees {gone} roobot pixels"
+    );
+    // One of three roobots heading apart, by name.
+    let one = dir.join("north.png");
+    run_ok(&[
+        "render",
+        "scenes/roobots.toml",
+        "--seconds",
+        "6",
+        "--width",
+        "240",
+        "--height",
+        "160",
+        "--follow",
+        "north",
+        "--out",
+        one.to_str().unwrap(),
+    ]);
+    assert!(orange_pixels(&decode_png(&one)) > 150);
+    let o = animats(&[
+        "render",
+        "scenes/roobots.toml",
+        "--seconds",
+        "1",
+        "--follow",
+        "south",
+        "--out",
+        one.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o)
+            .1
+            .contains("no particle or creature called `south`"),
+        "{}",
+        text(&o).1
+    );
+}

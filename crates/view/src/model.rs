@@ -51,6 +51,20 @@ pub struct Describe {
     pub distance: f64,
     /// The colour of each kind of part, 0xRRGGBB (see `palette.rs`).
     pub palette: std::collections::BTreeMap<&'static str, u32>,
+    /// Text drawn over the 3-D view above particles (an evolution's lanes).
+    pub labels: Vec<Label>,
+    /// Whether the camera orbits what it follows until the user takes over
+    /// (an evolution's exhibition, as the thesis showed it).
+    pub orbit: bool,
+}
+
+/// A caption that stays above a particle in the 3-D view.
+#[derive(Clone, Debug, Serialize)]
+pub struct Label {
+    /// What it says.
+    pub text: String,
+    /// The particle it hangs above.
+    pub particle: usize,
 }
 
 /// A creature's state, for the overlay.

@@ -40,13 +40,30 @@ pub trait Stage: Send {
 pub struct SceneStage {
     path: PathBuf,
     scene: Scene,
+    /// The particles the camera frames and follows (see [`SceneStage::follow`]).
+    focus: Vec<usize>,
 }
 
 impl SceneStage {
-    /// Loads the scene at `path`.
+    /// Loads the scene at `path`, framing and following its default focus.
     pub fn load(path: PathBuf) -> Result<SceneStage, String> {
+        SceneStage::following(path, None)
+    }
+
+    /// Loads the scene at `path`; the camera frames and follows the
+    /// particle or creature called `follow` (a creature's particles are
+    /// `NAME.part`), or by default the scene's `[evolve]` particles, or the
+    /// first roobot or quadruped; a scene with none of them is framed whole
+    /// and not followed.
+    pub fn following(path: PathBuf, follow: Option<&str>) -> Result<SceneStage, String> {
         let scene = animats_scene::load(&path).map_err(|e| e.to_string())?;
-        Ok(SceneStage { path, scene })
+        let focus = focus_of(&scene, follow).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(SceneStage { path, scene, focus })
+    }
+
+    /// Indices of the particles followed (empty: none).
+    pub fn followed(&self) -> &[usize] {
+        &self.focus
     }
 
     /// The scene's warnings (see `animats_scene::Scene::warnings`).
@@ -57,6 +74,38 @@ impl SceneStage {
     fn food(&self) -> Option<usize> {
         self.scene.kinds.iter().position(|k| *k == "food")
     }
+}
+
+/// What the camera follows in `scene` (see [`SceneStage::following`]).
+fn focus_of(scene: &Scene, follow: Option<&str>) -> Result<Vec<usize>, String> {
+    let of = |name: &str| -> Vec<usize> {
+        let prefix = format!("{name}.");
+        (0..scene.names.len())
+            .filter(|&i| scene.names[i] == name || scene.names[i].starts_with(&prefix))
+            .collect()
+    };
+    if let Some(name) = follow {
+        let found = of(name);
+        if found.is_empty() {
+            return Err(format!(
+                "--follow {name}: no particle or creature called `{name}` (a creature's particles are `{name}.part`)"
+            ));
+        }
+        return Ok(found);
+    }
+    if let Some(spec) = &scene.evolve {
+        return Ok(spec.particles.iter().map(|p| p.index()).collect());
+    }
+    let walker = (0..scene.kinds.len()).find(|&i| matches!(scene.kinds[i], "roobot" | "quadruped"));
+    Ok(match walker {
+        Some(i) => {
+            let name = &scene.names[i];
+            of(name
+                .rsplit_once('.')
+                .map_or(name.as_str(), |(creature, _)| creature))
+        }
+        None => Vec::new(),
+    })
 }
 
 /// Where to point the camera at a set of positions: their middle, from a
@@ -126,7 +175,16 @@ impl Stage for SceneStage {
                 .collect();
         }
         let floor = w.event::<animats_engine::FloorCollision>().is_some();
-        let (target, distance) = framing(&w.state().pos, floor);
+        let pos = &w.state().pos;
+        let (target, distance) = if self.focus.is_empty() {
+            framing(pos, floor)
+        } else {
+            let followed: Vec<DVec3> = self.focus.iter().map(|&i| pos[i]).collect();
+            // Room for the legs around the followed body and the ground it
+            // crosses.
+            let (target, distance) = framing(&followed, floor);
+            (target, distance.max(1.6))
+        };
         Describe {
             kind: "scene",
             title: self.path.display().to_string(),
@@ -139,6 +197,8 @@ impl Stage for SceneStage {
             target,
             distance,
             palette: crate::palette::PALETTE.into_iter().collect(),
+            labels: Vec::new(),
+            orbit: false,
         }
     }
 
@@ -179,6 +239,15 @@ impl Stage for SceneStage {
                 phase: s.phase,
             })
             .collect()
+    }
+
+    fn focus(&self) -> Option<[f64; 3]> {
+        if self.focus.is_empty() {
+            return None;
+        }
+        let pos = &self.scene.world.state().pos;
+        let c = self.focus.iter().map(|&i| pos[i]).sum::<DVec3>() / self.focus.len() as f64;
+        Some(c.to_array())
     }
 
     fn reset(&mut self) -> Result<(), String> {

@@ -131,8 +131,14 @@ impl Stage for Exhibition {
         let mut particles = Vec::new();
         let mut springs = Vec::new();
         let mut pos = Vec::new();
+        let mut labels = Vec::new();
         for (k, lane) in self.lanes.iter().enumerate() {
             let first = particles.len();
+            // Above its hip (the first part).
+            labels.push(animats_view::model::Label {
+                text: format!("lane {k}"),
+                particle: first,
+            });
             let w = &lane.world;
             for (i, r) in w.particles().radius.iter().enumerate() {
                 particles.push(Part {
@@ -163,6 +169,8 @@ impl Stage for Exhibition {
             target,
             distance: distance.max(3.0),
             palette: animats_view::palette::PALETTE.into_iter().collect(),
+            labels,
+            orbit: true,
         }
     }
 

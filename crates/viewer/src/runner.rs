@@ -56,6 +56,8 @@ pub struct Runner {
     /// Real-time factor; 0 is flat out.
     speed: f64,
     paused: bool,
+    /// True until the first tab connects: nothing is simulated unseen.
+    waiting: bool,
     error: Option<String>,
     positions: Vec<f32>,
     summary: Summary,
@@ -104,6 +106,7 @@ impl Runner {
             period: Duration::from_secs_f64(1.0 / display_hz.clamp(1.0, 240.0)),
             speed: clamp_speed(speed),
             paused: false,
+            waiting: true,
             error: None,
             positions: Vec::new(),
             summary: Summary::default(),
@@ -190,6 +193,17 @@ impl Runner {
                 }
             }
 
+            if self.waiting {
+                if self.out.frames.receiver_count() == 0 {
+                    std::thread::sleep(self.period);
+                    last = Instant::now();
+                    next_frame = last;
+                    target = self.stage.time();
+                    window = (last, self.stage.time(), 0);
+                    continue;
+                }
+                self.waiting = false;
+            }
             let now = Instant::now();
             let wall = now.duration_since(last).as_secs_f64();
             last = now;

@@ -32,6 +32,11 @@ impl Live {
 
     /// Serves on `host` (port 0); also returns the access token, if any.
     fn on(host: &str, max_clients: usize) -> (Live, Option<String>) {
+        Live::scene(host, max_clients, seaworld())
+    }
+
+    /// Serves the scene at `path` on `host` (port 0).
+    fn scene(host: &str, max_clients: usize, path: PathBuf) -> (Live, Option<String>) {
         let server = Server::bind(Options {
             host: host.into(),
             port: 0,
@@ -42,7 +47,7 @@ impl Live {
         let token = server.token().map(str::to_string);
         let port = server.address().expect("address").port();
         let url = format!("ws://127.0.0.1:{port}/ws");
-        let stage = SceneStage::load(seaworld()).expect("scene");
+        let stage = SceneStage::load(path).expect("scene");
         let stop = Arc::new(AtomicBool::new(false));
         let s = stop.clone();
         let thread = Some(std::thread::spawn(move || server.serve(Box::new(stage), s)));
@@ -381,4 +386,29 @@ fn the_page_and_three_js_are_served_from_the_binary() {
         .0
         .starts_with("HTTP/1.1 404"));
     assert!(get("/nothing").0.starts_with("HTTP/1.1 404"));
+}
+
+/// Nothing is simulated before the first tab connects (a hopping roobot
+/// would be gone before anyone saw it), and the frames carry the walker's
+/// centre for the page's camera to follow.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_view_waits_for_its_first_tab_and_follows_the_walker() {
+    let roobot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/roobot.toml");
+    let (live, _) = Live::scene("127.0.0.1", 4, roobot);
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    let mut ws = connect(&live.url).await;
+    let scene = next(&mut ws).await.expect("the scene");
+    assert_eq!(scene["type"], "scene");
+    assert_eq!(scene["orbit"], false);
+    let first = frame(&mut ws).await;
+    let t = first["t"].as_f64().unwrap();
+    assert!(
+        t < 0.5,
+        "1.5 s passed before the tab connected, and the run is at t = {t}"
+    );
+    let x0 = first["focus"][0].as_f64().expect("a focus to follow");
+    let later = frame_where(&mut ws, |f| f["t"].as_f64().unwrap_or(0.0) > 2.0).await;
+    let x1 = later["focus"][0].as_f64().unwrap();
+    // The evolved gait travels about 2 m/s along +x.
+    assert!(x1 - x0 > 1.0, "the focus moved from x = {x0} to {x1}");
 }

@@ -185,7 +185,17 @@ function build(desc) {
   });
 
   scene.add(group);
-  drawn = { group, spheres, springs, domes, floor, water, size: desc.distance };
+  // Captions over the 3-D view (an evolution's lanes), placed every frame.
+  const box = $('labels');
+  box.replaceChildren();
+  const labels = (desc.labels ?? []).map((l) => {
+    const div = document.createElement('div');
+    div.className = 'label';
+    div.textContent = l.text;
+    box.appendChild(div);
+    return { div, particle: l.particle, lift: 3 * desc.particles[l.particle].radius + 0.05 };
+  });
+  drawn = { group, spheres, springs, domes, floor, water, labels, size: desc.distance };
 
   // Depth precision: the near plane scales with the scene, or the grid
   // flickers into the floor.
@@ -267,7 +277,8 @@ function draw(frame) {
   }
   if (frame.focus && $('follow').checked) {
     const target = new THREE.Vector3(...frame.focus);
-    const shift = target.sub(controls.target).multiplyScalar(0.08);
+    // An evolution's leader changes: ease over; a walker is tracked closely.
+    const shift = target.sub(controls.target).multiplyScalar(viewer.scene.orbit ? 0.08 : 0.3);
     controls.target.add(shift);
     camera.position.add(shift);
   }
@@ -359,13 +370,25 @@ function animate() {
   if (pending && drawn) {
     // An evolution is shown as the thesis did: the camera orbits the
     // leader until the user takes over.
-    if (pending.focus && !viewer.orbited) { viewer.orbited = true; controls.autoRotate = true; }
+    if (pending.focus && viewer.scene.orbit && !viewer.orbited) { viewer.orbited = true; controls.autoRotate = true; }
     draw(pending);
     pending = null;
   }
   controls.update();
   if (drawn) aimSun(drawn.size);
   renderer.render(scene, camera);
+  if (drawn && viewer.frame) placeLabels(viewer.frame.p);
+}
+
+/** Puts each caption above its particle, as the camera sees it now. */
+function placeLabels(p) {
+  for (const l of drawn.labels) {
+    const i = 3 * l.particle;
+    const at = project(p[i], p[i + 1] + l.lift, p[i + 2]);
+    l.div.style.display = at.visible ? '' : 'none';
+    l.div.style.left = `${at.x.toFixed(1)}px`;
+    l.div.style.top = `${at.y.toFixed(1)}px`;
+  }
 }
 controls.autoRotateSpeed = 0.6;
 connect();

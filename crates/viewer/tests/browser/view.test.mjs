@@ -11,8 +11,9 @@
 // CHROMIUM (default /usr/bin/chromium), SCREENSHOT (default
 // ../../../../target/browser/seaworld.png).
 import { spawn } from 'node:child_process';
-import { mkdirSync } from 'node:fs';
-import { dirname, resolve } from 'node:path';
+import { mkdirSync, mkdtempSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
@@ -27,9 +28,9 @@ function check(ok, what, detail = '') {
   if (!ok) failures += 1;
 }
 
-/** Starts the server; resolves with its URL once it prints it. */
-function serve() {
-  const child = spawn(bin, ['view', resolve(root, 'scenes/seaworld.toml'), '--port', '0'], { stdio: ['ignore', 'pipe', 'inherit'] });
+/** Starts the server (`animats ARGS`); resolves with its URL once it prints it. */
+function serve(args = ['view', resolve(root, 'scenes/seaworld.toml'), '--port', '0']) {
+  const child = spawn(bin, args, { stdio: ['ignore', 'pipe', 'inherit'] });
   return new Promise((ok, fail) => {
     let out = '';
     const timer = setTimeout(() => fail(new Error(`no address from ${bin} within 20 s: ${out}`)), 20000);
@@ -167,6 +168,26 @@ try {
   await page.screenshot({ path: screenshot });
   console.log(`screenshot: ${screenshot}`);
   check(errors.length === 0, 'no script errors on the page', errors.join('; '));
+
+  // `evolve --view`: every lane's roobot is labelled in the 3-D view, on
+  // screen, above its own hip.
+  const out = mkdtempSync(join(tmpdir(), 'animats-evolve-view-'));
+  const evo = await serve(['evolve', '--generations', '30', '--lanes', '3', '--view', '--port', '0', '--out', out]);
+  try {
+    const tab = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    await tab.goto(evo.url);
+    await tab.waitForFunction(() => window.__viewer && window.__viewer.frames > 30, null, { timeout: 30000 });
+    const labels = await tab.evaluate(() => [...document.querySelectorAll('.label')].map((d) => {
+      const r = d.getBoundingClientRect();
+      return { text: d.textContent, shown: d.style.display !== 'none', x: r.left + r.width / 2, y: r.bottom };
+    }));
+    const onScreen = labels.filter((l) => l.shown && l.x > 0 && l.x < 1100 && l.y > 0 && l.y < 700);
+    check(labels.map((l) => l.text).join(',') === 'lane 0,lane 1,lane 2' && onScreen.length === 3,
+      'evolve --view labels each lane in the 3-D view', labels.map((l) => `${l.text} at (${l.x.toFixed(0)}, ${l.y.toFixed(0)})`).join('; '));
+    await tab.close();
+  } finally {
+    evo.child.kill('SIGINT');
+  }
 } finally {
   await browser.close();
   child.kill('SIGINT');
