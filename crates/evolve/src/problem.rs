@@ -4,7 +4,7 @@
 
 use crate::optimiser::Bounds;
 use animats_creatures::roobot::evaluate::{evaluate, EvalSettings};
-use animats_creatures::roobot::{HopParams, PARAM_COUNT};
+use animats_creatures::roobot::{raibert, HopParams, PARAM_COUNT};
 
 /// The outcome of one evaluation.
 #[derive(Clone, Debug, PartialEq)]
@@ -105,6 +105,44 @@ impl Problem for SceneEvolution {
             time: e.time,
             distance: e.distance,
             ended: e.ended.to_string(),
+        })
+    }
+}
+
+/// Raibert's three-part controller on the roobot's body, its 8 gains
+/// evolved (`animats_creatures::roobot::raibert`): the hand-designed
+/// baseline the hopping FSM is compared with.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RaibertProblem {
+    /// How it is evaluated (the FSM's settings).
+    pub settings: EvalSettings,
+}
+
+impl Problem for RaibertProblem {
+    fn dim(&self) -> usize {
+        raibert::GAIN_COUNT
+    }
+    fn start(&self) -> Vec<f64> {
+        raibert::START.to_vec()
+    }
+    fn bounds(&self) -> Option<Bounds> {
+        let (lo, hi) = raibert::BOUNDS.iter().copied().unzip();
+        Some(Bounds { lo, hi })
+    }
+    fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
+        let gains: [f64; raibert::GAIN_COUNT] = genome.try_into().map_err(|_| {
+            format!(
+                "Raibert's controller has {} gains, got {}",
+                raibert::GAIN_COUNT,
+                genome.len()
+            )
+        })?;
+        let e = raibert::evaluate(gains, &self.settings).map_err(|e| e.to_string())?;
+        Ok(Outcome {
+            fitness: e.fitness,
+            time: e.time_up,
+            distance: e.distance,
+            ended: e.ending.name().to_string(),
         })
     }
 }

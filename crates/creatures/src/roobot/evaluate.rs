@@ -137,6 +137,28 @@ pub fn ended(world: &World, roobot: &Roobot, settings: &EvalSettings) -> Option<
 pub fn evaluate_with(
     params: HopParams,
     settings: &EvalSettings,
+    observe: impl FnMut(&World, &Roobot),
+) -> Result<Evaluation, ModelError> {
+    evaluate_driven(
+        params,
+        settings,
+        |world, roobot, dt| {
+            let before = roobot.landings();
+            roobot.act(world, dt);
+            roobot.landings() > before
+        },
+        observe,
+    )
+}
+
+/// One evaluation with any controller of the roobot's body: `control`
+/// sets the actuators before every step and says whether the foot just
+/// landed (the hops counted). The world, the end rule and the fitness are
+/// the FSM's (`params` only set the FSM, which `control` may ignore).
+pub fn evaluate_driven(
+    params: HopParams,
+    settings: &EvalSettings,
+    mut control: impl FnMut(&mut World, &mut Roobot, f64) -> bool,
     mut observe: impl FnMut(&World, &Roobot),
 ) -> Result<Evaluation, ModelError> {
     let (mut world, mut roobot) = evaluation_world(params, settings)?;
@@ -144,7 +166,7 @@ pub fn evaluate_with(
     let hip = roobot.body.hip;
     let x0 = world.position(hip).dot(forward);
     let steps = (settings.seconds / settings.dt).round() as u64;
-    let mut up = 0u64;
+    let (mut up, mut hops) = (0u64, 0u32);
     let mut ending = Ending::Timeout;
     observe(&world, &roobot);
     for _ in 0..steps {
@@ -152,7 +174,7 @@ pub fn evaluate_with(
             ending = end;
             break;
         }
-        roobot.act(&mut world, settings.dt);
+        hops += control(&mut world, &mut roobot, settings.dt) as u32;
         if world.step(settings.dt).is_err() {
             ending = Ending::BlewUp;
             break;
@@ -166,7 +188,7 @@ pub fn evaluate_with(
         fitness: time_up + 50.0 * distance,
         time_up,
         distance,
-        hops: roobot.landings(),
+        hops,
         ending,
     })
 }

@@ -16,6 +16,7 @@ pub mod fsm;
 pub mod gait;
 pub mod params;
 pub mod params_file;
+pub mod raibert;
 
 use crate::actuator::Actuator;
 use crate::actuators::{JointTorque, SpringRestLength};
@@ -134,6 +135,21 @@ impl Roobot {
         self.sensors.height.level(world) <= 0.0
     }
 
+    /// The hip motor acts only in flight and the ankle motor only in stance
+    /// (thesis §3.2.1.2): the one without ground to push against is idle,
+    /// whatever level the controller left it at. `down`: the foot is on the
+    /// floor.
+    pub fn gate_motors(&self, world: &mut World, down: bool) {
+        let motors = &mut world.forces_mut().torque_joints;
+        if down {
+            motors.set_torque(self.body.hip_motor, 0.0);
+            motors.set_torque(self.body.ankle_motor, self.ankle.value());
+        } else {
+            motors.set_torque(self.body.hip_motor, self.hip.value());
+            motors.set_torque(self.body.ankle_motor, 0.0);
+        }
+    }
+
     /// Landings (flight → stance transitions) so far.
     pub fn landings(&self) -> u32 {
         self.landings
@@ -170,18 +186,7 @@ impl Actor for Roobot {
         if self.fsm.last_transition() == Some((HopState::Flight, HopState::Stance)) {
             self.landings += 1;
         }
-        // The hip motor acts only in flight and the ankle motor only in stance
-        // (thesis §3.2.1.2): the one without ground to push against is idle,
-        // whatever level the controller left it at.
-        let down = senses.height <= 0.0;
-        let motors = &mut world.forces_mut().torque_joints;
-        if down {
-            motors.set_torque(self.body.hip_motor, 0.0);
-            motors.set_torque(self.body.ankle_motor, self.ankle.value());
-        } else {
-            motors.set_torque(self.body.hip_motor, self.hip.value());
-            motors.set_torque(self.body.ankle_motor, 0.0);
-        }
+        self.gate_motors(world, senses.height <= 0.0);
     }
 
     fn status(&self) -> Option<Status> {
