@@ -5,6 +5,13 @@
 //!
 //! A brain that can be evolved exposes its parameters as a *genome*: a flat
 //! vector of numbers with bounds, in an order its file documents.
+//!
+//! Conventions for the creatures' own brains, whose inputs and outputs
+//! each file lists: an input may be a raw reading where the thesis reads
+//! one (the roobot's hip velocity), or an actuator's level now or at the
+//! start (so that "return to rest" is a level too); an output of NaN means
+//! "leave that actuator as it is". The scene's controllers always write
+//! every output.
 
 /// Sensor levels in, actuator levels out.
 pub trait Brain: Send {

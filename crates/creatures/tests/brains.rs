@@ -149,3 +149,41 @@ fn fsm_transitions_happen_on_time_and_on_thresholds_and_rates_limit_the_levels()
     f.reset();
     assert_eq!(f.state(), Some("down"));
 }
+
+/// The thesis's creatures' FSMs are brains too: the roobot's FSM reads its
+/// senses and actuator levels as inputs and answers Keep with NaN and Reset
+/// with the initial level it was given.
+#[test]
+fn the_roobot_fsm_is_a_brain_whose_keep_is_nan_and_reset_the_initial_level() {
+    use animats_creatures::roobot::{HopFsm, HopParams};
+    let mut fsm = HopFsm::new(HopParams::INITIAL);
+    let p = HopParams::INITIAL.0;
+    // In stance with the leg angle below p1: the leg and ankle are set, the
+    // hip reset to its initial level (here 0.37, to tell it from 0.5).
+    let mut inputs = [
+        0.0,
+        p[1] - 0.1,
+        0.0,
+        0.0,
+        0.0,
+        0.6,
+        0.5,
+        0.5,
+        0.55,
+        0.37,
+        0.42,
+    ];
+    let mut out = [0.0; 3];
+    fsm.think(0.0, 0.008, &inputs, &mut out);
+    assert_eq!(Brain::state(&fsm), Some("stance"));
+    assert!(out[0].is_finite() && out[2].is_finite());
+    assert_eq!(out[1], 0.37);
+    // Past p1 it leaps: the leg is kept (NaN), hip and ankle reset.
+    inputs[1] = p[1] + 0.1;
+    fsm.think(0.008, 0.008, &inputs, &mut out);
+    assert_eq!(Brain::state(&fsm), Some("leap"));
+    assert!(out[0].is_nan());
+    assert_eq!((out[1], out[2]), (0.37, 0.42));
+    assert_eq!(fsm.genome(), p);
+    assert_eq!(fsm.bounds().len(), 14);
+}

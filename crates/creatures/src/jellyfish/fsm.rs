@@ -238,3 +238,37 @@ impl JellyfishFsm {
         }
     }
 }
+
+/// The FSM as a [`crate::brain::Brain`], for `n` dome masses: inputs are
+/// the food level at each dome mass (n), the depth level, the lean of each
+/// dome mass (n, in dome radii), then the pulse's and each steering
+/// actuator's initial level (1 + n); outputs the pulse level and each
+/// steering level (1 + n), "rest" being the initial level.
+impl crate::brain::Brain for JellyfishFsm {
+    fn kind(&self) -> &'static str {
+        "jellyfish-fsm"
+    }
+
+    fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
+        let n = (inputs.len() - 2) / 3;
+        let senses = Senses {
+            food: inputs[..n].to_vec(),
+            depth: inputs[n],
+            time: t,
+            lean: inputs[n + 1..2 * n + 1].to_vec(),
+        };
+        let rest = &inputs[2 * n + 1..];
+        let orders = self.step(&senses, dt);
+        outputs[0] = orders.pulse.unwrap_or(rest[0]);
+        for i in 0..n {
+            outputs[1 + i] = match &orders.steer {
+                Some(levels) => levels[i],
+                None => rest[1 + i],
+            };
+        }
+    }
+
+    fn state(&self) -> Option<&str> {
+        Some(self.behaviour.name())
+    }
+}

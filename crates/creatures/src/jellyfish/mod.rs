@@ -17,6 +17,7 @@ pub mod fsm;
 
 use crate::actuator::Actuator;
 use crate::actuators::ForceMagnitude;
+use crate::brain::Brain;
 use crate::controller::{Actor, Status};
 use crate::sensor::Sensor;
 use crate::sensors::{DepthSensor, FoodSensor};
@@ -111,27 +112,21 @@ impl Actor for Jellyfish {
         }
         let centre = self.body.centre(world);
         let radius = self.body_radius;
-        let senses = Senses {
-            food: self.food.iter().map(|f| f.level(world)).collect(),
-            depth: self.depth.level(world),
-            time: world.time(),
-            lean: self
-                .body
+        let mut inputs: Vec<f64> = self.food.iter().map(|f| f.level(world)).collect();
+        inputs.push(self.depth.level(world));
+        inputs.extend(
+            self.body
                 .dome
                 .iter()
-                .map(|d| (world.position(*d).y - centre.y) / radius)
-                .collect(),
-        };
-        let orders = self.fsm.step(&senses, dt);
-        match orders.pulse {
-            Some(l) => self.pulse.set_level(world, l),
-            None => self.pulse.reset(world),
-        }
-        for (i, s) in self.steer.iter_mut().enumerate() {
-            match &orders.steer {
-                Some(levels) => s.set_level(world, levels[i]),
-                None => s.reset(world),
-            }
+                .map(|d| (world.position(*d).y - centre.y) / radius),
+        );
+        inputs.push(self.pulse.initial_level());
+        inputs.extend(self.steer.iter().map(|s| s.initial_level()));
+        let mut out = vec![0.0; 1 + self.steer.len()];
+        Brain::think(&mut self.fsm, world.time(), dt, &inputs, &mut out);
+        self.pulse.set_level(world, out[0]);
+        for (s, level) in self.steer.iter_mut().zip(&out[1..]) {
+            s.set_level(world, *level);
         }
     }
 

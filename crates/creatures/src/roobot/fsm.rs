@@ -217,3 +217,79 @@ impl HopFsm {
         }
     }
 }
+
+/// Inputs of the FSM as a [`Brain`]: the four sensor levels, the hip's
+/// forward velocity (m/s, unclamped, as Appendix B reads it), then for the
+/// leg, the hip and the ankle their levels now and their initial levels.
+pub const BRAIN_INPUTS: [&str; 11] = [
+    "foot height",
+    "leg angle",
+    "hip forward speed",
+    "time till touchdown",
+    "hip forward velocity, m/s",
+    "leg level",
+    "hip level",
+    "ankle level",
+    "leg initial level",
+    "hip initial level",
+    "ankle initial level",
+];
+
+/// Outputs of the FSM as a [`Brain`]: the leg, hip and ankle levels (NaN:
+/// keep).
+pub const BRAIN_OUTPUTS: [&str; 3] = ["leg", "hip", "ankle"];
+
+impl crate::brain::Brain for HopFsm {
+    fn kind(&self) -> &'static str {
+        "roobot-fsm"
+    }
+
+    /// See [`BRAIN_INPUTS`] and [`BRAIN_OUTPUTS`].
+    fn think(&mut self, _t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
+        let senses = Senses {
+            height: inputs[0],
+            angle: inputs[1],
+            speed: inputs[2],
+            touchdown: inputs[3],
+            hip_velocity: inputs[4],
+        };
+        let orders = self.step(&senses, inputs[5], dt);
+        for (k, c) in [orders.leg, orders.hip, orders.ankle]
+            .into_iter()
+            .enumerate()
+        {
+            outputs[k] = match c {
+                Command::Keep => f64::NAN,
+                Command::Reset => inputs[8 + k],
+                Command::Set(level) => level,
+            };
+        }
+    }
+
+    fn state(&self) -> Option<&str> {
+        Some(self.state.name())
+    }
+
+    fn genome(&self) -> Vec<f64> {
+        self.params.0.to_vec()
+    }
+
+    fn set_genome(&mut self, genome: &[f64]) -> Result<(), String> {
+        crate::brain::check_genome("roobot-fsm", super::PARAM_COUNT, genome)?;
+        self.params.0.copy_from_slice(genome);
+        Ok(())
+    }
+
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.params
+            .0
+            .iter()
+            .zip(super::params::BOUNDS)
+            .map(|(&p, (lo, hi))| crate::brain::around(p, lo, hi))
+            .collect()
+    }
+
+    fn reset(&mut self) {
+        HopFsm::reset(self);
+    }
+}

@@ -20,6 +20,7 @@ pub mod raibert;
 
 use crate::actuator::Actuator;
 use crate::actuators::{JointTorque, SpringRestLength};
+use crate::brain::Brain;
 use crate::controller::{Actor, Status};
 use crate::sensor::Sensor;
 use crate::sensors::{HeightSensor, SpeedSensor, TiltSensor, TouchdownSensor};
@@ -168,21 +169,33 @@ impl Roobot {
     }
 }
 
-fn apply<T: crate::actuator::Actuated>(a: &mut Actuator<T>, world: &mut World, c: Command) {
-    match c {
-        Command::Keep => {}
-        Command::Reset => a.reset(world),
-        Command::Set(level) => a.set_level(world, level),
-    }
-}
-
 impl Actor for Roobot {
     fn act(&mut self, world: &mut World, dt: f64) {
         let senses = self.sensors.read(world);
-        let orders = self.fsm.step(&senses, self.leg.level(), dt);
-        apply(&mut self.leg, world, orders.leg);
-        apply(&mut self.hip, world, orders.hip);
-        apply(&mut self.ankle, world, orders.ankle);
+        let inputs = [
+            senses.height,
+            senses.angle,
+            senses.speed,
+            senses.touchdown,
+            senses.hip_velocity,
+            self.leg.level(),
+            self.hip.level(),
+            self.ankle.level(),
+            self.leg.initial_level(),
+            self.hip.initial_level(),
+            self.ankle.initial_level(),
+        ];
+        let mut out = [0.0; 3];
+        Brain::think(&mut self.fsm, world.time(), dt, &inputs, &mut out);
+        // NaN: the FSM keeps that actuator as it is.
+        if !out[0].is_nan() {
+            self.leg.set_level(world, out[0]);
+        }
+        for (a, level) in [&mut self.hip, &mut self.ankle].into_iter().zip(&out[1..]) {
+            if !level.is_nan() {
+                a.set_level(world, *level);
+            }
+        }
         if self.fsm.last_transition() == Some((HopState::Flight, HopState::Stance)) {
             self.landings += 1;
         }
