@@ -2,21 +2,13 @@
 //! particle name resolved, every mistake reported with its entry and field.
 
 use crate::def::*;
+use crate::entries::{each, one, Builder};
 use crate::error::SceneError;
+use crate::nervous::Handles;
 use crate::source::Source;
 use crate::Scene;
-use animats_creatures::jellyfish::{Jellyfish, JellyfishConstants};
-use animats_creatures::quadruped::{Demo, Model, Quadruped, QuadrupedConstants};
-use animats_creatures::roobot::{BodyConstants, Roobot};
-use animats_creatures::seaworld::{
-    rocks, seaweed, BubbleColumn, BubbleConstants, Random, RocksConstants, SeaweedConstants,
-};
-use animats_creatures::Actor;
 use animats_engine::DVec3;
-use animats_engine::{
-    AngleJointDef, Current, FloorDef, FluidMedium, Gravity, ModelError, NBodyGravity, ParticleDef,
-    ParticleId, ReefWater, SpringDef, Targets, TorqueJointDef, World,
-};
+use animats_engine::{Gravity, ModelError, ParticleId, Targets, World};
 use std::collections::HashMap;
 use toml::Spanned;
 
@@ -27,11 +19,11 @@ use toml::Spanned;
 pub const MAX_PARTICLES: usize = 1_000_000;
 
 /// At least as many particles as any built-in creature has.
-const CREATURE_PARTICLES: usize = 64;
+pub(crate) const CREATURE_PARTICLES: usize = 64;
 
 /// Refuses a count that would take the world past [`MAX_PARTICLES`], before
 /// anything is allocated for it.
-fn room(at: &At, field: &str, count: usize, world: &World) -> Result<(), SceneError> {
+pub(crate) fn room(at: &At, field: &str, count: usize, world: &World) -> Result<(), SceneError> {
     let left = MAX_PARTICLES.saturating_sub(world.len());
     if count > left {
         return Err(at.err(
@@ -123,7 +115,11 @@ impl Names {
             .ok_or_else(|| at.err(field, format!("unknown particle `{name}`")))
     }
 
-    fn targets(&self, at: &At, names: &Option<Vec<String>>) -> Result<Targets, SceneError> {
+    pub(crate) fn targets(
+        &self,
+        at: &At,
+        names: &Option<Vec<String>>,
+    ) -> Result<Targets, SceneError> {
         match names {
             None => Ok(Targets::All),
             Some(list) => Ok(Targets::Only(
@@ -179,407 +175,45 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .map_err(|e| wat.model(e))?;
     }
 
-    // [[particle]]
-    let mut names = Names {
-        ids: HashMap::new(),
+    // Every entry builds itself (`entries/`), in this order: particles and
+    // food first, so that everything else can name them.
+    let mut cx = Builder {
+        src,
+        world,
+        names: Names {
+            ids: HashMap::new(),
+        },
+        list: Vec::with_capacity(def.particle.len()),
+        kinds: Vec::with_capacity(def.particle.len()),
+        handles: Handles::default(),
+        actors: Vec::new(),
+        seed: wd.seed,
+        gravity,
     };
-    let mut name_list = Vec::with_capacity(def.particle.len());
-    let mut kinds: Vec<&'static str> = Vec::with_capacity(def.particle.len());
-    for (k, entry) in def.particle.iter().enumerate() {
-        let p = entry.get_ref();
-        let at = at(src, format!("particle[{k}]"), entry);
-        room(&at, "", 1, &world)?;
-        check_name(&at, &p.name)?;
-        if names.ids.contains_key(&p.name) {
-            return Err(at.err("name", format!("duplicate particle name `{}`", p.name)));
-        }
-        if p.radius.is_none() && p.volume.is_none() {
-            return Err(at.err(
-                "radius",
-                "give the particle a `radius` or a `volume` (or both)",
-            ));
-        }
-        let pdef = ParticleDef {
-            mass: p.mass,
-            position: DVec3::from_array(p.position),
-            velocity: DVec3::from_array(p.velocity),
-            radius: p.radius,
-            volume: p.volume,
-            mu_s: p.mu_s,
-            mu_k: p.mu_k,
-            restitution: p.restitution,
-            fixed: p.fixed,
-        };
-        let id = world.add_particle(pdef).map_err(|e| at.model(e))?;
-        names.ids.insert(p.name.clone(), id);
-        name_list.push(p.name.clone());
-        kinds.push("particle");
-    }
-
-    // [[food]]: before the creatures that smell it.
-    for (k, entry) in def.food.iter().enumerate() {
-        let f = entry.get_ref();
-        let at = at(src, format!("food[{k}]"), entry);
-        room(&at, "", 1, &world)?;
-        check_name(&at, &f.name)?;
-        if names.ids.contains_key(&f.name) {
-            return Err(at.err("name", format!("duplicate particle name `{}`", f.name)));
-        }
-        let position = at.vec3("position", f.position)?;
-        let radius = match f.radius {
-            Some(r) => at.positive("radius", r)?,
-            None => animats_engine::particle::sphere_radius(1e-3),
-        };
-        // Appendix B's food is 1 kg in a litre; it is nailed in place (the
-        // thesis never simulates it) and moved by hand.
-        let id = world
-            .add_particle(
-                ParticleDef::new(1.0)
-                    .with_radius(radius)
-                    .at(position)
-                    .fixed(),
-            )
-            .map_err(|e| at.model(e))?;
-        names.ids.insert(f.name.clone(), id);
-        name_list.push(f.name.clone());
-        kinds.push("food");
-    }
-
-    // [floor]
-    if let Some(entry) = &def.floor {
-        let f = entry.get_ref();
-        let at = at(src, "floor", entry);
-        let targets = names.targets(&at, &f.particles)?;
-        world
-            .add_floor(FloorDef {
-                envelope: f.envelope,
-                static_speed: f.static_speed,
-                rest_speed: f.rest_speed,
-                targets,
-                ..FloorDef::default()
-            })
-            .map_err(|e| at.model(e))?;
-    }
-
-    // [fluid]
-    if let Some(entry) = &def.fluid {
-        let f = entry.get_ref();
-        let at = at(src, "fluid", entry);
-        let current = current(&at, &f.current, gravity.length())?;
-        let targets = names.targets(&at, &f.particles)?;
-        let fluid = FluidMedium {
-            density: f.density,
-            drag_coefficient: f.drag_coefficient,
-            current,
-            targets,
-        };
-        world.add_fluid(fluid).map_err(|e| at.model(e))?;
-    }
-
-    let mut handles = crate::nervous::Handles::default();
-
-    // [[spring]]
-    for (k, entry) in def.spring.iter().enumerate() {
-        let s = entry.get_ref();
-        let at = at(src, format!("spring[{k}]"), entry);
-        let sdef = SpringDef {
-            a: names.one(&at, "a", &s.a)?,
-            b: names.one(&at, "b", &s.b)?,
-            stiffness: s.stiffness,
-            damping: s.damping,
-            rest_length: s.rest_length,
-        };
-        let id = world.add_spring(sdef).map_err(|e| at.model(e))?;
-        crate::nervous::insert(&mut handles.springs, &at, "spring", &s.name, id)?;
-    }
-
-    // [[angle_joint]]
-    for (k, entry) in def.angle_joint.iter().enumerate() {
-        let j = entry.get_ref();
-        let at = at(src, format!("angle_joint[{k}]"), entry);
-        let jdef = AngleJointDef {
-            a: names.one(&at, "a", &j.a)?,
-            joint: names.one(&at, "joint", &j.joint)?,
-            b: names.one(&at, "b", &j.b)?,
-            stiffness: j.stiffness,
-            damping: j.damping,
-            rest_angle: j.rest_angle,
-        };
-        let id = world.add_angle_joint(jdef).map_err(|e| at.model(e))?;
-        crate::nervous::insert(&mut handles.angle_joints, &at, "angle joint", &j.name, id)?;
-    }
-
-    // [[torque_joint]]
-    for (k, entry) in def.torque_joint.iter().enumerate() {
-        let j = entry.get_ref();
-        let at = at(src, format!("torque_joint[{k}]"), entry);
-        let jdef = TorqueJointDef {
-            end: names.one(&at, "end", &j.end)?,
-            joint: names.one(&at, "joint", &j.joint)?,
-            axis: DVec3::from_array(j.axis),
-            torque: j.torque,
-        };
-        let id = world.add_torque_joint(jdef).map_err(|e| at.model(e))?;
-        crate::nervous::insert(&mut handles.torque_joints, &at, "torque joint", &j.name, id)?;
-    }
-
-    // [[constant_force]]
-    for (k, entry) in def.constant_force.iter().enumerate() {
-        let c = entry.get_ref();
-        let at = at(src, format!("constant_force[{k}]"), entry);
-        let ids = match names.targets(&at, &c.particles)? {
-            Targets::All => world.particle_ids().collect(),
-            Targets::Only(ids) => ids,
-        };
-        let force = at.vec3("force", c.force)?;
-        let id = world
-            .add_constant_force(ids, force)
-            .map_err(|e| at.model(e))?;
-        crate::nervous::insert(
-            &mut handles.constant_forces,
-            &at,
-            "constant force",
-            &c.name,
-            (id, force),
-        )?;
-    }
-
-    // [[nbody]]
-    for (k, entry) in def.nbody.iter().enumerate() {
-        let n = entry.get_ref();
-        let at = at(src, format!("nbody[{k}]"), entry);
-        let targets = names.targets(&at, &n.particles)?;
-        world
-            .add_nbody(NBodyGravity::new(n.g, n.softening, targets))
-            .map_err(|e| at.model(e))?;
-    }
-
-    // [[roobot]]
-    let mut actors: Vec<Box<dyn Actor>> = Vec::new();
-    for (k, entry) in def.roobot.iter().enumerate() {
-        let r = entry.get_ref();
-        let at = at(src, format!("roobot[{k}]"), entry);
-        let name = r.name.clone().unwrap_or_else(|| format!("roobot{k}"));
-        check_name(&at, &name)?;
-        let position = at.vec3("position", r.position)?;
-        let heading = at.finite("heading", r.heading)?;
-        let params = match &r.params {
-            None => crate::params::load("evolved", None),
-            Some(ParamsEntry::Inline(v)) => crate::params::check(src.file, "params", v),
-            Some(ParamsEntry::Named(n)) if crate::params::BUILT_IN.contains(&n.as_str()) => {
-                crate::params::load(n, None)
-            }
-            Some(ParamsEntry::Named(path)) => {
-                let base = std::path::Path::new(src.file)
-                    .parent()
-                    .unwrap_or(std::path::Path::new(""));
-                crate::params::load(&base.join(path).to_string_lossy(), None)
-            }
-        }
-        .map_err(|e| at.err("params", e.to_string()))?;
-        room(&at, "", CREATURE_PARTICLES, &world)?;
-        let first = world.len();
-        let roobot = Roobot::build(
-            &mut world,
-            &name,
-            &BodyConstants::STANDARD,
-            position,
-            heading,
-            params,
-        )
-        .map_err(|e| at.model(e))?;
-        for (i, part) in ["hip", "foot", "head", "tail1", "tail2"].iter().enumerate() {
-            let full = format!("{name}.{part}");
-            if names.ids.contains_key(&full) {
-                return Err(at.err("name", format!("duplicate particle name `{full}`")));
-            }
-            names
-                .ids
-                .insert(full.clone(), ParticleId::from_index(first + i));
-            name_list.push(full);
-            kinds.push("roobot");
-        }
-        actors.push(Box::new(roobot));
-    }
-
-    let mut namer = Namer {
-        names: &mut names,
-        list: &mut name_list,
-        kinds: &mut kinds,
-    };
-    let seed = wd.seed;
-
-    // [[jellyfish]]
-    for (k, entry) in def.jellyfish.iter().enumerate() {
-        let j = entry.get_ref();
-        let at = at(src, format!("jellyfish[{k}]"), entry);
-        let name = j.name.clone().unwrap_or_else(|| format!("jellyfish{k}"));
-        check_name(&at, &name)?;
-        let food = namer.names.ids.get(&j.food).copied().ok_or_else(|| {
-            at.err(
-                "food",
-                format!(
-                    "no particle `{}` to track: add a [[food]] entry named so",
-                    j.food
-                ),
-            )
-        })?;
-        let position = at.vec3("position", j.position)?;
-        let mut constants = JellyfishConstants::new(j.dome_mass, j.tentacle_mass);
-        if let Some(f) = j.pulse_force {
-            constants.pulse_force = at.positive("pulse_force", f)?;
-        }
-        if let Some(f) = j.steer_force {
-            constants.steer_force = at.finite("steer_force", f)?.abs();
-        }
-        if let Some(c) = j.ceiling {
-            constants.ceiling = at.positive("ceiling", c)?;
-        }
-        room(&at, "", CREATURE_PARTICLES, &world)?;
-        let first = world.len();
-        let jelly = Jellyfish::build(&mut world, &name, &constants, position, food)
-            .map_err(|e| at.model(e))?;
-        let mut parts: Vec<String> = (0..constants.tentacles)
-            .map(|i| format!("{name}.dome{i}"))
-            .collect();
-        for i in 0..constants.tentacles {
-            parts.extend((0..constants.segments).map(|s| format!("{name}.tentacle{i}.{s}")));
-        }
-        let domes = constants.tentacles;
-        namer.add(&at, first, &parts, |i| {
-            if i < domes {
-                "dome"
-            } else {
-                "tentacle"
-            }
-        })?;
-        actors.push(Box::new(jelly));
-    }
-
-    // [[seaweed]]
-    for (k, entry) in def.seaweed.iter().enumerate() {
-        let w = entry.get_ref();
-        let at = at(src, format!("seaweed[{k}]"), entry);
-        let name = w.name.clone().unwrap_or_else(|| format!("seaweed{k}"));
-        check_name(&at, &name)?;
-        let d = SeaweedConstants::default();
-        let c = SeaweedConstants {
-            segments: w.segments.unwrap_or(d.segments),
-            segment_length: w.segment_length.unwrap_or(d.segment_length),
-            mass: w.mass.unwrap_or(d.mass),
-            density: w.density.unwrap_or(d.density),
-            stiffness: w.stiffness.unwrap_or(d.stiffness),
-            damping: w.damping.unwrap_or(d.damping),
-        };
-        let position = at.vec3("position", w.position)?;
-        room(&at, "segments", c.segments.saturating_add(1), &world)?;
-        let first = world.len();
-        seaweed::build(&mut world, &c, position).map_err(|e| at.model(e))?;
-        let parts: Vec<String> = (0..=c.segments).map(|i| format!("{name}.{i}")).collect();
-        namer.add(&at, first, &parts, |_| "seaweed")?;
-    }
-
-    // [[bubble_column]]
-    for (k, entry) in def.bubble_column.iter().enumerate() {
-        let b = entry.get_ref();
-        let at = at(src, format!("bubble_column[{k}]"), entry);
-        let name = b.name.clone().unwrap_or_else(|| format!("bubbles{k}"));
-        check_name(&at, &name)?;
-        let d = BubbleConstants::default();
-        let c = BubbleConstants {
-            bubbles: b.bubbles.unwrap_or(d.bubbles),
-            interval: b.interval.map_or(d.interval, |[a, z]| (a, z)),
-            radius: b.radius.map_or(d.radius, |[a, z]| (a, z)),
-            density: b.density.unwrap_or(d.density),
-            surface: b.surface.unwrap_or(d.surface),
-            spread: d.spread,
-        };
-        let position = at.vec3("position", b.position)?;
-        let base = DVec3::new(position.x, 0.0, position.z);
-        room(&at, "bubbles", c.bubbles, &world)?;
-        let first = world.len();
-        let column = BubbleColumn::build(
-            &mut world,
-            &c,
-            base,
-            Random::for_entry(seed, 1000 + k as u64),
-        )
-        .map_err(|e| at.model(e))?;
-        let parts: Vec<String> = (0..c.bubbles).map(|i| format!("{name}.{i}")).collect();
-        namer.add(&at, first, &parts, |_| "bubble")?;
-        actors.push(Box::new(column));
-    }
-
-    // [[rocks]]
-    for (k, entry) in def.rocks.iter().enumerate() {
-        let r = entry.get_ref();
-        let at = at(src, format!("rocks[{k}]"), entry);
-        let name = r.name.clone().unwrap_or_else(|| "rock".into());
-        check_name(&at, &name)?;
-        let d = RocksConstants::default();
-        let c = RocksConstants {
-            count: r.count.unwrap_or(d.count),
-            mass: r.mass.map_or(d.mass, |[a, z]| (a, z)),
-            density: r.density.unwrap_or(d.density),
-            from: r.from.map_or(Ok(d.from), |v| at.vec3("from", v))?,
-            to: r.to.map_or(Ok(d.to), |v| at.vec3("to", v))?,
-        };
-        room(&at, "count", c.count, &world)?;
-        let first = world.len();
-        rocks::scatter(
-            &mut world,
-            &c,
-            &mut Random::for_entry(seed, 2000 + k as u64),
-        )
-        .map_err(|e| at.model(e))?;
-        let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
-        namer.add(&at, first, &parts, |_| "rock")?;
-    }
-
-    // [[quadruped]]
-    for (k, entry) in def.quadruped.iter().enumerate() {
-        let q = entry.get_ref();
-        let at = at(src, format!("quadruped[{k}]"), entry);
-        let name = q.name.clone().unwrap_or_else(|| format!("quadruped{k}"));
-        check_name(&at, &name)?;
-        let model = Model::from_number(q.model)
-            .ok_or_else(|| at.err("model", format!("must be 1, 2 or 3, got {}", q.model)))?;
-        let position = at.vec3("position", q.position)?;
-        let heading = at.finite("heading", q.heading)?;
-        let demo_at = at.finite("demo_at", q.demo_at)?;
-        room(&at, "", CREATURE_PARTICLES, &world)?;
-        let first = world.len();
-        let mut quad = Quadruped::build(
-            &mut world,
-            &name,
-            model,
-            &QuadrupedConstants::default(),
-            position,
-            heading,
-        )
-        .map_err(|e| at.model(e))?;
-        quad.demo = (demo_at >= 0.0).then_some(Demo { at: demo_at });
-        // Its leg springs by name, for actuators: `NAME.legI` (corner or
-        // knee to foot) and, for model 3, `NAME.legI.back` / `NAME.legI.side`
-        // (foot to the front–back and left–right neighbouring corners).
-        for (i, leg) in quad.legs.iter().enumerate() {
-            let named = |suffix: &str| Some(format!("{name}.leg{i}{suffix}"));
-            crate::nervous::insert(&mut handles.springs, &at, "spring", &named(""), leg.spring)?;
-            if let Some((back, side)) = leg.supports {
-                crate::nervous::insert(&mut handles.springs, &at, "spring", &named(".back"), back)?;
-                crate::nervous::insert(&mut handles.springs, &at, "spring", &named(".side"), side)?;
-            }
-        }
-        let mut parts: Vec<String> = (0..4).map(|i| format!("{name}.corner{i}")).collect();
-        for i in 0..4 {
-            if model == Model::TwoSegment {
-                parts.push(format!("{name}.knee{i}"));
-            }
-            parts.push(format!("{name}.foot{i}"));
-        }
-        namer.add(&at, first, &parts, |_| "quadruped")?;
-        actors.push(Box::new(quad));
-    }
+    each(&def.particle, "particle", &mut cx)?;
+    each(&def.food, "food", &mut cx)?;
+    one(&def.floor, "floor", &mut cx)?;
+    one(&def.fluid, "fluid", &mut cx)?;
+    each(&def.spring, "spring", &mut cx)?;
+    each(&def.angle_joint, "angle_joint", &mut cx)?;
+    each(&def.torque_joint, "torque_joint", &mut cx)?;
+    each(&def.constant_force, "constant_force", &mut cx)?;
+    each(&def.nbody, "nbody", &mut cx)?;
+    each(&def.roobot, "roobot", &mut cx)?;
+    each(&def.jellyfish, "jellyfish", &mut cx)?;
+    each(&def.seaweed, "seaweed", &mut cx)?;
+    each(&def.bubble_column, "bubble_column", &mut cx)?;
+    each(&def.rocks, "rocks", &mut cx)?;
+    each(&def.quadruped, "quadruped", &mut cx)?;
+    let Builder {
+        mut world,
+        names,
+        list: name_list,
+        kinds,
+        handles,
+        actors,
+        ..
+    } = cx;
 
     let nervous = crate::nervous::build(def, src, &names, &handles, &mut world)?;
     let evolve = match &def.evolve {
@@ -612,89 +246,6 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         actors,
         nervous,
         evolve,
-    })
-}
-
-/// Gives names to the particles a builder just added.
-struct Namer<'a> {
-    names: &'a mut Names,
-    list: &'a mut Vec<String>,
-    kinds: &'a mut Vec<&'static str>,
-}
-
-impl Namer<'_> {
-    fn add(
-        &mut self,
-        at: &At,
-        first: usize,
-        parts: &[String],
-        kind: impl Fn(usize) -> &'static str,
-    ) -> Result<(), SceneError> {
-        for (i, full) in parts.iter().enumerate() {
-            self.kinds.push(kind(i));
-            if self.names.ids.contains_key(full) {
-                return Err(at.err("name", format!("duplicate particle name `{full}`")));
-            }
-            self.names
-                .ids
-                .insert(full.clone(), ParticleId::from_index(first + i));
-            self.list.push(full.clone());
-        }
-        Ok(())
-    }
-}
-
-fn current(at: &At, c: &CurrentEntry, g: f64) -> Result<Current, SceneError> {
-    Ok(match c {
-        CurrentEntry::Still => Current::Still,
-        CurrentEntry::Uniform { velocity } => {
-            Current::Uniform(at.vec3("current.velocity", *velocity)?)
-        }
-        CurrentEntry::Reef {
-            surface,
-            amplitude,
-            wavelength,
-            period,
-            direction,
-            drift,
-        } => {
-            let d = ReefWater::default();
-            let wavelength =
-                at.positive("current.wavelength", wavelength.unwrap_or(d.wavelength))?;
-            let period = match period {
-                Some(p) => at.positive("current.period", *p)?,
-                None if g > 0.0 => ReefWater::deep_water_period(wavelength, g),
-                None => d.period,
-            };
-            let direction = match direction {
-                Some(v) => at.vec3("current.direction", *v)?,
-                None => d.direction,
-            };
-            if DVec3::new(direction.x, 0.0, direction.z).length() == 0.0 {
-                return Err(at.err(
-                    "current.direction",
-                    "must have a horizontal (x or z) component",
-                ));
-            }
-            let amplitude = at.finite("current.amplitude", amplitude.unwrap_or(d.amplitude))?;
-            if amplitude < 0.0 {
-                return Err(at.err(
-                    "current.amplitude",
-                    format!("must be >= 0, got {amplitude}"),
-                ));
-            }
-            Current::Reef(ReefWater {
-                surface: at.finite("current.surface", surface.unwrap_or(d.surface))?,
-                amplitude,
-                wavelength,
-                period,
-                direction,
-                drift: match drift {
-                    Some(v) => at.vec3("current.drift", *v)?,
-                    None => d.drift,
-                },
-            })
-        }
     })
 }
 

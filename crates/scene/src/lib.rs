@@ -25,6 +25,7 @@
 
 pub mod build;
 pub mod def;
+pub(crate) mod entries;
 pub mod error;
 pub mod evaluate;
 pub(crate) mod nervous;

@@ -1,0 +1,68 @@
+//! `[[quadruped]]`: one of the thesis's three quadrupeds, its leg springs named for actuators.
+
+use super::*;
+
+impl Build for QuadrupedEntry {
+    fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
+        let q = self;
+        let name = q.name.clone().unwrap_or_else(|| format!("quadruped{k}"));
+        check_name(at, &name)?;
+        let model = Model::from_number(q.model)
+            .ok_or_else(|| at.err("model", format!("must be 1, 2 or 3, got {}", q.model)))?;
+        let position = at.vec3("position", q.position)?;
+        let heading = at.finite("heading", q.heading)?;
+        let demo_at = at.finite("demo_at", q.demo_at)?;
+        room(at, "", CREATURE_PARTICLES, &cx.world)?;
+        let first = cx.world.len();
+        let mut quad = Quadruped::build(
+            &mut cx.world,
+            &name,
+            model,
+            &QuadrupedConstants::default(),
+            position,
+            heading,
+        )
+        .map_err(|e| at.model(e))?;
+        quad.demo = (demo_at >= 0.0).then_some(Demo { at: demo_at });
+        // Its leg springs by name, for actuators: `NAME.legI` (corner or
+        // knee to foot) and, for model 3, `NAME.legI.back` / `NAME.legI.side`
+        // (foot to the front–back and left–right neighbouring corners).
+        for (i, leg) in quad.legs.iter().enumerate() {
+            let named = |suffix: &str| Some(format!("{name}.leg{i}{suffix}"));
+            crate::nervous::insert(
+                &mut cx.handles.springs,
+                at,
+                "spring",
+                &named(""),
+                leg.spring,
+            )?;
+            if let Some((back, side)) = leg.supports {
+                crate::nervous::insert(
+                    &mut cx.handles.springs,
+                    at,
+                    "spring",
+                    &named(".back"),
+                    back,
+                )?;
+                crate::nervous::insert(
+                    &mut cx.handles.springs,
+                    at,
+                    "spring",
+                    &named(".side"),
+                    side,
+                )?;
+            }
+        }
+        let mut parts: Vec<String> = (0..4).map(|i| format!("{name}.corner{i}")).collect();
+        for i in 0..4 {
+            if model == Model::TwoSegment {
+                parts.push(format!("{name}.knee{i}"));
+            }
+            parts.push(format!("{name}.foot{i}"));
+        }
+        cx.add(at, first, &parts, |_| "quadruped")?;
+        cx.actors.push(Box::new(quad));
+
+        Ok(())
+    }
+}
