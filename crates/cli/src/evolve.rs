@@ -10,7 +10,7 @@ use animats_render::{step_plot_png, Plot, Series};
 use animats_scene::evaluate::SceneProblem;
 use animats_scene::params::{format_best, LaneBest};
 use animats_viewer::exhibition::Showcase;
-use animats_viewer::Exhibition;
+use animats_viewer::{BestBrain, Exhibition, SceneExhibition};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -52,8 +52,10 @@ pub struct Args {
     /// Seconds between checkpoints (0: after every batch of generations).
     #[arg(long, default_value_t = 5.0, value_parser = crate::non_negative_f64)]
     checkpoint_every: f64,
-    /// Watch it live in the browser: every lane's current best hopping side
-    /// by side. The view stays open after the run until Ctrl-C.
+    /// Watch it live in the browser: the roobot's lanes' current bests
+    /// hopping side by side, or the scene driven by its best brain so far
+    /// (restarted with the newest best when each run ends). The view stays
+    /// open after the run until Ctrl-C.
     #[arg(long)]
     view: bool,
     #[command(flatten)]
@@ -187,16 +189,35 @@ fn scene_best(state: &State, file: &str, text: &str) -> Result<Option<String>, F
         .map_err(Failure::Other)
 }
 
-/// Shows every lane's best so far to the viewer.
-fn publish(showcase: &Showcase, state: &State) {
-    for l in &state.lanes {
-        if let Some(b) = &l.best {
-            let mut params = animats_creatures::roobot::HopParams::INITIAL;
-            params.0.copy_from_slice(&b.genome);
-            showcase.set_best(l.lane, params, b.fitness);
+/// What the live view shows: the roobot's lanes side by side, or a scene
+/// driven by its best brain.
+enum Watched {
+    Roobot(Showcase),
+    Scene(BestBrain),
+}
+
+/// Shows the bests so far to the viewer.
+fn publish(watched: &Watched, state: &State) {
+    match watched {
+        Watched::Roobot(showcase) => {
+            for l in &state.lanes {
+                if let Some(b) = &l.best {
+                    let mut params = animats_creatures::roobot::HopParams::INITIAL;
+                    params.0.copy_from_slice(&b.genome);
+                    showcase.set_best(l.lane, params, b.fitness);
+                }
+            }
+            showcase.set_generation(state.generation(), state.config.generations);
+        }
+        Watched::Scene(board) => {
+            if let Some(l) = state.best_lane() {
+                if let Some(b) = &l.best {
+                    board.set_best(&b.genome, b.fitness, l.lane);
+                }
+            }
+            board.set_generation(state.generation(), state.config.generations);
         }
     }
-    showcase.set_generation(state.generation(), state.config.generations);
 }
 
 /// Runs the command.
@@ -255,11 +276,6 @@ pub fn run(args: Args) -> Result<(), Failure> {
                     file: problem.file().to_string(),
                     text: animats_scene::read(path).map_err(|e| input(e.to_string()))?,
                 };
-                if args.view {
-                    return Err(input(
-                        "--view shows the roobot's lanes only; evolve the scene without it and watch DIR/best.toml with `animats view`",
-                    ));
-                }
             }
             if let Some(o) = args.optimiser {
                 config.optimiser = o;
@@ -287,14 +303,28 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     let viewing = if args.view {
-        let showcase = Showcase::new(state.config.lanes);
-        publish(&showcase, &state);
-        let exhibition =
-            Exhibition::new(showcase.clone(), state.config.settings()).map_err(Failure::Other)?;
+        let (watched, stage): (Watched, Box<dyn animats_viewer::Stage>) =
+            match &state.config.problem {
+                ProblemSpec::Roobot { .. } => {
+                    let showcase = Showcase::new(state.config.lanes);
+                    let exhibition = Exhibition::new(showcase.clone(), state.config.settings())
+                        .map_err(Failure::Other)?;
+                    (Watched::Roobot(showcase), Box::new(exhibition))
+                }
+                ProblemSpec::Scene { file, text } => {
+                    let problem =
+                        SceneProblem::parse(text, file).map_err(|e| input(e.to_string()))?;
+                    let board = BestBrain::default();
+                    let exhibition =
+                        SceneExhibition::new(problem, board.clone()).map_err(Failure::Other)?;
+                    (Watched::Scene(board), Box::new(exhibition))
+                }
+            };
+        publish(&watched, &state);
         let server = args.serving.bind(1.0)?;
         let stop = stop.clone();
-        let thread = std::thread::spawn(move || server.serve(Box::new(exhibition), stop));
-        Some((showcase, thread))
+        let thread = std::thread::spawn(move || server.serve(stage, stop));
+        Some((watched, thread))
     } else {
         None
     };
@@ -332,8 +362,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
             .map_err(Failure::Other)?;
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
-        if let Some((showcase, _)) = &viewing {
-            publish(showcase, &state);
+        if let Some((watched, _)) = &viewing {
+            publish(watched, &state);
         }
         bar.set_position(state.generation());
         let message = format!(

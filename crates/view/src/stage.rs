@@ -61,6 +61,22 @@ impl SceneStage {
         Ok(SceneStage { path, scene, focus })
     }
 
+    /// A scene already built (`path` names it), following as
+    /// [`SceneStage::following`] does; a reset reloads `path`.
+    pub fn from_scene(
+        path: PathBuf,
+        scene: Scene,
+        follow: Option<&str>,
+    ) -> Result<SceneStage, String> {
+        let focus = focus_of(&scene, follow).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok(SceneStage { path, scene, focus })
+    }
+
+    /// The scene being played.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
     /// Indices of the particles followed (empty: none).
     pub fn followed(&self) -> &[usize] {
         &self.focus

@@ -139,3 +139,43 @@ fn the_exhibition_shows_each_lane_as_its_fitness_was_measured() {
         .expect("note")
         .contains("generation 1000 of 1000"));
 }
+
+/// `evolve SCENE --view`: the scene plays the best brain so far and, when
+/// a run ends as an evaluation would, starts again with the newest best.
+#[test]
+fn a_scene_exhibition_replays_the_newest_best_brain() {
+    use animats_viewer::{BestBrain, SceneExhibition};
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/walker.toml"),
+    )
+    .unwrap()
+    .replace("duration = 10.0\nparticles", "duration = 0.5\nparticles");
+    let problem = animats_scene::evaluate::SceneProblem::parse(&text, "walker.toml").unwrap();
+    let board = BestBrain::default();
+    let mut show = SceneExhibition::new(problem.clone(), board.clone()).unwrap();
+    assert!(show.note().unwrap().contains("the scene's own brain"));
+    let dt = show.dt();
+    let mut g = problem.start().to_vec();
+    g[0] = 3.0; // another frequency
+    board.set_best(&g, 123.0, 0);
+    // It finishes the run it is showing (0.5 s), then restarts with the best.
+    let mut restarted = false;
+    for _ in 0..2000 {
+        let before = show.time();
+        show.step(dt).unwrap();
+        if show.time() < before {
+            restarted = true;
+            break;
+        }
+    }
+    assert!(restarted, "the run of 0.5 s ended and started again");
+    assert_eq!(show.time(), 0.0);
+    assert!(
+        show.note()
+            .unwrap()
+            .contains("showing fitness 123.00 (lane 0)"),
+        "{:?}",
+        show.note()
+    );
+    assert!(show.focus().is_some(), "it follows the [evolve] particles");
+}
