@@ -213,7 +213,8 @@ pub struct State {
     pub config: Config,
     /// Each lane.
     pub lanes: Vec<Lane>,
-    /// One row per lane per generation, in (generation, lane) order.
+    /// One row per lane per generation (the roobot's: per improvement), in
+    /// (generation, lane) order.
     pub log: Vec<LogRow>,
     /// Evaluations done so far.
     pub evaluations: u64,
@@ -320,6 +321,11 @@ impl State {
             rows.extend(r?);
         }
         self.evaluations = self.lanes.iter().map(|l| l.evaluations).sum();
+        // The roobot's log (Table 6's shape) is its improvements only: a long
+        // run keeps as few rows as before in memory and in its checkpoint.
+        if self.config.problem.is_roobot() {
+            rows.retain(|r| r.improved.is_some());
+        }
         rows.sort_by_key(|r| (r.generation, r.lane));
         self.log.extend(rows);
         Ok(())
