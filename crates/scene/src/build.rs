@@ -223,6 +223,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             &names,
             &nervous,
             &world,
+            dt,
         )?),
         None => None,
     };

@@ -25,6 +25,9 @@ use std::fmt;
 /// The longest evaluation, s (a simulated day).
 pub const MAX_DURATION: f64 = 86_400.0;
 
+/// The most steps an evaluation may take (as `animats simulate` allows).
+pub const MAX_STEPS: f64 = 1e12;
+
 /// A scene's `[evolve]` table, resolved against its world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvolveSpec {
@@ -53,6 +56,7 @@ impl EvolveSpec {
         names: &Names,
         nervous: &NervousSystem,
         world: &World,
+        dt: f64,
     ) -> Result<EvolveSpec, SceneError> {
         let index = nervous.controller(&e.controller).ok_or_else(|| {
             at.err(
@@ -65,6 +69,15 @@ impl EvolveSpec {
             return Err(at.err(
                 "duration",
                 format!("must be at most {MAX_DURATION} s (a simulated day), got {duration}"),
+            ));
+        }
+        if duration / dt > MAX_STEPS {
+            return Err(at.err(
+                "duration",
+                format!(
+                    "{duration} s at dt = {dt} s is {:.3e} steps, more than {MAX_STEPS:e}: raise dt or shorten the evaluation",
+                    duration / dt
+                ),
             ));
         }
         let particles = match &e.particles {

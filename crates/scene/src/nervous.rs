@@ -382,10 +382,18 @@ pub(crate) fn brain(
                     "a neural controller needs inputs, a clock, or both",
                 ));
             }
-            let mut net = Neural::new(c.inputs.len(), &hidden, n, clock);
-            if net.weights.len() > 1_000_000 {
-                return Err(at.err("hidden", "more than 1,000,000 weights"));
+            // Counted before anything is allocated.
+            let mut sizes = vec![c.inputs.len() + if clock.is_some() { 2 } else { 0 }];
+            sizes.extend(&hidden);
+            sizes.push(n);
+            let count = Neural::weight_count(&sizes);
+            if count > 1_000_000 {
+                return Err(at.err(
+                    "hidden",
+                    format!("{count} weights and biases: more than the limit of 1,000,000"),
+                ));
             }
+            let mut net = Neural::new(c.inputs.len(), &hidden, n, clock);
             match &c.weights {
                 Some(w) => {
                     net.set_genome(w).map_err(|_| {

@@ -264,6 +264,25 @@ fn mistakes_are_refused_naming_the_entry_and_field() {
         e.contains("evolve.fail_on_touch: unknown particle `z`"),
         "{e}"
     );
+    // Sizes that would exhaust memory or time are refused before anything runs.
+    let huge = PAIR.replacen(
+        "kind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 2.0\namplitude = [0.3]\nphase = [0.5]\noffset = [0.4]",
+        "kind = \"neural\"\ninputs = [\"gap\"]\noutputs = [\"m\"]\nhidden = [4096, 4096, 4096, 4096]",
+        1,
+    );
+    let e = refused(&huge);
+    assert!(
+        e.contains("controller[0].hidden: 50356225 weights and biases: more than the limit"),
+        "{e}"
+    );
+    let e = refused(&format!(
+        "{}\n[evolve]\ncontroller = \"osc\"\nduration = 86000.0\n",
+        PAIR.replace("dt = 0.001", "dt = 1e-9")
+    ));
+    assert!(
+        e.contains("evolve.duration: 86000 s at dt = 0.000000001 s is 8.600e13 steps"),
+        "{e}"
+    );
     // Springs with the same name.
     let e = refused(&PAIR.replacen(
         "[[actuator]]",
