@@ -55,6 +55,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
             seed: 1,
             lane: 0,
             sigma: Some(0.02),
+            restarts: 0,
         };
         // A population as CMA-ES asks it late in a run, around the evolved
         // brain: nearly every evaluation runs its full length.

@@ -30,6 +30,10 @@ pub struct Args {
     /// cma-es 4 + 3 ln n).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     population: Option<u64>,
+    /// CMA-ES only: start again with twice the population, up to this many
+    /// times, when a run converges or stagnates (IPOP).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=20))]
+    restarts: Option<u32>,
     /// Generations per lane (a resumed run can be given a new total).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     generations: Option<u64>,
@@ -281,6 +285,15 @@ pub fn run(args: Args) -> Result<(), Failure> {
                 config.optimiser = o;
             }
             config.population = args.population.map(|p| p as usize);
+            if let Some(r) = args.restarts {
+                if config.optimiser != OptimiserKind::CmaEs {
+                    return Err(input(format!(
+                        "--restarts is for --optimiser cma-es, not {}",
+                        config.optimiser.name()
+                    )));
+                }
+                config.restarts = r;
+            }
             let state = State::new(config).map_err(input)?;
             writable(&dir)?;
             (dir, state)

@@ -11,6 +11,17 @@
 //!
 //! It minimises internally; [`Optimiser`] maximises, so fitness is negated.
 //!
+//! **Restarts** (IPOP, Auger & Hansen 2005), when asked for: a run that has
+//! converged (σ × the largest axis of C below 1e-12 × σ₀), whose C is
+//! ill-conditioned (condition number above 1e14), or that has not improved
+//! its best for `100 + 30 n / λ` generations starts again with twice the
+//! population, from a point drawn uniformly in the bounds (without bounds,
+//! from the start), with σ₀. The best so far is kept across restarts.
+//! Whether or not restarts were asked for, a state that has broken down
+//! numerically (σ beyond 1e8 σ₀, or anything non-finite: what a run does
+//! long after it has converged) starts afresh from the best so far with the
+//! same population, so that a long evolution never asks for NaN.
+//!
 //! **Bounds**, when given, are handled in the unit box: the strategy works
 //! on `y` with `genome = lo + (hi − lo) y`, starts at the start genome with
 //! step size σ₀ (default 0.3) in those units, evaluates the candidate
@@ -55,6 +66,23 @@ pub struct CmaEs {
     generation: u64,
     pending: Vec<Vec<f64>>,
     best: BestSoFar,
+    /// Where the first run started (a genome), for restarts without bounds.
+    #[serde(default)]
+    start: Vec<f64>,
+    /// σ₀.
+    #[serde(default)]
+    sigma0: f64,
+    /// Restarts still allowed.
+    #[serde(default)]
+    restarts_left: u32,
+    /// Restarts done.
+    #[serde(default)]
+    pub restarts_done: u32,
+    /// The best value (minimised) of this run, and generations since it improved.
+    #[serde(default)]
+    run_best: Option<f64>,
+    #[serde(default)]
+    stale: u64,
 }
 
 impl CmaEs {
@@ -141,7 +169,64 @@ impl CmaEs {
             generation: 0,
             pending: Vec::new(),
             best: BestSoFar::default(),
+            start: s.start.clone(),
+            sigma0: s.sigma.unwrap_or(0.3),
+            restarts_left: s.restarts,
+            restarts_done: 0,
+            run_best: None,
+            stale: 0,
         }
+    }
+
+    /// Whether this run is done: converged, ill-conditioned or stagnant.
+    fn run_is_over(&self) -> bool {
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for d in &self.d {
+            lo = lo.min(*d);
+            hi = hi.max(*d);
+        }
+        let patience = 100 + (30 * self.n).div_ceil(self.lambda) as u64;
+        self.sigma * hi < 1e-12 * self.sigma0 || hi > 1e7 * lo || self.stale >= patience
+    }
+
+    /// Whether the state has broken down numerically: σ beyond 1e8 × σ₀ or
+    /// anything non-finite. Long after a run has converged, with the fitness
+    /// flat to the last bit, σ drifts up as C's axes shrink until σ
+    /// overflows.
+    fn broken(&self) -> bool {
+        !(self.sigma.is_finite() && self.sigma <= 1e8 * self.sigma0)
+            || self.mean.iter().chain(&self.c).any(|x| !x.is_finite())
+    }
+
+    /// Starts a new run of population `lambda`, keeping the best, the
+    /// generation count and the random streams' names: an IPOP restart from
+    /// a random point in the bounds (`random`), or a fresh run from the best
+    /// so far.
+    fn restart(&mut self, lambda: usize, random: bool, restarts_left: u32) {
+        let mut rng = Random::for_evaluation(self.seed ^ 0x4950_4f50, self.lane, self.generation);
+        let start = match (&self.bounds, random, self.best.get()) {
+            (Some(b), true, _) => (0..self.n)
+                .map(|i| b.lo[i] + b.width(i) * rng.uniform())
+                .collect(),
+            (_, false, Some((best, _))) => best.to_vec(),
+            _ => self.start.clone(),
+        };
+        let setup = Setup {
+            kind: crate::optimiser::OptimiserKind::CmaEs,
+            start,
+            bounds: self.bounds.clone(),
+            population: Some(lambda),
+            seed: self.seed,
+            lane: self.lane,
+            sigma: Some(self.sigma0),
+            restarts: restarts_left,
+        };
+        let mut next = CmaEs::new(&setup);
+        next.generation = self.generation;
+        next.best = std::mem::take(&mut self.best);
+        next.start = std::mem::take(&mut self.start);
+        next.restarts_done = self.restarts_done + u32::from(random);
+        *self = next;
     }
 
     /// Candidates per generation.
@@ -336,6 +421,23 @@ impl Optimiser for CmaEs {
         }
         self.pending.clear();
         self.generation += 1;
+        if self.restarts_left > 0 {
+            let top = values[order[0]];
+            if self.run_best.map_or(true, |b| top < b) {
+                self.run_best = Some(top);
+                self.stale = 0;
+            } else {
+                self.stale += 1;
+            }
+            if self.run_is_over() || self.broken() {
+                let left = self.restarts_left - 1;
+                self.restart(2 * self.lambda, true, left);
+                return Ok(());
+            }
+        }
+        if self.broken() {
+            self.restart(self.lambda, false, 0);
+        }
         Ok(())
     }
 

@@ -134,6 +134,9 @@ pub struct Setup {
     /// CMA-ES's initial step size: in units of the bounds' widths when
     /// bounded (default 0.3), absolute otherwise (default 0.3).
     pub sigma: Option<f64>,
+    /// CMA-ES's restarts with a doubled population (IPOP) when a run
+    /// converges or stagnates; 0: none.
+    pub restarts: u32,
 }
 
 impl Setup {
@@ -178,8 +181,8 @@ pub enum AnyOptimiser {
     HillClimber(HillClimber),
     /// See [`Ga`].
     Ga(Ga),
-    /// See [`CmaEs`].
-    CmaEs(CmaEs),
+    /// See [`CmaEs`] (boxed: its state is the largest by far).
+    CmaEs(Box<CmaEs>),
 }
 
 impl AnyOptimiser {
@@ -189,7 +192,7 @@ impl AnyOptimiser {
         Ok(match setup.kind {
             OptimiserKind::HillClimber => AnyOptimiser::HillClimber(HillClimber::from_setup(setup)),
             OptimiserKind::Ga => AnyOptimiser::Ga(Ga::new(setup)),
-            OptimiserKind::CmaEs => AnyOptimiser::CmaEs(CmaEs::new(setup)),
+            OptimiserKind::CmaEs => AnyOptimiser::CmaEs(Box::new(CmaEs::new(setup))),
         })
     }
 
@@ -206,7 +209,7 @@ impl AnyOptimiser {
         match self {
             AnyOptimiser::HillClimber(o) => o,
             AnyOptimiser::Ga(o) => o,
-            AnyOptimiser::CmaEs(o) => o,
+            AnyOptimiser::CmaEs(o) => o.as_ref(),
         }
     }
 
@@ -214,7 +217,7 @@ impl AnyOptimiser {
         match self {
             AnyOptimiser::HillClimber(o) => o,
             AnyOptimiser::Ga(o) => o,
-            AnyOptimiser::CmaEs(o) => o,
+            AnyOptimiser::CmaEs(o) => o.as_mut(),
         }
     }
 }

@@ -79,6 +79,9 @@ pub struct Config {
     pub optimiser: OptimiserKind,
     /// Candidates per generation; `None`: the optimiser's default.
     pub population: Option<usize>,
+    /// CMA-ES's IPOP restarts (0: none).
+    #[serde(default)]
+    pub restarts: u32,
     /// What is evolved.
     pub problem: ProblemSpec,
 }
@@ -93,6 +96,7 @@ impl Config {
             seed,
             optimiser: OptimiserKind::HillClimber,
             population: None,
+            restarts: 0,
             problem: ProblemSpec::Roobot {
                 start: HopParams::INITIAL.0.to_vec(),
                 seconds: 20.0,
@@ -149,6 +153,7 @@ impl Config {
             seed: self.seed,
             lane,
             sigma: None,
+            restarts: self.restarts,
         }
     }
 }
