@@ -274,10 +274,10 @@ pub fn run(args: Args) -> Result<(), Failure> {
                 args.seed.unwrap_or(1),
             );
             if let Some(path) = &args.scene {
-                // Refused here, before any output exists, if it does not parse.
-                let problem = SceneProblem::load(path).map_err(|e| input(e.to_string()))?;
+                // Read once; refused here, before any output exists, if it
+                // does not parse (State::new builds it).
                 config.problem = ProblemSpec::Scene {
-                    file: problem.file().to_string(),
+                    file: path.display().to_string(),
                     text: animats_scene::read(path).map_err(|e| input(e.to_string()))?,
                 };
             }
@@ -342,6 +342,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
         None
     };
 
+    // Built once for the whole run (a scene is parsed and checked here).
+    let problem = state.config.problem.build().map_err(input)?;
     let total = state.config.generations;
     // A terminal gets a bar; a log file a line every few seconds.
     let lines = !std::io::stderr().is_terminal();
@@ -371,7 +373,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         } else {
             1
         };
-        pool.install(|| state.advance(batch))
+        pool.install(|| state.advance_with(problem.as_ref(), batch))
             .map_err(Failure::Other)?;
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);

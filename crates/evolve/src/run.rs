@@ -312,13 +312,19 @@ impl State {
     /// parallel on the current rayon pool.
     pub fn advance(&mut self, generations: u64) -> Result<(), String> {
         let problem = self.config.problem.build()?;
+        self.advance_with(problem.as_ref(), generations)
+    }
+
+    /// [`State::advance`] with the problem already built from
+    /// `self.config.problem` (a long run builds it once, not per batch).
+    pub fn advance_with(&mut self, problem: &dyn Problem, generations: u64) -> Result<(), String> {
         let target = self.config.generations;
         let results: Vec<Result<Vec<LogRow>, String>> = self
             .lanes
             .par_iter_mut()
             .map(|lane| {
                 let n = generations.min(target.saturating_sub(lane.generation));
-                advance_lane(lane, problem.as_ref(), n)
+                advance_lane(lane, problem, n)
             })
             .collect();
         let mut rows = Vec::new();
