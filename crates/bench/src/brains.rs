@@ -4,7 +4,7 @@
 //! efficiency); and CMA-ES's own time per generation (ask and tell) against
 //! the time its evaluations take.
 
-use crate::{measure, measure_pair, Check, Row, Timing};
+use crate::{measure, measure_pair, Check, Row};
 use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 use animats_scene::evaluate::SceneProblem;
 use rayon::prelude::*;
@@ -18,18 +18,6 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
         .num_threads(threads)
         .build()
         .map_err(|e| e.to_string())
-}
-
-/// The per-evaluation timing of a run of `POPULATION` evaluations.
-fn per_evaluation(t: &Timing) -> Timing {
-    let n = POPULATION as f64;
-    Timing {
-        median: t.median / n,
-        min: t.min / n,
-        max: t.max / n,
-        runs: t.runs,
-        times: t.times.iter().map(|x| x / n).collect(),
-    }
 }
 
 /// Runs the workload for the evolved walker and quadruped
@@ -82,7 +70,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         let (particles, springs) = (scene.world.len(), scene.world.forces().springs.len());
         let efficiency = t1.median / t2.median;
         for (threads, t) in [(1, &t1), (2, &t2)] {
-            let per = per_evaluation(t);
+            let per = t.divided(POPULATION as f64);
             let mut checks = vec![Check::info("evaluations per s", 1.0 / per.median)];
             if threads == 2 {
                 checks.push(Check::target("speed-up on 2 threads", efficiency, 1.8));
@@ -129,14 +117,8 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
                 }
             },
         );
-        let per_generation = Timing {
-            median: tc.median / generations as f64,
-            min: tc.min / generations as f64,
-            max: tc.max / generations as f64,
-            runs: tc.runs,
-            times: tc.times.iter().map(|x| x / generations as f64).collect(),
-        };
-        let evaluations = lambda as f64 * per_evaluation(&t2).median;
+        let per_generation = tc.divided(generations as f64);
+        let evaluations = lambda as f64 * t2.divided(POPULATION as f64).median;
         rows.push(Row {
             workload: "brains".into(),
             variant: format!(

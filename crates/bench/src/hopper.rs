@@ -23,17 +23,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
             }
         },
     );
-    let per_eval = Timing {
-        median: timing.median / EVALS_PER_RUN as f64,
-        min: timing.min / EVALS_PER_RUN as f64,
-        max: timing.max / EVALS_PER_RUN as f64,
-        runs: timing.runs,
-        times: timing
-            .times
-            .iter()
-            .map(|t| t / EVALS_PER_RUN as f64)
-            .collect(),
-    };
+    let per_eval = timing.divided(EVALS_PER_RUN as f64);
     let e = last.ok_or("the evolved gait could not be evaluated")?;
     let steps = (settings.seconds / settings.dt).round() as usize;
     let eval_row = Row {

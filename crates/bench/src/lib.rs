@@ -69,6 +69,18 @@ pub struct Timing {
 }
 
 impl Timing {
+    /// The timing of one of `n` equal pieces of each run (a run that did
+    /// `n` evaluations → per evaluation).
+    pub fn divided(&self, n: f64) -> Timing {
+        Timing {
+            median: self.median / n,
+            min: self.min / n,
+            max: self.max / n,
+            runs: self.runs,
+            times: self.times.iter().map(|t| t / n).collect(),
+        }
+    }
+
     /// Summarises run times (s).
     pub fn from_runs(runs: Vec<f64>) -> Timing {
         let mut times = runs.clone();
