@@ -18,6 +18,7 @@
 //! The hill climber of run k mutates as the thesis's lane (k − 1) mod 6
 //! does (±25 % to ±150 %), so the 20 runs cover all six of its lanes.
 
+use animats_creatures::roobot::evaluate::Evaluation;
 use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind};
 use animats_evolve::problem::{Problem, RaibertProblem};
 use animats_evolve::Config;
@@ -90,23 +91,28 @@ fn run(controller: Controller, kind: OptimiserKind, seed: u64, budget: usize) ->
     }
 }
 
-/// The run's best genome evaluated at a quarter of the step (2 ms): its
-/// distance if it stays up for the 20 s, else `None`.
-fn at_quarter_step(controller: Controller, genome: &[f64]) -> Option<f64> {
+/// `genome` for `controller` evaluated at the thesis's step divided by
+/// `divide`.
+fn evaluate_at(controller: Controller, genome: &[f64], divide: f64) -> Option<Evaluation> {
     let mut settings = Config::thesis(1, 1, 1).settings();
-    settings.dt /= 4.0;
-    let e = match controller {
-        Controller::Raibert => animats_creatures::roobot::raibert::evaluate(
-            genome.to_vec().try_into().ok()?,
-            &settings,
-        ),
+    settings.dt /= divide;
+    match controller {
+        Controller::Raibert => {
+            animats_creatures::roobot::raibert::evaluate(genome.try_into().ok()?, &settings)
+        }
         Controller::Fsm => {
             let mut p = animats_creatures::roobot::HopParams::INITIAL;
             p.0.copy_from_slice(genome);
             animats_creatures::roobot::evaluate::evaluate(p, &settings)
         }
     }
-    .ok()?;
+    .ok()
+}
+
+/// The run's best genome evaluated at a quarter of the step (2 ms): its
+/// distance if it stays up for the 20 s, else `None`.
+fn at_quarter_step(controller: Controller, genome: &[f64]) -> Option<f64> {
+    let e = evaluate_at(controller, genome, 4.0)?;
     (e.time_up >= 20.0).then_some(e.distance)
 }
 
@@ -147,30 +153,17 @@ fn one(args: &[String]) {
         r.best
     );
     for divide in [1.0, 2.0, 4.0] {
-        let mut settings = Config::thesis(1, 1, seed).settings();
-        settings.dt /= divide;
-        let e = match controller {
-            Controller::Raibert => animats_creatures::roobot::raibert::evaluate(
-                r.best.clone().try_into().expect("8 gains"),
-                &settings,
-            ),
-            Controller::Fsm => {
-                let mut p = animats_creatures::roobot::HopParams::INITIAL;
-                p.0.copy_from_slice(&r.best);
-                animats_creatures::roobot::evaluate::evaluate(p, &settings)
-            }
-        }
-        .expect("an evaluation");
+        let e = evaluate_at(controller, &r.best, divide).expect("an evaluation");
         println!(
-        "dt {} s: fitness {}, upright {} s, distance {} m, {} hops, mean speed {:.3} m/s, ended: {}",
-        settings.dt,
-        e.fitness,
-        e.time_up,
-        e.distance,
-        e.hops,
-        e.mean_speed(),
-        e.ending
-    );
+            "dt {} s: fitness {}, upright {} s, distance {} m, {} hops, mean speed {:.3} m/s, ended: {}",
+            Config::thesis(1, 1, 1).settings().dt / divide,
+            e.fitness,
+            e.time_up,
+            e.distance,
+            e.hops,
+            e.mean_speed(),
+            e.ending
+        );
     }
 }
 
