@@ -259,11 +259,8 @@ impl SceneProblem {
             )
         })?;
         let brain = &scene.nervous.controllers[spec.index].brain;
-        let controller = def
-            .controller
-            .iter()
-            .position(|c| c.get_ref().name == spec.controller)
-            .unwrap_or(spec.index);
+        // Controllers are built in the order written: the same index.
+        let controller = spec.index;
         Ok(SceneProblem {
             file: file.to_string(),
             text: text.to_string(),

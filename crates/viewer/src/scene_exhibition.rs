@@ -53,31 +53,34 @@ pub struct SceneExhibition {
 impl SceneExhibition {
     /// Starts with the scene's own brain until the evolution has a best.
     pub fn new(problem: SceneProblem, board: BestBrain) -> Result<SceneExhibition, String> {
-        let stage = Self::stage(&problem, problem.start())?;
-        let mut e = SceneExhibition {
+        let (stage, shown) = Self::best_stage(&problem, &board)?;
+        Ok(SceneExhibition {
             problem,
             board,
             stage,
-            shown: None,
-        };
-        e.restart()?;
-        Ok(e)
+            shown,
+        })
     }
 
-    fn stage(problem: &SceneProblem, genome: &[f64]) -> Result<SceneStage, String> {
-        let scene = problem.scene(genome)?;
-        SceneStage::from_scene(PathBuf::from(problem.file()), scene, None)
+    /// The scene from its start with the best brain now, and which brain
+    /// that is.
+    fn best_stage(
+        problem: &SceneProblem,
+        board: &BestBrain,
+    ) -> Result<(SceneStage, Option<(f64, usize)>), String> {
+        let best = board.board().best.clone();
+        let (genome, shown) = match best {
+            Some((g, f, lane)) => (g, Some((f, lane))),
+            None => (problem.start().to_vec(), None),
+        };
+        let scene = problem.scene(&genome)?;
+        let stage = SceneStage::from_scene(PathBuf::from(problem.file()), scene, None)?;
+        Ok((stage, shown))
     }
 
     /// Starts the scene again with the best brain now.
     fn restart(&mut self) -> Result<(), String> {
-        let best = self.board.board().best.clone();
-        let (genome, shown) = match best {
-            Some((g, f, lane)) => (g, Some((f, lane))),
-            None => (self.problem.start().to_vec(), None),
-        };
-        self.stage = Self::stage(&self.problem, &genome)?;
-        self.shown = shown;
+        (self.stage, self.shown) = Self::best_stage(&self.problem, &self.board)?;
         Ok(())
     }
 
