@@ -43,6 +43,9 @@ pub struct Jellyfish {
     /// Its controller.
     pub fsm: JellyfishFsm,
     body_radius: f64,
+    /// The brain's inputs and outputs, kept between steps (no allocation
+    /// per step).
+    scratch: (Vec<f64>, Vec<f64>),
 }
 
 impl Jellyfish {
@@ -93,6 +96,7 @@ impl Jellyfish {
             steer,
             fsm: JellyfishFsm::new(constants.pulse_period),
             body_radius: constants.dome_radius,
+            scratch: (Vec::new(), Vec::new()),
         })
     }
 
@@ -112,7 +116,9 @@ impl Actor for Jellyfish {
         }
         let centre = self.body.centre(world);
         let radius = self.body_radius;
-        let mut inputs: Vec<f64> = self.food.iter().map(|f| f.level(world)).collect();
+        let (inputs, out) = &mut self.scratch;
+        inputs.clear();
+        inputs.extend(self.food.iter().map(|f| f.level(world)));
         inputs.push(self.depth.level(world));
         inputs.extend(
             self.body
@@ -122,8 +128,9 @@ impl Actor for Jellyfish {
         );
         inputs.push(self.pulse.initial_level());
         inputs.extend(self.steer.iter().map(|s| s.initial_level()));
-        let mut out = vec![0.0; 1 + self.steer.len()];
-        Brain::think(&mut self.fsm, world.time(), dt, &inputs, &mut out);
+        out.clear();
+        out.resize(1 + self.steer.len(), 0.0);
+        Brain::think(&mut self.fsm, world.time(), dt, inputs, out);
         self.pulse.set_level(world, out[0]);
         for (s, level) in self.steer.iter_mut().zip(&out[1..]) {
             s.set_level(world, *level);
