@@ -8,7 +8,6 @@ use crate::Failure;
 use animats_evolve::{checkpoint, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
 use animats_scene::evaluate::SceneProblem;
-use animats_scene::params::{format_best, LaneBest};
 use animats_viewer::exhibition::Showcase;
 use animats_viewer::{BestBrain, Exhibition, SceneExhibition};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -101,11 +100,7 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     let io = Failure::Other;
     animats_files::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes())
         .map_err(io)?;
-    let best = match &state.config.problem {
-        ProblemSpec::Roobot { .. } => Some(roobot_best(state)),
-        ProblemSpec::Scene { file, text } => scene_best(state, file, text)?,
-    };
-    if let Some(best) = best {
+    if let Some(best) = state.best_toml().map_err(Failure::Other)? {
         animats_files::write_atomically(&dir.join("best.toml"), best.as_bytes()).map_err(io)?;
     }
     if with_plot {
@@ -137,60 +132,6 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
         animats_files::write_atomically(&dir.join("fitness.png"), &png).map_err(io)?;
     }
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
-}
-
-/// The roobot's best.toml: every lane's best parameters.
-fn roobot_best(state: &State) -> String {
-    let lanes: Vec<LaneBest> = state
-        .lanes
-        .iter()
-        .filter_map(|l| {
-            let b = l.best.as_ref()?;
-            let mut params = animats_creatures::roobot::HopParams::INITIAL;
-            params.0.copy_from_slice(&b.genome);
-            Some(LaneBest {
-                lane: l.lane,
-                params,
-                fitness: b.fitness,
-                time_up: b.time,
-                distance: b.distance,
-            })
-        })
-        .collect();
-    let comment = format!(
-        "Best roobot hopping parameters of `animats evolve` (seed {}, {} lanes, generation {}).\nLoad the best with `animats hop best.toml`, lane K's with `--lane K`.",
-        state.config.seed,
-        state.config.lanes,
-        state.generation()
-    );
-    format_best(&lanes, &comment)
-}
-
-/// A scene's best.toml: the whole scene with the best lane's genome in it.
-fn scene_best(state: &State, file: &str, text: &str) -> Result<Option<String>, Failure> {
-    let Some(lane) = state.best_lane() else {
-        return Ok(None);
-    };
-    let Some(best) = &lane.best else {
-        return Ok(None);
-    };
-    let problem = SceneProblem::parse(text, file).map_err(|e| Failure::Input(e.to_string()))?;
-    let comment = format!(
-        "{file} with the best controller of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nlane {}, fitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate best.toml`; watch it with `animats view best.toml`.",
-        state.config.optimiser.name(),
-        state.config.seed,
-        state.config.lanes,
-        state.generation(),
-        lane.lane,
-        best.fitness,
-        best.distance,
-        best.time,
-        best.ended
-    );
-    problem
-        .best_toml(&best.genome, &comment)
-        .map(Some)
-        .map_err(Failure::Other)
 }
 
 /// What the live view shows: the roobot's lanes side by side, or a scene

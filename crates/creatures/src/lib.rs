@@ -20,6 +20,7 @@ pub mod actuators;
 pub mod brain;
 pub mod brains;
 pub mod controller;
+pub mod env;
 pub mod jellyfish;
 pub mod nervous_system;
 pub mod quadruped;
@@ -28,6 +29,7 @@ pub mod roobot;
 pub mod seaworld;
 pub mod sensor;
 pub mod sensors;
+pub mod vec_env;
 
 pub use brain::Brain;
 pub use controller::{Actor, Controller, Status};

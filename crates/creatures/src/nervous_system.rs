@@ -32,6 +32,12 @@ pub struct Wired {
 }
 
 impl Wired {
+    /// The levels the brain ordered at the last step, before clamping and
+    /// its actuators' `rate` (one per output).
+    pub fn orders(&self) -> &[f64] {
+        &self.out_buf
+    }
+
     /// Wires `brain` to sensors `inputs` and actuators `outputs`.
     pub fn new(
         name: String,
@@ -121,16 +127,56 @@ impl NervousSystem {
             }
             c.brain.think(t, dt, &c.in_buf, &mut c.out_buf);
             for (&o, &l) in c.outputs.iter().zip(&c.out_buf) {
-                let a = &mut self.actuators[o].1;
-                let mut level = unit(l);
-                if let Some(Some(rate)) = self.rates.get(o) {
-                    let now = a.level();
-                    level = now + (level - now).clamp(-rate * dt, rate * dt);
-                }
-                a.set_level(world, level);
+                slew(
+                    &mut self.actuators[o].1,
+                    self.rates.get(o).copied().flatten(),
+                    world,
+                    l,
+                    dt,
+                );
             }
         }
     }
+
+    /// Drives every actuator towards `levels` (scene order) for the step
+    /// about to be taken, each at most its `rate` allows, and runs no
+    /// controller: a program outside the scene is the brain (the Python
+    /// environments). Levels must be finite; they are clamped to [0, 1].
+    pub fn drive(&mut self, world: &mut World, levels: &[f64], dt: f64) -> Result<(), String> {
+        if levels.len() != self.actuators.len() {
+            return Err(format!(
+                "{} levels given for {} actuators",
+                levels.len(),
+                self.actuators.len()
+            ));
+        }
+        if let Some(i) = levels.iter().position(|l| !l.is_finite()) {
+            return Err(format!(
+                "the level of actuator `{}` is not finite: {}",
+                self.actuators[i].0, levels[i]
+            ));
+        }
+        for (o, &l) in levels.iter().enumerate() {
+            slew(
+                &mut self.actuators[o].1,
+                self.rates.get(o).copied().flatten(),
+                world,
+                l,
+                dt,
+            );
+        }
+        Ok(())
+    }
+}
+
+/// Moves `a` towards `level` (clamped to [0, 1]), at most `rate × dt`.
+fn slew(a: &mut AnyActuator, rate: Option<f64>, world: &mut World, level: f64, dt: f64) {
+    let mut level = unit(level);
+    if let Some(rate) = rate {
+        let now = a.level();
+        level = now + (level - now).clamp(-rate * dt, rate * dt);
+    }
+    a.set_level(world, level);
 }
 
 impl Actor for NervousSystem {

@@ -14,6 +14,8 @@ use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 use crate::problem::{Outcome, Problem, RoobotProblem, SceneEvolution};
 use animats_creatures::roobot::evaluate::EvalSettings;
 use animats_creatures::roobot::{HopParams, PARAM_COUNT};
+use animats_scene::evaluate::SceneProblem;
+use animats_scene::params::{format_best, LaneBest};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -331,6 +333,51 @@ impl State {
         for r in results {
             rows.extend(r?);
         }
+        self.extend_log(rows);
+        Ok(())
+    }
+
+    /// The next generation of every lane not yet at the configured total,
+    /// to be evaluated elsewhere (another process, a cluster) and handed
+    /// back to [`State::tell`]. A run advanced by `ask`/`tell` writes the
+    /// same log, bit for bit, as one advanced by [`State::advance`].
+    pub fn ask(&mut self) -> Generation {
+        let target = self.config.generations;
+        let lanes = self
+            .lanes
+            .iter_mut()
+            .filter(|l| l.generation < target)
+            .map(|l| (l.lane, l.optimiser.ask()))
+            .collect();
+        Generation { lanes }
+    }
+
+    /// Takes the outcomes of `generation`'s genomes, in the order of
+    /// [`Generation::genomes`].
+    pub fn tell(&mut self, generation: Generation, outcomes: &[Outcome]) -> Result<(), String> {
+        let asked = generation.len();
+        if outcomes.len() != asked {
+            return Err(format!(
+                "{} outcomes told for a generation of {asked} genomes",
+                outcomes.len()
+            ));
+        }
+        let mut rows = Vec::with_capacity(generation.lanes.len());
+        let mut at = 0;
+        for (lane, population) in generation.lanes {
+            let n = population.len();
+            let l = self
+                .lanes
+                .get_mut(lane)
+                .ok_or_else(|| format!("lane {lane} does not exist"))?;
+            rows.push(record(l, population, &outcomes[at..at + n])?);
+            at += n;
+        }
+        self.extend_log(rows);
+        Ok(())
+    }
+
+    fn extend_log(&mut self, mut rows: Vec<LogRow>) {
         self.evaluations = self.lanes.iter().map(|l| l.evaluations).sum();
         // The roobot's log (Table 6's shape) is its improvements only: a long
         // run keeps as few rows as before in memory and in its checkpoint.
@@ -339,7 +386,65 @@ impl State {
         }
         rows.sort_by_key(|r| (r.generation, r.lane));
         self.log.extend(rows);
-        Ok(())
+    }
+
+    /// `best.toml`, as `animats evolve` writes it: for the roobot every
+    /// lane's best parameters; for a scene the whole scene with the best
+    /// lane's genome written in. `None` before the first generation.
+    pub fn best_toml(&self) -> Result<Option<String>, String> {
+        match &self.config.problem {
+            ProblemSpec::Roobot { .. } => Ok(Some(self.roobot_best())),
+            ProblemSpec::Scene { file, text } => self.scene_best(file, text),
+        }
+    }
+
+    fn roobot_best(&self) -> String {
+        let lanes: Vec<LaneBest> = self
+            .lanes
+            .iter()
+            .filter_map(|l| {
+                let b = l.best.as_ref()?;
+                let mut params = HopParams::INITIAL;
+                params.0.copy_from_slice(&b.genome);
+                Some(LaneBest {
+                    lane: l.lane,
+                    params,
+                    fitness: b.fitness,
+                    time_up: b.time,
+                    distance: b.distance,
+                })
+            })
+            .collect();
+        let comment = format!(
+            "Best roobot hopping parameters of `animats evolve` (seed {}, {} lanes, generation {}).\nLoad the best with `animats hop best.toml`, lane K's with `--lane K`.",
+            self.config.seed,
+            self.config.lanes,
+            self.generation()
+        );
+        format_best(&lanes, &comment)
+    }
+
+    fn scene_best(&self, file: &str, text: &str) -> Result<Option<String>, String> {
+        let Some(lane) = self.best_lane() else {
+            return Ok(None);
+        };
+        let Some(best) = &lane.best else {
+            return Ok(None);
+        };
+        let problem = SceneProblem::parse(text, file).map_err(|e| e.to_string())?;
+        let comment = format!(
+            "{file} with the best controller of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nlane {}, fitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate best.toml`; watch it with `animats view best.toml`.",
+            self.config.optimiser.name(),
+            self.config.seed,
+            self.config.lanes,
+            self.generation(),
+            lane.lane,
+            best.fitness,
+            best.distance,
+            best.time,
+            best.ended
+        );
+        problem.best_toml(&best.genome, &comment).map(Some)
     }
 
     /// `log.csv`. For the roobot, the thesis's Table 6 shape as always: one
@@ -397,6 +502,7 @@ impl State {
     }
 }
 
+/// Generations of one lane; rows in generation order.
 fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {
@@ -405,40 +511,77 @@ fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<Lo
             .par_iter()
             .map(|g| problem.evaluate(g))
             .collect::<Result<_, _>>()?;
-        let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
-        lane.optimiser.tell(&fitness)?;
-        lane.generation += 1;
-        lane.evaluations += population.len() as u64;
-        // The generation's best (the first of equals).
-        let mut top = 0;
-        for (i, f) in fitness.iter().enumerate() {
-            if crate::optimiser::sane(*f) > crate::optimiser::sane(fitness[top]) {
-                top = i;
-            }
+        rows.push(record(lane, population, &outcomes)?);
+    }
+    Ok(rows)
+}
+
+/// Tells `lane`'s optimiser how its `population` fared and keeps its best:
+/// one generation's log row.
+fn record(
+    lane: &mut Lane,
+    population: Vec<Vec<f64>>,
+    outcomes: &[Outcome],
+) -> Result<LogRow, String> {
+    let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
+    lane.optimiser.tell(&fitness)?;
+    lane.generation += 1;
+    lane.evaluations += population.len() as u64;
+    // The generation's best (the first of equals).
+    let mut top = 0;
+    for (i, f) in fitness.iter().enumerate() {
+        if crate::optimiser::sane(*f) > crate::optimiser::sane(fitness[top]) {
+            top = i;
         }
-        let o = &outcomes[top];
-        let f = crate::optimiser::sane(o.fitness);
-        let improved = lane.best.as_ref().map_or(true, |b| f > b.fitness);
-        if improved {
-            lane.best = Some(Best {
-                genome: population[top].clone(),
-                fitness: f,
-                time: o.time,
-                distance: o.distance,
-                ended: o.ended.clone(),
-            });
-        }
-        rows.push(LogRow {
-            lane: lane.lane,
-            generation: lane.generation,
-            evaluations: lane.evaluations,
-            fitness: o.fitness,
-            best_fitness: lane.best.as_ref().map_or(o.fitness, |b| b.fitness),
+    }
+    let o = &outcomes[top];
+    let f = crate::optimiser::sane(o.fitness);
+    let improved = lane.best.as_ref().map_or(true, |b| f > b.fitness);
+    if improved {
+        lane.best = Some(Best {
+            genome: population[top].clone(),
+            fitness: f,
             time: o.time,
             distance: o.distance,
             ended: o.ended.clone(),
-            improved: improved.then(|| population[top].clone()),
         });
     }
-    Ok(rows)
+    Ok(LogRow {
+        lane: lane.lane,
+        generation: lane.generation,
+        evaluations: lane.evaluations,
+        fitness: o.fitness,
+        best_fitness: lane.best.as_ref().map_or(o.fitness, |b| b.fitness),
+        time: o.time,
+        distance: o.distance,
+        ended: o.ended.clone(),
+        improved: improved.then(|| population[top].clone()),
+    })
+}
+
+/// One generation of a run handed out by [`State::ask`]: each lane's
+/// population.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Generation {
+    /// (lane, its population), in lane order.
+    pub lanes: Vec<(usize, Vec<Vec<f64>>)>,
+}
+
+impl Generation {
+    /// Genomes in all.
+    pub fn len(&self) -> usize {
+        self.lanes.iter().map(|(_, p)| p.len()).sum()
+    }
+
+    /// True when every lane is done: nothing to evaluate.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Every genome, lane by lane.
+    pub fn genomes(&self) -> impl Iterator<Item = &[f64]> {
+        self.lanes
+            .iter()
+            .flat_map(|(_, p)| p.iter().map(|g| g.as_slice()))
+    }
 }

@@ -224,3 +224,57 @@ fn fitness_keeps_rising_after_stable_hopping_is_found() {
         "only {higher} of 6 lanes improved between generations 100 and 300"
     );
 }
+
+/// A run whose generations are evaluated elsewhere (`ask`, then `tell` with
+/// the outcomes in any order of computation) is the run `advance` makes.
+fn external(config: Config, reverse: bool) -> State {
+    let mut s = State::new(config).unwrap();
+    let problem = s.config.problem.build().unwrap();
+    while !s.done() {
+        let g = s.ask();
+        let genomes: Vec<&[f64]> = g.genomes().collect();
+        // Evaluated back to front, as workers finishing in any order would.
+        let mut outcomes = vec![None; genomes.len()];
+        let order: Vec<usize> = if reverse {
+            (0..genomes.len()).rev().collect()
+        } else {
+            (0..genomes.len()).collect()
+        };
+        for i in order {
+            outcomes[i] = Some(problem.evaluate(genomes[i]).unwrap());
+        }
+        let outcomes: Vec<_> = outcomes.into_iter().map(Option::unwrap).collect();
+        s.tell(g, &outcomes).unwrap();
+    }
+    s
+}
+
+#[test]
+fn a_run_evaluated_elsewhere_equals_one_advanced_here() {
+    let config = Config::thesis(3, 25, 11);
+    let a = run(config.clone(), 2, 25);
+    let b = external(config, true);
+    assert_eq!(a.log_csv(), b.log_csv());
+    assert_eq!(a, b);
+    assert_eq!(a.best_toml().unwrap(), b.best_toml().unwrap());
+
+    let text = include_str!("../../cli/tests/crawler.toml");
+    let scene = Config {
+        optimiser: animats_evolve::optimiser::OptimiserKind::CmaEs,
+        problem: animats_evolve::run::ProblemSpec::Scene {
+            file: "crawler.toml".into(),
+            text: text.into(),
+        },
+        generations: 4,
+        ..Config::thesis(2, 4, 5)
+    };
+    let a = run(scene.clone(), 2, 4);
+    let b = external(scene, false);
+    assert_eq!(a.log_csv(), b.log_csv());
+    assert_eq!(a.log.len(), 8, "a scene logs every lane's every generation");
+    assert_eq!(a.best_toml().unwrap(), b.best_toml().unwrap());
+    // Outcomes of the wrong count are refused.
+    let mut s = State::new(a.config.clone()).unwrap();
+    let g = s.ask();
+    assert!(s.tell(g, &[]).is_err());
+}

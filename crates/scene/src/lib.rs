@@ -26,6 +26,7 @@
 pub mod build;
 pub mod def;
 pub(crate) mod entries;
+pub mod env;
 pub mod error;
 pub mod evaluate;
 pub(crate) mod nervous;
@@ -70,6 +71,15 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
+/// The state of a scene at one instant (see [`Scene::snapshot`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneSnapshot {
+    /// The world's state.
+    pub world: animats_engine::Snapshot,
+    /// Each actuator's level, in the scene's order.
+    pub levels: Vec<f64>,
+}
+
 /// Steps between the divergence guard's checks (it sums the energy).
 const GUARD_EVERY: u64 = 64;
 
@@ -92,6 +102,36 @@ impl Scene {
     /// steps) a run-away that [`DivergenceGuard`] catches.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
         self.nervous.act(&mut self.world, dt);
+        self.advance(dt)
+    }
+
+    /// Like [`Scene::step`], but a program is the brain: every actuator is
+    /// driven towards `levels` (scene order, each at most its `rate`
+    /// allows) and no controller runs. The other actors act as usual.
+    pub fn step_driven(&mut self, levels: &[f64], dt: f64) -> Result<StepReport, String> {
+        self.nervous.drive(&mut self.world, levels, dt)?;
+        self.advance(dt).map_err(|e| e.to_string())
+    }
+
+    /// Everything that changes as the scene runs, but for its controllers'
+    /// and creatures' own state (an FSM's state, a timer): the world's
+    /// [`animats_engine::Snapshot`] and the actuators' levels.
+    pub fn snapshot(&self) -> SceneSnapshot {
+        SceneSnapshot {
+            world: self.world.snapshot(),
+            levels: self.nervous.actuator_levels(),
+        }
+    }
+
+    /// Puts back a [`Scene::snapshot`] of this scene (or of one built from
+    /// the same file).
+    pub fn restore(&mut self, s: &SceneSnapshot) -> Result<(), String> {
+        self.nervous.set_levels(&mut self.world, &s.levels)?;
+        // After the levels: the world's own values are the exact ones.
+        self.world.restore(&s.world).map_err(|e| e.to_string())
+    }
+
+    fn advance(&mut self, dt: f64) -> Result<StepReport, SimError> {
         for a in &mut self.actors {
             a.act(&mut self.world, dt);
         }

@@ -4,6 +4,7 @@
 //! - `fsm.rs`: the four-state hopping controller.
 //! - `params.rs`: its 14 parameters; `params_file.rs`: their files (`params/`, `best.toml`).
 //! - `evaluate.rs`: one fitness evaluation, as the thesis's `HopEvolver` runs it.
+//! - `env.rs`: the same evaluation stepped by a program (reinforcement learning).
 //! - `gait.rs`: stance durations and foot slide, for reports.
 //!
 //! Actuators: the leg's rest length, the hip motor (acts only in flight) and
@@ -11,6 +12,7 @@
 //! from the vertical, hip forward speed, time till touchdown.
 
 pub mod body;
+pub mod env;
 pub mod evaluate;
 pub mod fsm;
 pub mod gait;
