@@ -41,6 +41,8 @@ pub trait Env: Send {
     fn step(&mut self, action: &[f64]) -> Result<Transition, String>;
     /// Simulated time since the reset, s.
     fn time(&self) -> f64;
+    /// The world as it stands (positions for drawing, tests).
+    fn world(&self) -> &animats_engine::World;
 }
 
 /// Checks an action's length and that every level is finite.
@@ -89,4 +91,40 @@ pub fn perturb(world: &mut animats_engine::World, seed: u64, noise: f64) -> Resu
         world.set_velocity(p, v).map_err(|e| e.to_string())?;
     }
     Ok(())
+}
+
+impl<E: Env + ?Sized> Env for Box<E> {
+    fn observation_size(&self) -> usize {
+        (**self).observation_size()
+    }
+    fn action_size(&self) -> usize {
+        (**self).action_size()
+    }
+    fn observation_names(&self) -> Vec<String> {
+        (**self).observation_names()
+    }
+    fn action_names(&self) -> Vec<String> {
+        (**self).action_names()
+    }
+    fn dt(&self) -> f64 {
+        (**self).dt()
+    }
+    fn max_steps(&self) -> u64 {
+        (**self).max_steps()
+    }
+    fn reset(&mut self, seed: u64) -> Result<(), String> {
+        (**self).reset(seed)
+    }
+    fn observe(&self, out: &mut [f64]) {
+        (**self).observe(out)
+    }
+    fn step(&mut self, action: &[f64]) -> Result<Transition, String> {
+        (**self).step(action)
+    }
+    fn time(&self) -> f64 {
+        (**self).time()
+    }
+    fn world(&self) -> &animats_engine::World {
+        (**self).world()
+    }
 }

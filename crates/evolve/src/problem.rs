@@ -21,7 +21,7 @@ pub struct Outcome {
 }
 
 /// A genome → fitness function, evaluated from many threads at once.
-pub trait Problem: Sync {
+pub trait Problem: Send + Sync {
     /// The genome's length.
     fn dim(&self) -> usize;
     /// Where evolution starts.

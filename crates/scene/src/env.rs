@@ -192,4 +192,8 @@ impl Env for SceneEnv {
     fn time(&self) -> f64 {
         self.scene.world.time()
     }
+
+    fn world(&self) -> &animats_engine::World {
+        &self.scene.world
+    }
 }

@@ -66,11 +66,6 @@ impl RoobotEnv {
         Ok(env)
     }
 
-    /// The world (read-only: positions for drawing, tests).
-    pub fn world(&self) -> &World {
-        &self.world
-    }
-
     /// The roobot.
     pub fn roobot(&self) -> &Roobot {
         &self.roobot
@@ -170,5 +165,9 @@ impl Env for RoobotEnv {
 
     fn time(&self) -> f64 {
         self.world.time()
+    }
+
+    fn world(&self) -> &World {
+        &self.world
     }
 }

@@ -1,0 +1,79 @@
+"""animats: creatures from the physics up, driven from Python.
+
+The Rust core, without a copy of its logic: scenes and worlds, parallel
+evaluation, the optimisers and whole evolution runs, and environments.
+
+    >>> import animats, numpy as np
+    >>> scene = animats.load("scenes/walker.toml")
+    >>> world = scene.world(); world.step(100)
+    >>> world.positions()                       # (N, 3) float64
+    >>> animats.evaluate(scene, scene.start())  # its own parameters' fitness
+    >>> animats.evaluate("roobot", np.tile(animats.ROOBOT_INITIAL, (8, 1)))
+
+``import animats.gym`` registers the Gymnasium environments
+``animats/Roobot-v0`` and ``animats/Scene-v0``; ``animats.distributed``
+spreads an evolution over a Ray cluster.
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Union
+import os
+
+import numpy as np
+
+from . import _animats
+from ._animats import (
+    Env,
+    Evaluator,
+    Evolution,
+    Optimiser,
+    Scene,
+    SceneError,
+    Snapshot,
+    VecEnv,
+    World,
+    load,
+    parse,
+)
+
+__all__ = [
+    "Env",
+    "Evaluator",
+    "Evolution",
+    "Optimiser",
+    "Scene",
+    "SceneError",
+    "Snapshot",
+    "VecEnv",
+    "World",
+    "evaluate",
+    "load",
+    "parse",
+    "ROOBOT_INITIAL",
+    "ROOBOT_BOUNDS",
+]
+
+#: Appendix B's initial roobot parameters (the hill climber's start).
+ROOBOT_INITIAL = np.array(_animats.ROOBOT_INITIAL, dtype=np.float64)
+#: The roobot parameters' bounds, ``(14, 2)``.
+ROOBOT_BOUNDS = np.array(_animats.ROOBOT_BOUNDS, dtype=np.float64)
+
+SceneLike = Union[Scene, str, "os.PathLike[str]"]
+
+
+def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None) -> np.ndarray:
+    """Fitness of each row of ``genomes`` under ``scene``'s ``[evolve]``
+    evaluation (``"roobot"``: the thesis's hopping gait).
+
+    ``genomes`` is a ``(P, D)`` array (a single ``(D,)`` genome gives one
+    fitness in a ``(1,)`` array). The evaluations run in parallel on
+    ``threads`` threads (default: every core) with the GIL released, and
+    each is bit-identical to ``animats evaluate`` on the same parameters.
+    """
+    g = np.ascontiguousarray(genomes, dtype=np.float64)
+    if g.ndim == 1:
+        g = g[None, :]
+    if g.ndim != 2:
+        raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
+    return _animats.evaluate(scene, g, threads)

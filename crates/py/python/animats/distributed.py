@@ -1,0 +1,230 @@
+"""Evolution and evaluation spread over a Ray cluster (``pip install
+./crates/py[ray]``).
+
+Long-lived actors each hold a Rust :class:`animats.Evaluator`; each
+generation's genomes are split among them, and their outcomes are told to
+the optimisers in the order the genomes were asked, so the run is the same,
+bit for bit, as ``animats evolve`` on one machine, however many actors and
+whatever order they finish in. An actor that dies mid-generation costs time,
+not results: Ray restarts it and its share is evaluated again.
+
+On a cluster::
+
+    ray start --head                          # on the first machine
+    ray start --address=HEAD_IP:6379          # on each of the others
+    python -m animats.evolve scenes/walker.toml --ray auto --actors 32 \\
+        --optimiser cma-es --generations 500 --out walker-run
+
+or from Python, ``animats.distributed.evolve("scenes/walker.toml",
+address="auto", actors=32, optimiser="cma-es", generations=500)``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable, List, Optional
+
+import numpy as np
+
+from . import _animats
+
+__all__ = ["Pool", "Stats", "evolve"]
+
+
+class _Worker:
+    """A Ray actor's state: one evaluator, one thread (Ray gives each actor
+    one CPU; the parallelism is across actors)."""
+
+    def __init__(self, file: str, text: str) -> None:
+        scene = "roobot" if file == "roobot" and text == "" else _animats.parse(text, file)
+        self.evaluator = _animats.Evaluator(scene, threads=1)
+
+    def pid(self) -> int:
+        return os.getpid()
+
+    def outcomes(self, genomes: np.ndarray) -> dict:
+        return self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
+
+
+@dataclass
+class Stats:
+    """What a distributed run did besides its results."""
+
+    #: Generations dispatched.
+    generations: int = 0
+    #: Shares evaluated again after their actor died.
+    retries: int = 0
+    #: Seconds spent waiting for the actors.
+    wall: float = 0.0
+    #: Each actor's process id at the start.
+    pids: List[int] = field(default_factory=list)
+
+
+_LOST = None  # filled with Ray's exception types on first use
+
+
+def _lost_errors() -> tuple:
+    global _LOST
+    if _LOST is None:
+        from ray import exceptions as e
+
+        names = ["RayActorError", "ActorDiedError", "ActorUnavailableError", "WorkerCrashedError"]
+        _LOST = tuple(getattr(e, n) for n in names if hasattr(e, n))
+    return _LOST
+
+
+class Pool:
+    """``actors`` Ray actors evaluating one problem: ``scene`` is an
+    ``animats.Scene``, a path or ``"roobot"``; or give ``problem_text`` as
+    ``Evolution.problem_text()`` returns it."""
+
+    def __init__(
+        self,
+        scene: Any = "roobot",
+        actors: int = 2,
+        *,
+        problem_text: Optional[tuple] = None,
+        max_retries: int = 5,
+    ) -> None:
+        import ray
+
+        if actors < 1:
+            raise ValueError(f"actors must be at least 1, got {actors}")
+        if problem_text is None:
+            problem_text = _problem_text(scene)
+        file, text = problem_text
+        # Refuse a bad scene here, not in every actor.
+        if not (file == "roobot" and text == ""):
+            _animats.parse(text, file)
+        self.max_retries = max_retries
+        self.stats = Stats()
+        remote = ray.remote(num_cpus=1, max_restarts=-1)(_Worker)
+        self.actors = [remote.remote(file, text) for _ in range(actors)]
+        self.stats.pids = ray.get([a.pid.remote() for a in self.actors])
+        self._next = 0
+
+    def outcomes(
+        self, genomes: np.ndarray, on_dispatch: Optional[Callable[["Pool"], None]] = None
+    ) -> dict:
+        """Outcomes of each row of ``genomes`` (``Evaluator.outcomes``'s
+        dict), the rows split into one share per actor. ``on_dispatch`` is
+        called once the shares are sent (tests kill a worker there)."""
+        import ray
+
+        g = np.ascontiguousarray(genomes, dtype=np.float64)
+        if g.ndim != 2:
+            raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
+        start = time.perf_counter()
+        shares = [s for s in np.array_split(np.arange(len(g)), len(self.actors)) if len(s)]
+        results: list = [None] * len(shares)
+        tries = [0] * len(shares)
+        pending = {}
+        for i, rows in enumerate(shares):
+            pending[self.actors[i].outcomes.remote(g[rows])] = i
+        if on_dispatch is not None:
+            on_dispatch(self)
+        while pending:
+            done, _ = ray.wait(list(pending), num_returns=1)
+            i = pending.pop(done[0])
+            try:
+                results[i] = ray.get(done[0])
+            except _lost_errors() as e:
+                tries[i] += 1
+                self.stats.retries += 1
+                if tries[i] > self.max_retries:
+                    raise RuntimeError(
+                        f"a share of {len(shares[i])} genomes failed {tries[i]} times: {e}"
+                    ) from e
+                # Another actor (the dead one restarts behind the scenes).
+                actor = self.actors[(i + tries[i]) % len(self.actors)]
+                pending[actor.outcomes.remote(g[shares[i]])] = i
+        self.stats.wall += time.perf_counter() - start
+        return _merge(results, len(g))
+
+    def evaluate(self, genomes: np.ndarray) -> np.ndarray:
+        """Fitness of each row of ``genomes``."""
+        return self.outcomes(genomes)["fitness"]
+
+    def shutdown(self) -> None:
+        """Ends the actors."""
+        import ray
+
+        for a in self.actors:
+            ray.kill(a)
+        self.actors = []
+
+
+def _merge(results: list, n: int) -> dict:
+    if not results:
+        return {"fitness": np.zeros(0), "time": np.zeros(0), "distance": np.zeros(0), "ended": []}
+    out = {k: np.concatenate([r[k] for r in results]) for k in ("fitness", "time", "distance")}
+    out["ended"] = [e for r in results for e in r["ended"]]
+    assert len(out["ended"]) == n
+    return out
+
+
+def _problem_text(scene: Any) -> tuple:
+    if isinstance(scene, _animats.Scene):
+        return (scene.file, scene.text)
+    if isinstance(scene, str) and scene == "roobot" and not os.path.exists(scene):
+        return ("roobot", "")
+    s = _animats.load(scene)
+    return (s.file, s.text)
+
+
+def evolve(
+    scene: Any = "roobot",
+    *,
+    generations: int = 100,
+    lanes: Optional[int] = None,
+    seed: int = 1,
+    optimiser: str = "hill-climber",
+    population: Optional[int] = None,
+    restarts: int = 0,
+    actors: int = 2,
+    address: Optional[str] = None,
+    out: Optional[str] = None,
+    on_generation: Optional[Callable[[int, Pool], None]] = None,
+    progress: bool = False,
+) -> "tuple[_animats.Evolution, Stats]":
+    """An ``animats evolve`` run whose evaluations are spread over Ray
+    actors; the same arguments and defaults, and the same ``log.csv`` and
+    ``best.toml`` (written into ``out`` if given). ``address``: the cluster
+    (``"auto"`` on a machine that ran ``ray start``); without it, Ray starts
+    a local one unless one is already initialised. ``on_generation(g,
+    pool)`` is called as generation ``g``'s shares are sent."""
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(address=address, log_to_driver=False)
+    run = _animats.Evolution(
+        scene,
+        lanes=lanes,
+        generations=generations,
+        seed=seed,
+        optimiser=optimiser,
+        population=population,
+        restarts=restarts,
+    )
+    pool = Pool(problem_text=run.problem_text(), actors=actors)
+    try:
+        last = time.monotonic()
+        while not run.done:
+            g = run.generation + 1
+            genomes, _ = run.ask()
+            hook = None if on_generation is None else (lambda p, g=g: on_generation(g, p))
+            run.tell(pool.outcomes(genomes, on_dispatch=hook))
+            pool.stats.generations += 1
+            if progress and time.monotonic() - last > 5:
+                last = time.monotonic()
+                print(
+                    f"generation {run.generation}/{generations}, best {run.best_fitness}",
+                    flush=True,
+                )
+        if out is not None:
+            run.save(out)
+    finally:
+        pool.shutdown()
+    return run, pool.stats

@@ -1,0 +1,75 @@
+"""``python -m animats.evolve [SCENE] [--ray ADDRESS] ...``: ``animats
+evolve`` from Python, here or spread over a Ray cluster; the same log.csv
+and best.toml, bit for bit, for the same arguments."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from . import _animats
+
+
+def main(argv: "list[str] | None" = None) -> int:
+    p = argparse.ArgumentParser(
+        prog="python -m animats.evolve",
+        description="Evolve the roobot or a scene's [evolve] controller, locally or on Ray.",
+    )
+    p.add_argument("scene", nargs="?", default="roobot", help="a scene file with [evolve] (default: the roobot)")
+    p.add_argument("--optimiser", default="hill-climber", choices=["hill-climber", "ga", "cma-es"])
+    p.add_argument("--population", type=int)
+    p.add_argument("--restarts", type=int, default=0)
+    p.add_argument("--generations", type=int, default=100)
+    p.add_argument("--lanes", type=int)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--out", default="evolution", help="directory for log.csv and best.toml")
+    p.add_argument("--ray", metavar="ADDRESS", help="run on a Ray cluster: `auto`, HOST:PORT, or `local`")
+    p.add_argument("--actors", type=int, default=2, help="Ray actors (with --ray)")
+    p.add_argument("--threads", type=int, help="threads (without --ray)")
+    a = p.parse_args(argv)
+    start = time.perf_counter()
+    try:
+        if a.ray is None:
+            run = _animats.Evolution(
+                a.scene,
+                lanes=a.lanes,
+                generations=a.generations,
+                seed=a.seed,
+                optimiser=a.optimiser,
+                population=a.population,
+                restarts=a.restarts,
+            )
+            run.run(threads=a.threads)
+            run.save(a.out)
+            how = "here"
+        else:
+            from . import distributed
+
+            run, stats = distributed.evolve(
+                a.scene,
+                generations=a.generations,
+                lanes=a.lanes,
+                seed=a.seed,
+                optimiser=a.optimiser,
+                population=a.population,
+                restarts=a.restarts,
+                actors=a.actors,
+                address=None if a.ray == "local" else a.ray,
+                out=a.out,
+                progress=True,
+            )
+            how = f"on Ray, {a.actors} actors, {stats.retries} shares retried"
+    except (ValueError, OSError, RuntimeError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 1
+    print(
+        f"{run.generation} generations, {run.evaluations} evaluations {how} in "
+        f"{time.perf_counter() - start:.2f} s; best fitness {run.best_fitness}; "
+        f"wrote {a.out}/log.csv, best.toml"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,85 @@
+//! `animats._animats`: the Python bindings. Thin: each class wraps a Rust
+//! type of the libraries and translates arrays and errors; the logic lives
+//! in `animats-scene`, `animats-creatures` and `animats-evolve`. The Python
+//! package (`python/animats/`) re-exports these and adds the Gymnasium
+//! environments and the Ray distribution.
+//!
+//! - `scene.rs`: `load`, `Scene`, `World`, `Snapshot`.
+//! - `evaluate.rs`: `evaluate`, `Evaluator` (in parallel, the GIL released).
+//! - `optimise.rs`: `Optimiser`, `Evolution` (`animats evolve`'s run).
+//! - `env.rs`: `Env`, `VecEnv` (what the Gymnasium wrappers step).
+
+use pyo3::prelude::*;
+
+mod env;
+mod evaluate;
+mod optimise;
+mod scene;
+
+pyo3::create_exception!(
+    _animats,
+    SceneError,
+    pyo3::exceptions::PyValueError,
+    "A scene file that cannot be read or built; the message names the file, line, entry and field."
+);
+
+/// A Rust error message as a Python `ValueError`.
+pub(crate) fn value_error(e: impl std::fmt::Display) -> PyErr {
+    pyo3::exceptions::PyValueError::new_err(e.to_string())
+}
+
+/// A simulation or evaluation failure as a Python `RuntimeError`.
+pub(crate) fn runtime_error(e: impl std::fmt::Display) -> PyErr {
+    pyo3::exceptions::PyRuntimeError::new_err(e.to_string())
+}
+
+/// A scene error as `animats.SceneError`.
+pub(crate) fn scene_error(e: impl std::fmt::Display) -> PyErr {
+    SceneError::new_err(e.to_string())
+}
+
+/// A rayon pool of `threads` threads, or `None` for the global pool (every
+/// core).
+pub(crate) fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {
+    match threads {
+        None => Ok(None),
+        Some(0) => Err(value_error("threads must be at least 1")),
+        Some(n) if n > 4096 => Err(value_error(format!("threads: {n} is too many"))),
+        Some(n) => rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .map(Some)
+            .map_err(runtime_error),
+    }
+}
+
+/// Runs `f` on `pool` (or the global pool).
+pub(crate) fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
+    match pool {
+        Some(p) => p.install(f),
+        None => f(),
+    }
+}
+
+#[pymodule]
+fn _animats(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("SceneError", m.py().get_type::<SceneError>())?;
+    use animats_creatures::roobot::{params::BOUNDS, HopParams};
+    m.add("ROOBOT_INITIAL", HopParams::INITIAL.0.to_vec())?;
+    m.add(
+        "ROOBOT_BOUNDS",
+        BOUNDS.iter().map(|(a, b)| vec![*a, *b]).collect::<Vec<_>>(),
+    )?;
+    m.add_function(wrap_pyfunction!(scene::load, m)?)?;
+    m.add_function(wrap_pyfunction!(scene::parse, m)?)?;
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<scene::World>()?;
+    m.add_class::<scene::Snapshot>()?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_class::<evaluate::Evaluator>()?;
+    m.add_class::<optimise::Optimiser>()?;
+    m.add_class::<optimise::Evolution>()?;
+    m.add_class::<env::Env>()?;
+    m.add_class::<env::VecEnv>()?;
+    Ok(())
+}

@@ -1,0 +1,425 @@
+//! `Optimiser` (one lane's ask/tell strategy) and `Evolution` (a whole
+//! `animats evolve` run: lanes, log, best), both the Rust ones: the same
+//! seed gives the same candidates, log and best.toml as the command line.
+
+use crate::evaluate::{build, outcome_dict, outcomes, problem_spec};
+use crate::{on, pool, runtime_error, value_error};
+use animats_evolve::optimiser::{Bounds, Optimiser as _};
+use animats_evolve::run::Generation;
+use animats_evolve::{AnyOptimiser, Config, OptimiserKind, Outcome, ProblemSpec, Setup, State};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::path::PathBuf;
+
+fn kind(name: &str) -> PyResult<OptimiserKind> {
+    OptimiserKind::parse(name).map_err(value_error)
+}
+
+fn matrix<'py>(
+    py: Python<'py>,
+    rows: &[Vec<f64>],
+    d: usize,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+    let a = Array2::from_shape_vec((rows.len(), d), flat).map_err(runtime_error)?;
+    Ok(a.into_pyarray(py))
+}
+
+/// One lane's optimiser: `ask()` a population, `tell(fitness)`; maximises.
+#[pyclass(module = "animats")]
+pub struct Optimiser {
+    inner: AnyOptimiser,
+    dim: usize,
+    asked: bool,
+}
+
+#[pymethods]
+impl Optimiser {
+    /// `kind`: "hill-climber", "ga" or "cma-es". Give `problem` (an
+    /// `animats.Scene`, a path or "roobot") to start from its parameters
+    /// within its bounds exactly as `animats evolve` does, or `dim` / `start`
+    /// (and optionally `bounds`, a `(D, 2)` array) for a problem of your own.
+    /// `lane` picks the random stream (and the hill climber's step size) as
+    /// the lanes of `animats evolve` do.
+    #[new]
+    #[pyo3(signature = (kind, dim = None, seed = 0, *, start = None, bounds = None, population = None, lane = 0, sigma = None, restarts = 0, problem = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        kind: &str,
+        dim: Option<usize>,
+        seed: u64,
+        start: Option<PyReadonlyArray1<'_, f64>>,
+        bounds: Option<PyReadonlyArray2<'_, f64>>,
+        population: Option<usize>,
+        lane: usize,
+        sigma: Option<f64>,
+        restarts: u32,
+        problem: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Optimiser> {
+        let kind = self::kind(kind)?;
+        let mut setup = match problem {
+            Some(p) => {
+                let spec = problem_spec(p)?;
+                let problem = build(&spec)?;
+                let config = Config {
+                    optimiser: kind,
+                    population,
+                    restarts,
+                    seed,
+                    ..Config::thesis(lane + 1, 1, seed)
+                };
+                config.setup(problem.as_ref(), lane)
+            }
+            None => Setup {
+                kind,
+                start: Vec::new(),
+                bounds: None,
+                population,
+                seed,
+                lane,
+                sigma,
+                restarts,
+            },
+        };
+        setup.lane = lane;
+        if let Some(s) = start {
+            setup.start = s.as_array().to_vec();
+        } else if setup.start.is_empty() {
+            let d = dim.ok_or_else(|| value_error("give dim, start or problem"))?;
+            setup.start = vec![0.0; d];
+        }
+        if let Some(d) = dim {
+            if d != setup.start.len() {
+                return Err(value_error(format!(
+                    "dim is {d} but the start has {} genes",
+                    setup.start.len()
+                )));
+            }
+        }
+        if let Some(b) = bounds {
+            let b = b.as_array();
+            if b.ncols() != 2 {
+                return Err(value_error("bounds must be a (D, 2) array of (low, high)"));
+            }
+            setup.bounds = Some(Bounds {
+                lo: b.column(0).to_vec(),
+                hi: b.column(1).to_vec(),
+            });
+        }
+        if sigma.is_some() {
+            setup.sigma = sigma;
+        }
+        let dim = setup.start.len();
+        Ok(Optimiser {
+            inner: AnyOptimiser::new(&setup).map_err(value_error)?,
+            dim,
+            asked: false,
+        })
+    }
+
+    /// The next population, a `(P, D)` array.
+    fn ask<'py>(&mut self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        if self.asked {
+            return Err(value_error("tell the fitness of the last population first"));
+        }
+        let pop = self.inner.ask();
+        self.asked = true;
+        matrix(py, &pop, self.dim)
+    }
+
+    /// The fitness of each row of the last `ask()` (higher is better;
+    /// NaN counts as the worst).
+    fn tell(&mut self, fitness: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+        if !self.asked {
+            return Err(value_error("ask for a population first"));
+        }
+        self.inner
+            .tell(&fitness.as_array().to_vec())
+            .map_err(value_error)?;
+        self.asked = false;
+        Ok(())
+    }
+
+    /// Generations told so far.
+    #[getter]
+    fn generation(&self) -> u64 {
+        self.inner.generation()
+    }
+
+    /// The genome's length.
+    #[getter]
+    fn dim(&self) -> usize {
+        self.dim
+    }
+
+    /// The kind's name.
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.inner.kind().name()
+    }
+
+    /// The best genome told so far and its fitness, or None.
+    fn best<'py>(&self, py: Python<'py>) -> Option<(Bound<'py, PyArray1<f64>>, f64)> {
+        self.inner
+            .best()
+            .map(|(g, f)| (PyArray1::from_vec(py, g.to_vec()), f))
+    }
+}
+
+/// A whole evolution run, as `animats evolve [SCENE]` makes it: lanes, the
+/// log, the best. `run()` advances it here; `ask()`/`tell()` hand each
+/// generation out to be evaluated elsewhere (`animats.distributed`).
+#[pyclass(module = "animats")]
+pub struct Evolution {
+    state: State,
+    problem: Option<Box<dyn animats_evolve::Problem>>,
+    pending: Option<Generation>,
+}
+
+impl Evolution {
+    fn problem(&mut self) -> PyResult<&dyn animats_evolve::Problem> {
+        if self.problem.is_none() {
+            self.problem = Some(build(&self.state.config.problem)?);
+        }
+        Ok(self.problem.as_deref().expect("built above"))
+    }
+}
+
+#[pymethods]
+impl Evolution {
+    /// `scene`: an `animats.Scene`, a path, or "roobot" (the default). The
+    /// other arguments are `animats evolve`'s, with its defaults.
+    #[new]
+    #[pyo3(signature = (scene = None, *, lanes = None, generations = 100, seed = 1, optimiser = "hill-climber", population = None, restarts = 0))]
+    fn new(
+        scene: Option<&Bound<'_, PyAny>>,
+        lanes: Option<usize>,
+        generations: u64,
+        seed: u64,
+        optimiser: &str,
+        population: Option<usize>,
+        restarts: u32,
+    ) -> PyResult<Evolution> {
+        let spec = match scene {
+            Some(s) => problem_spec(s)?,
+            None => Config::thesis(1, 1, 0).problem,
+        };
+        let default_lanes = if spec.is_roobot() { 6 } else { 1 };
+        let kind = kind(optimiser)?;
+        if restarts > 0 && kind != OptimiserKind::CmaEs {
+            return Err(value_error(format!(
+                "restarts are for cma-es, not {}",
+                kind.name()
+            )));
+        }
+        if !(1..=100_000_000).contains(&generations) {
+            return Err(value_error("generations must be between 1 and 100000000"));
+        }
+        let config = Config {
+            optimiser: kind,
+            population,
+            restarts,
+            problem: spec,
+            ..Config::thesis(lanes.unwrap_or(default_lanes), generations, seed)
+        };
+        let state = State::new(config).map_err(value_error)?;
+        Ok(Evolution {
+            state,
+            problem: None,
+            pending: None,
+        })
+    }
+
+    /// The next generation of every lane not yet done: `(genomes, lanes)`,
+    /// a `(N, D)` array and each row's lane. Evaluate every row and `tell`.
+    fn ask<'py>(&mut self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray2<f64>>, Vec<usize>)> {
+        if self.pending.is_some() {
+            return Err(value_error(
+                "tell the outcomes of the last generation first",
+            ));
+        }
+        let g = self.state.ask();
+        let d = self.dim();
+        let rows: Vec<Vec<f64>> = g.genomes().map(|x| x.to_vec()).collect();
+        let lanes = g
+            .lanes
+            .iter()
+            .flat_map(|(l, p)| std::iter::repeat(*l).take(p.len()))
+            .collect();
+        self.pending = Some(g);
+        Ok((matrix(py, &rows, d)?, lanes))
+    }
+
+    /// The outcomes of the last `ask()`'s rows: a dict with `fitness`,
+    /// `time`, `distance` (arrays) and `ended` (strings), as
+    /// `Evaluator.outcomes` gives.
+    fn tell(&mut self, outcomes: &Bound<'_, PyDict>) -> PyResult<()> {
+        let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
+            outcomes
+                .get_item(k)?
+                .ok_or_else(|| value_error(format!("the outcomes have no `{k}`")))
+        };
+        let fitness: Vec<f64> = get("fitness")?.extract()?;
+        let time: Vec<f64> = get("time")?.extract()?;
+        let distance: Vec<f64> = get("distance")?.extract()?;
+        let ended: Vec<String> = get("ended")?.extract()?;
+        let n = fitness.len();
+        if time.len() != n || distance.len() != n || ended.len() != n {
+            return Err(value_error(
+                "fitness, time, distance and ended differ in length",
+            ));
+        }
+        let g = self
+            .pending
+            .take()
+            .ok_or_else(|| value_error("ask for a generation first"))?;
+        if g.len() != n {
+            let asked = g.len();
+            self.pending = Some(g);
+            return Err(value_error(format!(
+                "{n} outcomes told for a generation of {asked} genomes"
+            )));
+        }
+        let o: Vec<Outcome> = (0..n)
+            .map(|i| Outcome {
+                fitness: fitness[i],
+                time: time[i],
+                distance: distance[i],
+                ended: ended[i].clone(),
+            })
+            .collect();
+        self.state.tell(g, &o).map_err(value_error)
+    }
+
+    /// Evaluates the outcomes of a generation here (what `tell` takes).
+    #[pyo3(signature = (genomes, threads = None))]
+    fn evaluate<'py>(
+        &mut self,
+        py: Python<'py>,
+        genomes: PyReadonlyArray2<'py, f64>,
+        threads: Option<usize>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pool = pool(threads)?;
+        let problem = self.problem()?;
+        let o = outcomes(py, problem, &genomes, &pool)?;
+        outcome_dict(py, &o)
+    }
+
+    /// Advances every lane by up to `generations` generations (default:
+    /// to the end) here, in parallel, the GIL released.
+    #[pyo3(signature = (generations = None, threads = None))]
+    fn run(
+        &mut self,
+        py: Python<'_>,
+        generations: Option<u64>,
+        threads: Option<usize>,
+    ) -> PyResult<()> {
+        if self.pending.is_some() {
+            return Err(value_error(
+                "tell the outcomes of the last generation first",
+            ));
+        }
+        let pool = pool(threads)?;
+        let n = generations.unwrap_or(self.state.config.generations);
+        self.problem()?;
+        let Evolution { state, problem, .. } = self;
+        let problem = problem.as_deref().expect("built above");
+        py.detach(|| on(&pool, || state.advance_with(problem, n)))
+            .map_err(runtime_error)
+    }
+
+    /// True when every lane has done its generations.
+    #[getter]
+    fn done(&self) -> bool {
+        self.state.done()
+    }
+
+    /// Generations every lane has completed.
+    #[getter]
+    fn generation(&self) -> u64 {
+        self.state.generation()
+    }
+
+    /// Evaluations so far.
+    #[getter]
+    fn evaluations(&self) -> u64 {
+        self.state.evaluations
+    }
+
+    /// The genome's length.
+    #[getter]
+    fn dim(&self) -> usize {
+        match &self.state.config.problem {
+            ProblemSpec::Roobot { start, .. } => start.len(),
+            ProblemSpec::Scene { .. } => self
+                .state
+                .lanes
+                .first()
+                .and_then(|l| l.best.as_ref().map(|b| b.genome.len()))
+                .or_else(|| self.problem.as_ref().map(|p| p.dim()))
+                .unwrap_or_else(|| build(&self.state.config.problem).map_or(0, |p| p.dim())),
+        }
+    }
+
+    /// The best fitness over all lanes so far, or None.
+    #[getter]
+    fn best_fitness(&self) -> Option<f64> {
+        self.state.best_fitness()
+    }
+
+    /// The run's settings as `animats evolve` stores them, as a dict.
+    #[getter]
+    fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let c = &self.state.config;
+        let d = PyDict::new(py);
+        d.set_item("lanes", c.lanes)?;
+        d.set_item("generations", c.generations)?;
+        d.set_item("seed", c.seed)?;
+        d.set_item("optimiser", c.optimiser.name())?;
+        d.set_item("population", c.population)?;
+        d.set_item("restarts", c.restarts)?;
+        match &c.problem {
+            ProblemSpec::Roobot { .. } => d.set_item("scene", "roobot")?,
+            ProblemSpec::Scene { file, .. } => d.set_item("scene", file)?,
+        }
+        Ok(d)
+    }
+
+    /// The problem as text a worker can rebuild: `("roobot", "")` or
+    /// `(file, scene text)`.
+    fn problem_text(&self) -> (String, String) {
+        match &self.state.config.problem {
+            ProblemSpec::Roobot { .. } => ("roobot".into(), String::new()),
+            ProblemSpec::Scene { file, text } => (file.clone(), text.clone()),
+        }
+    }
+
+    /// `log.csv`, exactly as `animats evolve` writes it.
+    fn log_csv(&self) -> String {
+        self.state.log_csv()
+    }
+
+    /// `best.toml`, exactly as `animats evolve` writes it (None before the
+    /// first generation).
+    fn best_toml(&self) -> PyResult<Option<String>> {
+        self.state.best_toml().map_err(runtime_error)
+    }
+
+    /// Writes `log.csv` and `best.toml` into `directory` (created if
+    /// needed), each file whole or not at all.
+    fn save(&self, directory: PathBuf) -> PyResult<()> {
+        std::fs::create_dir_all(&directory).map_err(|e| {
+            pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", directory.display()))
+        })?;
+        let io = |e: std::io::Error| pyo3::exceptions::PyOSError::new_err(e.to_string());
+        animats_files::write_atomically(&directory.join("log.csv"), self.log_csv().as_bytes())
+            .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        if let Some(b) = self.best_toml()? {
+            animats_files::write_atomically(&directory.join("best.toml"), b.as_bytes())
+                .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        }
+        Ok(())
+    }
+}

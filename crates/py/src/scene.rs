@@ -1,0 +1,327 @@
+//! `animats.load`, `Scene`, `World`, `Snapshot`.
+
+use crate::{runtime_error, scene_error, value_error};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::prelude::*;
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+/// Where a genome starts and its bounds.
+type Genome = (Vec<f64>, Vec<(f64, f64)>);
+
+/// A scene file, read and checked: what `animats simulate`, `evaluate` and
+/// `evolve` take. Build worlds from it with `world()`.
+#[pyclass(frozen, module = "animats")]
+pub struct Scene {
+    pub(crate) file: String,
+    pub(crate) text: String,
+    names: Vec<String>,
+    dt: f64,
+    duration: f64,
+    actuators: Vec<String>,
+    sensors: Vec<String>,
+    controllers: Vec<String>,
+    /// The `[evolve]` controller's start and bounds.
+    evolve: Option<Genome>,
+}
+
+impl Scene {
+    /// True when the scene has an `[evolve]` table.
+    pub(crate) fn is_evolvable(&self) -> bool {
+        self.evolve.is_some()
+    }
+
+    pub(crate) fn from_text(text: String, file: String) -> PyResult<Scene> {
+        let s = animats_scene::parse(&text, &file).map_err(scene_error)?;
+        let evolve = match &s.evolve {
+            Some(_) => {
+                let p = animats_scene::evaluate::SceneProblem::parse(&text, &file)
+                    .map_err(scene_error)?;
+                Some((p.start().to_vec(), p.bounds().to_vec()))
+            }
+            None => None,
+        };
+        Ok(Scene {
+            names: s.names.clone(),
+            dt: s.dt,
+            duration: s.duration,
+            actuators: s.nervous.actuators.iter().map(|(n, _)| n.clone()).collect(),
+            sensors: s.nervous.sensors.iter().map(|(n, _)| n.clone()).collect(),
+            controllers: s
+                .nervous
+                .controllers
+                .iter()
+                .map(|c| c.name.clone())
+                .collect(),
+            evolve,
+            file,
+            text,
+        })
+    }
+}
+
+/// Reads and checks the scene file at `path`. Raises `animats.SceneError`
+/// (a `ValueError`) naming the file, line, entry and field of a mistake.
+#[pyfunction]
+pub fn load(path: PathBuf) -> PyResult<Scene> {
+    let file = path.display().to_string();
+    let text = animats_scene::read(&path).map_err(scene_error)?;
+    Scene::from_text(text, file)
+}
+
+/// Checks a scene given as text; `file` names it in messages.
+#[pyfunction]
+#[pyo3(signature = (text, file = "<string>".to_string()))]
+pub fn parse(text: String, file: String) -> PyResult<Scene> {
+    Scene::from_text(text, file)
+}
+
+#[pymethods]
+impl Scene {
+    /// A fresh world built from the scene, at its start.
+    fn world(&self) -> PyResult<World> {
+        let scene = animats_scene::parse(&self.text, &self.file).map_err(scene_error)?;
+        Ok(World {
+            scene: Mutex::new(scene),
+        })
+    }
+
+    /// The scene file's name.
+    #[getter]
+    fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The scene file's text.
+    #[getter]
+    fn text(&self) -> &str {
+        &self.text
+    }
+
+    /// Each particle's name, in order.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+
+    /// The step, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The `[world]` duration, s.
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// Actuator names, in the scene's order (the order of levels).
+    #[getter]
+    fn actuators(&self) -> Vec<String> {
+        self.actuators.clone()
+    }
+
+    /// Sensor names, in the scene's order.
+    #[getter]
+    fn sensors(&self) -> Vec<String> {
+        self.sensors.clone()
+    }
+
+    /// Controller names, in the scene's order.
+    #[getter]
+    fn controllers(&self) -> Vec<String> {
+        self.controllers.clone()
+    }
+
+    /// True when the scene has an `[evolve]` table.
+    #[getter]
+    fn evolvable(&self) -> bool {
+        self.evolve.is_some()
+    }
+
+    /// The `[evolve]` controller's own parameters (where evolution starts).
+    fn start<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (start, _) = self.evolve.as_ref().ok_or_else(|| no_evolve(&self.file))?;
+        Ok(PyArray1::from_vec(py, start.clone()))
+    }
+
+    /// The genome's bounds, a `(D, 2)` array of (low, high).
+    fn bounds<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (_, b) = self.evolve.as_ref().ok_or_else(|| no_evolve(&self.file))?;
+        let flat: Vec<f64> = b.iter().flat_map(|(lo, hi)| [*lo, *hi]).collect();
+        let a = Array2::from_shape_vec((b.len(), 2), flat).map_err(runtime_error)?;
+        Ok(a.into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<animats.Scene {:?}: {} particles, {} actuators, {} sensors{}>",
+            self.file,
+            self.names.len(),
+            self.actuators.len(),
+            self.sensors.len(),
+            if self.evolve.is_some() {
+                ", [evolve]"
+            } else {
+                ""
+            }
+        )
+    }
+}
+
+pub(crate) fn no_evolve(file: &str) -> PyErr {
+    scene_error(format!(
+        "{file}: the scene has no [evolve] table (docs/SCENES.md)"
+    ))
+}
+
+/// A running scene: its world, creatures and controllers. Stepping
+/// releases the GIL.
+#[pyclass(module = "animats")]
+pub struct World {
+    scene: Mutex<animats_scene::Scene>,
+}
+
+/// The state of a world at one instant (positions, velocities, the
+/// parameters actuators drive, actuator levels). Controllers' and
+/// creatures' own state (an FSM's current state) is not part of it.
+#[pyclass(frozen, module = "animats")]
+pub struct Snapshot {
+    inner: animats_scene::SceneSnapshot,
+}
+
+#[pymethods]
+impl Snapshot {
+    /// Simulated time of the snapshot, s.
+    #[getter]
+    fn time(&self) -> f64 {
+        self.inner.world.time
+    }
+}
+
+impl World {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, animats_scene::Scene>> {
+        self.scene
+            .lock()
+            .map_err(|_| runtime_error("the world was poisoned by an earlier failure"))
+    }
+}
+
+fn vec3s<'py>(
+    py: Python<'py>,
+    v: impl Iterator<Item = [f64; 3]>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let flat: Vec<f64> = v.flatten().collect();
+    let n = flat.len() / 3;
+    let a = Array2::from_shape_vec((n, 3), flat).map_err(runtime_error)?;
+    Ok(a.into_pyarray(py))
+}
+
+#[pymethods]
+impl World {
+    /// Advances `n` steps of the scene's `dt` (controllers act before each).
+    /// Raises `RuntimeError` if the simulation blows up, naming the step.
+    #[pyo3(signature = (n = 1))]
+    fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
+        let mut s = self.lock()?;
+        let scene = &mut *s;
+        py.detach(|| {
+            let dt = scene.dt;
+            for _ in 0..n {
+                scene.step(dt).map_err(|e| e.to_string())?;
+            }
+            Ok::<(), String>(())
+        })
+        .map_err(runtime_error)
+    }
+
+    /// Simulated time, s.
+    #[getter]
+    fn time(&self) -> PyResult<f64> {
+        Ok(self.lock()?.world.time())
+    }
+
+    /// The step, s.
+    #[getter]
+    fn dt(&self) -> PyResult<f64> {
+        Ok(self.lock()?.dt)
+    }
+
+    /// Each particle's name, in order (the rows of `positions()`).
+    #[getter]
+    fn names(&self) -> PyResult<Vec<String>> {
+        Ok(self.lock()?.names.clone())
+    }
+
+    /// Positions, m: an `(N, 3)` float64 array (a copy).
+    fn positions<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let s = self.lock()?;
+        vec3s(py, s.world.state().pos.iter().map(|p| p.to_array()))
+    }
+
+    /// Velocities, m/s: an `(N, 3)` float64 array (a copy).
+    fn velocities<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let s = self.lock()?;
+        vec3s(py, s.world.state().vel.iter().map(|p| p.to_array()))
+    }
+
+    /// Sets every actuator's level (scene order, clamped to [0, 1]);
+    /// controllers overwrite those they drive at the next step.
+    fn set_actuators(&self, levels: Vec<f64>) -> PyResult<()> {
+        if let Some(i) = levels.iter().position(|l| !l.is_finite()) {
+            return Err(value_error(format!(
+                "level {i} is not finite: {}",
+                levels[i]
+            )));
+        }
+        let mut s = self.lock()?;
+        let scene = &mut *s;
+        scene
+            .nervous
+            .set_levels(&mut scene.world, &levels)
+            .map_err(value_error)
+    }
+
+    /// Every actuator's level, in the scene's order.
+    fn actuators<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(
+            py,
+            self.lock()?.nervous.actuator_levels(),
+        ))
+    }
+
+    /// Every sensor's level, in the scene's order.
+    fn sensors<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let s = self.lock()?;
+        Ok(PyArray1::from_vec(py, s.nervous.sensor_levels(&s.world)))
+    }
+
+    /// The world's state now; `restore` returns to it bit for bit.
+    fn snapshot(&self) -> PyResult<Snapshot> {
+        Ok(Snapshot {
+            inner: self.lock()?.snapshot(),
+        })
+    }
+
+    /// Returns to a snapshot of this world (or of one built from the same
+    /// scene).
+    fn restore(&self, snapshot: &Snapshot) -> PyResult<()> {
+        self.lock()?.restore(&snapshot.inner).map_err(value_error)
+    }
+
+    /// Total energy (kinetic + potential), J.
+    fn energy(&self) -> PyResult<f64> {
+        Ok(self.lock()?.world.energy().total())
+    }
+
+    fn __repr__(&self) -> PyResult<String> {
+        let s = self.lock()?;
+        Ok(format!(
+            "<animats.World: {} particles at t = {} s>",
+            s.world.len(),
+            s.world.time()
+        ))
+    }
+}

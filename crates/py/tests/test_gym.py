@@ -1,0 +1,126 @@
+"""The Gymnasium environments: Gymnasium's own checker, seeds, vector
+environments, and rewards that add up to the evaluation's fitness."""
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+
+import animats  # noqa: E402
+import animats.gym  # noqa: E402,F401  (registers the environments)
+
+
+def test_roobot_passes_gymnasiums_checker():
+    env = gymnasium.make("animats/Roobot-v0")
+    check_env(env.unwrapped)
+    assert env.observation_space.shape == (4,) and env.action_space.shape == (3,)
+    assert env.unwrapped.action_names == ["leg", "hip", "ankle"]
+
+
+def test_scene_passes_gymnasiums_checker(pogo_env):
+    env = gymnasium.make("animats/Scene-v0", scene=str(pogo_env))
+    check_env(env.unwrapped)
+    assert env.unwrapped.action_names == ["leg_muscle"]
+    assert env.observation_space.shape == (2,)
+
+
+def test_a_scene_without_sensors_is_refused(root):
+    with pytest.raises(animats.SceneError, match="sensor"):
+        gymnasium.make("animats/Scene-v0", scene=str(root / "scenes" / "walker.toml"))
+
+
+def _episode(env, policy, seed):
+    obs, _ = env.reset(seed=seed)
+    total, steps = 0.0, 0
+    while True:
+        obs, r, term, trunc, _ = env.step(policy(obs, steps))
+        total += r
+        steps += 1
+        assert env.observation_space.contains(obs)
+        if term or trunc:
+            return total, steps, term
+
+
+def test_rewards_add_up_to_the_evolve_fitness(pogo_env):
+    # [evolve] of the pogo: fitness = 1 × time + 50 × rise of the centre of
+    # mass (axis +y). Computed here from the particles' positions and the
+    # file's masses, independently of the environment's own bookkeeping.
+    import tomllib
+
+    masses = np.array([p["mass"] for p in tomllib.loads(pogo_env.read_text())["particle"]])
+    env = gymnasium.make("animats/Scene-v0", scene=str(pogo_env))
+    inner = env.unwrapped._env
+
+    def centre():
+        return masses @ inner.positions()[:, 1] / masses.sum()
+
+    env.reset(seed=0)
+    y0 = centre()
+    total, steps = 0.0, 0
+    while True:
+        # Hop by hand: thrust for 0.1 s in every 0.4 s.
+        a = np.array([0.9 if (steps * env.unwrapped.dt) % 0.4 < 0.1 else 0.3])
+        _, r, term, trunc, _ = env.step(a)
+        total += r
+        steps += 1
+        if term or trunc:
+            break
+    assert trunc and not term and steps == env.unwrapped.max_steps == round(5.0 / env.unwrapped.dt)
+    want = 1.0 * steps * env.unwrapped.dt + 50.0 * (centre() - y0)
+    assert total == pytest.approx(want, abs=1e-9)
+    assert abs(centre() - y0) > 1e-3, "the pogo moved"
+
+
+def test_reset_with_a_seed_repeats_the_episode():
+    env = gymnasium.make("animats/Roobot-v0", noise=0.05)
+    policy = lambda o, k: np.array([0.3 + 0.4 * (k % 50 < 25), 0.5 + 0.3 * o[1] - 0.15, 0.5])
+    a = _episode(env, policy, 5)
+    b = _episode(env, policy, 5)
+    c = _episode(env, policy, 6)
+    assert a == b
+    assert a != c
+
+
+def test_make_vec_sync_and_native_step_the_same_copies():
+    n, steps = 8, 300
+    sync = gymnasium.make_vec("animats/Roobot-v0", num_envs=n, vectorization_mode="sync", noise=0.02)
+    native = gymnasium.make_vec("animats/Roobot-v0", num_envs=n, noise=0.02)
+    assert isinstance(native, animats.gym.AnimatsVectorEnv)
+    o1, _ = sync.reset(seed=10)
+    o2, _ = native.reset(seed=10)
+    rng = np.random.default_rng(0)
+    # Gymnasium seeds copy k with seed + k: so do we. The noise is ours to
+    # draw; the sync copies draw theirs from np_random, so compare shapes.
+    assert o1.shape == o2.shape == (n, 4)
+    done_native = 0
+    for _ in range(steps):
+        a = rng.random((n, 3))
+        o2, r2, te2, tr2, _ = native.step(a)
+        o1, r1, te1, tr1, _ = sync.step(a)
+        assert o2.shape == (n, 4) and r2.shape == (n,)
+        done_native += int(np.sum(te2 | tr2))
+    assert done_native > 0, "random actions topple some roobots: autoreset exercised"
+
+
+def test_the_native_vector_environment_is_n_single_environments():
+    n = 5
+    vec = animats.VecEnv("roobot", n, seed=3, noise=0.05)
+    singles = [animats.Env("roobot", noise=0.05) for _ in range(n)]
+    obs = vec.reset(3)
+    for k, e in enumerate(singles):
+        assert np.array_equal(e.reset(3 + k), obs[k])
+    rng = np.random.default_rng(2)
+    compared = 0
+    for _ in range(100):
+        a = 0.5 + 0.1 * (rng.random((n, 3)) - 0.5)
+        o, r, te, tr = vec.step(a)
+        ended = False
+        for k, e in enumerate(singles):
+            ok, rk, tek, trk = e.step(a[k])
+            assert np.array_equal(ok, o[k]) and rk == r[k] and (tek, trk) == (te[k], tr[k])
+            ended |= tek or trk
+        compared += 1
+        if ended:  # the next-step reset is exercised in the test above
+            break
+    assert compared >= 50
