@@ -45,7 +45,10 @@ class _Worker:
         return os.getpid()
 
     def outcomes(self, genomes: np.ndarray) -> dict:
-        return self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
+        start = time.perf_counter()
+        out = self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
+        out["seconds"] = time.perf_counter() - start
+        return out
 
 
 @dataclass
@@ -58,6 +61,9 @@ class Stats:
     retries: int = 0
     #: Seconds spent waiting for the actors.
     wall: float = 0.0
+    #: Seconds the slowest actor of each call spent evaluating, summed: what
+    #: is left of `wall` went to Ray (dispatch, transfer, scheduling).
+    compute: float = 0.0
     #: Each actor's process id at the start.
     pids: List[int] = field(default_factory=list)
 
@@ -98,6 +104,12 @@ class Pool:
         # Refuse a bad scene here, not in every actor.
         if not (file == "roobot" and text == ""):
             _animats.parse(text, file)
+        cpus = ray.cluster_resources().get("CPU", 0)
+        if actors > cpus:
+            raise ValueError(
+                f"{actors} actors need {actors} CPUs (one each) but the Ray cluster has {cpus:g}: "
+                "they would wait forever; use fewer actors or add machines"
+            )
         self.max_retries = max_retries
         self.stats = Stats()
         remote = ray.remote(num_cpus=1, max_restarts=-1)(_Worker)
@@ -141,6 +153,7 @@ class Pool:
                 actor = self.actors[(i + tries[i]) % len(self.actors)]
                 pending[actor.outcomes.remote(g[shares[i]])] = i
         self.stats.wall += time.perf_counter() - start
+        self.stats.compute += max((r["seconds"] for r in results), default=0.0)
         return _merge(results, len(g))
 
     def evaluate(self, genomes: np.ndarray) -> np.ndarray:

@@ -1,0 +1,148 @@
+"""Type stubs of the compiled core (crates/py/src)."""
+
+from os import PathLike
+from typing import Dict, List, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+SceneLike = Union["Scene", str, PathLike[str]]
+
+ROOBOT_INITIAL: List[float]
+ROOBOT_BOUNDS: List[List[float]]
+
+class SceneError(ValueError):
+    """A scene that cannot be read or built; names file, line, entry, field."""
+
+def load(path: Union[str, PathLike[str]]) -> Scene: ...
+def parse(text: str, file: str = "<string>") -> Scene: ...
+
+class Scene:
+    file: str
+    text: str
+    names: List[str]
+    dt: float
+    duration: float
+    actuators: List[str]
+    sensors: List[str]
+    controllers: List[str]
+    evolvable: bool
+    def world(self) -> World: ...
+    def start(self) -> F64: ...
+    def bounds(self) -> F64: ...
+
+class Snapshot:
+    time: float
+
+class World:
+    time: float
+    dt: float
+    names: List[str]
+    def step(self, n: int = 1) -> None: ...
+    def positions(self) -> F64: ...
+    def velocities(self) -> F64: ...
+    def set_actuators(self, levels: Sequence[float]) -> None: ...
+    def actuators(self) -> F64: ...
+    def sensors(self) -> F64: ...
+    def snapshot(self) -> Snapshot: ...
+    def restore(self, snapshot: Snapshot) -> None: ...
+    def energy(self) -> float: ...
+
+def evaluate(scene: SceneLike, genomes: F64, threads: Optional[int] = None) -> F64: ...
+
+Outcomes = Dict[str, Union[F64, List[str]]]
+
+class Evaluator:
+    dim: int
+    roobot: bool
+    def __init__(self, scene: SceneLike, threads: Optional[int] = None) -> None: ...
+    def evaluate(self, genomes: F64) -> F64: ...
+    def outcomes(self, genomes: F64) -> Outcomes: ...
+
+class Optimiser:
+    generation: int
+    dim: int
+    kind: str
+    def __init__(
+        self,
+        kind: str,
+        dim: Optional[int] = None,
+        seed: int = 0,
+        *,
+        start: Optional[F64] = None,
+        bounds: Optional[F64] = None,
+        population: Optional[int] = None,
+        lane: int = 0,
+        sigma: Optional[float] = None,
+        restarts: int = 0,
+        problem: Optional[SceneLike] = None,
+    ) -> None: ...
+    def ask(self) -> F64: ...
+    def tell(self, fitness: F64) -> None: ...
+    def best(self) -> Optional[Tuple[F64, float]]: ...
+
+class Evolution:
+    done: bool
+    generation: int
+    evaluations: int
+    dim: int
+    best_fitness: Optional[float]
+    config: Dict[str, object]
+    def __init__(
+        self,
+        scene: Optional[SceneLike] = None,
+        *,
+        lanes: Optional[int] = None,
+        generations: int = 100,
+        seed: int = 1,
+        optimiser: str = "hill-climber",
+        population: Optional[int] = None,
+        restarts: int = 0,
+    ) -> None: ...
+    def ask(self) -> Tuple[F64, List[int]]: ...
+    def tell(self, outcomes: Outcomes) -> None: ...
+    def evaluate(self, genomes: F64, threads: Optional[int] = None) -> Outcomes: ...
+    def run(self, generations: Optional[int] = None, threads: Optional[int] = None) -> None: ...
+    def problem_text(self) -> Tuple[str, str]: ...
+    def log_csv(self) -> str: ...
+    def best_toml(self) -> Optional[str]: ...
+    def save(self, directory: Union[str, PathLike[str]]) -> None: ...
+
+class Env:
+    observation_names: List[str]
+    action_names: List[str]
+    dt: float
+    max_steps: int
+    time: float
+    def __init__(
+        self,
+        scene: SceneLike,
+        noise: float = 0.0,
+        seconds: Optional[float] = None,
+        dt: Optional[float] = None,
+    ) -> None: ...
+    def reset(self, seed: int = 0) -> F64: ...
+    def observe(self) -> F64: ...
+    def step(self, action: F64) -> Tuple[F64, float, bool, bool]: ...
+    def positions(self) -> F64: ...
+
+class VecEnv:
+    num_envs: int
+    observation_names: List[str]
+    action_names: List[str]
+    dt: float
+    max_steps: int
+    def __init__(
+        self,
+        scene: SceneLike,
+        n: int,
+        seed: int = 0,
+        noise: float = 0.0,
+        seconds: Optional[float] = None,
+        dt: Optional[float] = None,
+    ) -> None: ...
+    def reset(self, seed: int = 0) -> F64: ...
+    def step(
+        self, actions: F64
+    ) -> Tuple[F64, F64, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]: ...

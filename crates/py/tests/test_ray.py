@@ -1,0 +1,72 @@
+"""Evolution on a local Ray cluster: the same log.csv and best.toml, bit for
+bit, as `animats evolve` on one machine, even when a worker is killed in the
+middle of a generation."""
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+ray = pytest.importorskip("ray")
+
+import animats  # noqa: E402
+from animats import distributed  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield
+    ray.shutdown()
+
+
+def test_a_ray_evolution_writes_the_command_lines_log(cluster, cli, crawler, tmp_path):
+    args = dict(generations=6, lanes=3, seed=4, optimiser="cma-es")
+    cli("evolve", crawler, "--optimiser", "cma-es", "--generations", 6, "--lanes", 3,
+        "--seed", 4, "--out", tmp_path / "cli")
+    for actors in (1, 2):
+        run, stats = distributed.evolve(str(crawler), actors=actors, out=tmp_path / f"ray{actors}", **args)
+        assert stats.generations == 6 and stats.retries == 0
+        for f in ("log.csv", "best.toml"):
+            assert (tmp_path / f"ray{actors}" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), (actors, f)
+
+
+def test_a_worker_killed_mid_generation_costs_time_not_results(cluster, cli, tmp_path):
+    # The roobot with CMA-ES, 24 genomes a generation: each actor's share
+    # takes tens of milliseconds, and the kill lands while it runs.
+    cli("evolve", "--optimiser", "cma-es", "--population", 24, "--generations", 5,
+        "--lanes", 1, "--seed", 2, "--out", tmp_path / "cli")
+    killed = []
+
+    def kill(generation, pool):
+        if generation == 3 and not killed:
+            pid = pool.stats.pids[0]
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    run, stats = distributed.evolve(
+        "roobot", optimiser="cma-es", population=24, generations=5, lanes=1, seed=2,
+        actors=2, out=tmp_path / "ray", on_generation=kill,
+    )
+    assert killed, "the worker was killed"
+    assert stats.retries >= 1, "its share was evaluated again"
+    for f in ("log.csv", "best.toml"):
+        assert (tmp_path / "ray" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+
+
+def test_more_actors_than_cpus_are_refused_not_left_waiting(cluster):
+    with pytest.raises(ValueError, match="CPUs"):
+        distributed.Pool("roobot", actors=3)
+
+
+def test_a_pool_evaluates_as_evaluate_does(cluster, crawler):
+    scene = animats.load(crawler)
+    rng = np.random.default_rng(3)
+    b = scene.bounds()
+    g = b[:, 0] + (b[:, 1] - b[:, 0]) * rng.random((10, len(b)))
+    pool = distributed.Pool(scene, actors=2)
+    try:
+        assert np.array_equal(pool.evaluate(g), animats.evaluate(scene, g))
+    finally:
+        pool.shutdown()
