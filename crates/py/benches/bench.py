@@ -165,7 +165,7 @@ def bench_ray(repeats, genomes, here):
     rate = len(genomes) / t
     report("Ray, 2 actors, the same 600 genomes", rate, "evaluations/s",
            ratio=round(rate / here, 3), goal=">= 0.7",
-           slowest_actor_computing=f"{pool.stats.compute / pool.stats.wall:.0%} of the wall time")
+           busiest_actor_computing=f"{pool.stats.compute / pool.stats.wall:.0%} of the wall time")
     pool.shutdown()
     ray.shutdown()
 

@@ -61,7 +61,7 @@ class Stats:
     retries: int = 0
     #: Seconds spent waiting for the actors.
     wall: float = 0.0
-    #: Seconds the slowest actor of each call spent evaluating, summed: what
+    #: Seconds the busiest actor of each call spent evaluating, summed: what
     #: is left of `wall` went to Ray (dispatch, transfer, scheduling).
     compute: float = 0.0
     #: Each actor's process id at the start.
@@ -93,6 +93,7 @@ class Pool:
         *,
         problem_text: Optional[tuple] = None,
         max_retries: int = 5,
+        chunks: int = 4,
     ) -> None:
         import ray
 
@@ -111,6 +112,7 @@ class Pool:
                 "they would wait forever; use fewer actors or add machines"
             )
         self.max_retries = max_retries
+        self.chunks = max(1, chunks)
         self.stats = Stats()
         remote = ray.remote(num_cpus=1, max_restarts=-1)(_Worker)
         self.actors = [remote.remote(file, text) for _ in range(actors)]
@@ -121,27 +123,40 @@ class Pool:
         self, genomes: np.ndarray, on_dispatch: Optional[Callable[["Pool"], None]] = None
     ) -> dict:
         """Outcomes of each row of ``genomes`` (``Evaluator.outcomes``'s
-        dict), the rows split into one share per actor. ``on_dispatch`` is
-        called once the shares are sent (tests kill a worker there)."""
+        dict). The rows are cut into ``chunks`` shares per actor, handed out
+        as actors finish (evaluations differ in length: a fixed split would
+        wait for the unluckiest actor), and merged in row order.
+        ``on_dispatch`` is called once the first shares are sent (tests kill
+        a worker there)."""
         import ray
 
         g = np.ascontiguousarray(genomes, dtype=np.float64)
         if g.ndim != 2:
             raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
         start = time.perf_counter()
-        shares = [s for s in np.array_split(np.arange(len(g)), len(self.actors)) if len(s)]
+        n_shares = min(len(g), len(self.actors) * self.chunks)
+        shares = [s for s in np.array_split(np.arange(len(g)), max(n_shares, 1)) if len(s)]
         results: list = [None] * len(shares)
         tries = [0] * len(shares)
+        queue = list(range(len(shares)))
         pending = {}
-        for i, rows in enumerate(shares):
-            pending[self.actors[i].outcomes.remote(g[rows])] = i
+        busy = [0.0] * len(self.actors)
+
+        def send(actor: int) -> None:
+            i = queue.pop(0)
+            pending[self.actors[actor].outcomes.remote(g[shares[i]])] = (i, actor)
+
+        for a in range(len(self.actors)):
+            if queue:
+                send(a)
         if on_dispatch is not None:
             on_dispatch(self)
         while pending:
             done, _ = ray.wait(list(pending), num_returns=1)
-            i = pending.pop(done[0])
+            i, actor = pending.pop(done[0])
             try:
                 results[i] = ray.get(done[0])
+                busy[actor] += results[i]["seconds"]
             except _lost_errors() as e:
                 tries[i] += 1
                 self.stats.retries += 1
@@ -149,11 +164,14 @@ class Pool:
                     raise RuntimeError(
                         f"a share of {len(shares[i])} genomes failed {tries[i]} times: {e}"
                     ) from e
-                # Another actor (the dead one restarts behind the scenes).
-                actor = self.actors[(i + tries[i]) % len(self.actors)]
-                pending[actor.outcomes.remote(g[shares[i]])] = i
+                # Again, first in line, on the next actor; Ray restarts the
+                # dead one meanwhile.
+                queue.insert(0, i)
+                actor = (actor + 1) % len(self.actors)
+            if queue:
+                send(actor)
         self.stats.wall += time.perf_counter() - start
-        self.stats.compute += max((r["seconds"] for r in results), default=0.0)
+        self.stats.compute += max(busy)
         return _merge(results, len(g))
 
     def evaluate(self, genomes: np.ndarray) -> np.ndarray:
