@@ -169,3 +169,35 @@ def test_ask_and_tell_elsewhere_equal_run_here(crawler):
             there.ask()
         there.tell(ev.outcomes(genomes))
     assert there.log_csv() == here.log_csv()
+
+
+def test_a_blow_up_raises_runtime_error_naming_the_particle(tmp_path):
+    # A spring far too stiff for explicit Euler at this step diverges.
+    s = tmp_path / "stiff.toml"
+    s.write_text(
+        "[world]\ndt = 0.01\nintegrator = \"euler\"\n"
+        "[[particle]]\nname = \"a\"\nmass = 0.01\nposition = [0.0, 1.0, 0.0]\nradius = 0.01\n"
+        "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
+        "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
+    )
+    w = animats.load(s).world()
+    with pytest.raises(RuntimeError) as e:
+        w.step(100_000)
+    assert "diverged" in str(e.value) and "particle #0" in str(e.value), str(e.value)
+    assert 0 < w.time < 1000, "it stopped at the blow-up, not after 100,000 steps"
+
+
+def test_python_m_animats_evolve_writes_the_command_lines_files(cli, crawler, tmp_path):
+    import subprocess
+    import sys
+
+    args = ["--optimiser", "ga", "--generations", "4", "--lanes", "2", "--seed", "6"]
+    cli("evolve", crawler, *args, "--out", tmp_path / "cli")
+    r = subprocess.run([sys.executable, "-m", "animats.evolve", str(crawler), *args,
+                        "--out", str(tmp_path / "py")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    for f in ("log.csv", "best.toml"):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes()
+    bad = subprocess.run([sys.executable, "-m", "animats.evolve", str(tmp_path / "none.toml")],
+                         capture_output=True, text=True)
+    assert bad.returncode == 1 and "none.toml" in bad.stderr
