@@ -17,6 +17,23 @@ pub struct Transition {
     pub truncated: bool,
 }
 
+impl Transition {
+    /// A step's transition: `terminated` by the task's rule, else truncated
+    /// once `steps` reaches `max_steps`.
+    pub fn after(reward: f64, terminated: bool, steps: u64, max_steps: u64) -> Transition {
+        Transition {
+            reward,
+            terminated,
+            truncated: !terminated && steps >= max_steps,
+        }
+    }
+
+    /// True when the episode is over.
+    pub fn ends(&self) -> bool {
+        self.terminated || self.truncated
+    }
+}
+
 /// An environment: one world, reset and stepped by a program.
 pub trait Env: Send {
     /// Observations per step.

@@ -137,7 +137,7 @@ impl<E: Env> VecEnv<E> {
                 };
             } else {
                 *t = c.env.step(a)?;
-                c.done = t.terminated || t.truncated;
+                c.done = t.ends();
             }
             Ok::<(), String>(())
         };

@@ -180,13 +180,9 @@ impl Env for SceneEnv {
         let reward = fitness - self.fitness;
         self.fitness = fitness;
         let terminated = blew_up || self.spec.touching(&self.scene.world).is_some();
-        let truncated = !terminated && self.steps >= self.max_steps();
-        self.over = terminated || truncated;
-        Ok(Transition {
-            reward,
-            terminated,
-            truncated,
-        })
+        let t = Transition::after(reward, terminated, self.steps, self.max_steps());
+        self.over = t.ends();
+        Ok(t)
     }
 
     fn time(&self) -> f64 {

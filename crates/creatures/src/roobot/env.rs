@@ -154,13 +154,9 @@ impl Env for RoobotEnv {
         let terminated = blew_up
             || !fitness.is_finite()
             || ended(&self.world, &self.roobot, &self.settings).is_some();
-        let truncated = !terminated && self.steps >= self.max_steps();
-        self.over = terminated || truncated;
-        Ok(Transition {
-            reward,
-            terminated,
-            truncated,
-        })
+        let t = Transition::after(reward, terminated, self.steps, self.max_steps());
+        self.over = t.ends();
+        Ok(t)
     }
 
     fn time(&self) -> f64 {

@@ -29,17 +29,18 @@ def main(argv: "list[str] | None" = None) -> int:
     p.add_argument("--threads", type=int, help="threads (without --ray)")
     a = p.parse_args(argv)
     start = time.perf_counter()
+    # `animats evolve`'s arguments, the same here and on Ray.
+    run_args = dict(
+        lanes=a.lanes,
+        generations=a.generations,
+        seed=a.seed,
+        optimiser=a.optimiser,
+        population=a.population,
+        restarts=a.restarts,
+    )
     try:
         if a.ray is None:
-            run = _animats.Evolution(
-                a.scene,
-                lanes=a.lanes,
-                generations=a.generations,
-                seed=a.seed,
-                optimiser=a.optimiser,
-                population=a.population,
-                restarts=a.restarts,
-            )
+            run = _animats.Evolution(a.scene, **run_args)
             run.run(threads=a.threads)
             run.save(a.out)
             how = "here"
@@ -48,12 +49,7 @@ def main(argv: "list[str] | None" = None) -> int:
 
             run, stats = distributed.evolve(
                 a.scene,
-                generations=a.generations,
-                lanes=a.lanes,
-                seed=a.seed,
-                optimiser=a.optimiser,
-                population=a.population,
-                restarts=a.restarts,
+                **run_args,
                 actors=a.actors,
                 address=None if a.ray == "local" else a.ray,
                 out=a.out,
