@@ -468,20 +468,36 @@ fn allpairs_checks(x: &[DVec3], v: &[DVec3], steps: usize) -> Vec<Check> {
     checks
 }
 
+/// A rayon pool of `n` threads: what "1 thread" and "2 threads" mean for a
+/// world whose forces use threads (the n-body gather does).
+fn threads(n: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .expect("a thread pool")
+}
+
 fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
     use allpairs::*;
     let steps = if quick { 20 } else { STEPS };
+    let (p1, p2) = (threads(1), threads(2));
     let one = |w: &mut animats_engine::World| {
         for _ in 0..steps {
             w.step(DT).expect("all-pairs stays finite");
         }
     };
-    let (engine, baseline, world, base) =
-        measure_pair(runs, engine_world, one, Baseline::new, |b| {
+    let on = |p: &rayon::ThreadPool, w: &mut animats_engine::World| p.install(|| one(w));
+    let (engine, baseline, world, base) = measure_pair(
+        runs,
+        engine_world,
+        |w| on(&p1, w),
+        Baseline::new,
+        |b| {
             for _ in 0..steps {
                 b.step();
             }
-        });
+        },
+    );
     let mut checks = allpairs_checks(&world.state().pos, &world.state().vel, steps);
     checks.push(Check::new(
         "E vs baseline",
@@ -502,6 +518,7 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         baseline,
         checks,
     };
+    let one_thread = engine.median;
     let single = row(
         "symplectic, 1 thread",
         engine,
@@ -509,13 +526,18 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         N * N,
         checks,
     );
-    // The engine's force sums each pair once; so does this hand-written loop.
-    let (engine_pairs, pairs_base, _, _) =
-        measure_pair(runs, engine_world, one, Baseline::new, |b| {
+    // The hand-written loop that sums each pair once (half the pairs).
+    let (engine_pairs, pairs_base, _, _) = measure_pair(
+        runs,
+        engine_world,
+        |w| on(&p1, w),
+        Baseline::new,
+        |b| {
             for _ in 0..steps {
                 b.step_pairs();
             }
-        });
+        },
+    );
     let pairwise = row(
         "symplectic, 1 thread (i<j baseline)",
         engine_pairs,
@@ -523,15 +545,40 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         N * N,
         vec![],
     );
+    // One world, its bodies split between two threads; the same bits.
+    let (both, both_base, world2, _) = measure_pair(
+        runs,
+        engine_world,
+        |w| on(&p2, w),
+        Baseline::new,
+        |b| {
+            for _ in 0..steps {
+                b.step();
+            }
+        },
+    );
+    let same = world2.state().pos == world.state().pos && world2.state().vel == world.state().vel;
+    let speedup = one_thread / both.median;
+    let shared = row(
+        "symplectic, one world, 2 threads",
+        both,
+        Some(("hand-written loop (all i, j), 1 thread".into(), both_base)),
+        N * N,
+        vec![
+            Check::new("same bits as 1 thread", f64::from(u8::from(same)), 1.0, 0.0),
+            Check::target("speed-up over 1 thread", speedup, 1.8),
+        ],
+    );
     // Two threads: two independent copies, one per thread (the throughput an
     // evolution loop sees); the work of both counts.
+    let (pa, pb) = (threads(1), threads(1));
     let (two, two_base, _, _) = measure_pair(
         runs,
         || (engine_world(), engine_world()),
         |(a, b)| {
             std::thread::scope(|s| {
-                s.spawn(|| one(a));
-                s.spawn(|| one(b));
+                s.spawn(|| on(&pa, a));
+                s.spawn(|| on(&pb, b));
             })
         },
         || (Baseline::new(), Baseline::new()),
@@ -549,7 +596,7 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         2 * N * N,
         vec![],
     );
-    vec![single, pairwise, double]
+    vec![single, pairwise, shared, double]
 }
 
 #[cfg(test)]

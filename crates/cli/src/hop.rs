@@ -48,7 +48,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let e = evaluate_with(params, &settings, |world, roobot| {
         gait.observe(world, roobot);
         if let Some(t) = trajectory.as_mut() {
-            if step % args.every == 0 {
+            if step.is_multiple_of(args.every) {
                 if let Err(e) = t.record(world.time(), step, world.state()) {
                     write_error.get_or_insert(e);
                 }

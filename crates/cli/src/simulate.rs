@@ -197,7 +197,7 @@ fn realtime(args: Args) -> Result<(), Failure> {
             }
             steps += 1;
             if let Some(t) = trajectory.as_mut() {
-                if steps % args.every == 0 {
+                if steps.is_multiple_of(args.every) {
                     t.record(scene.world.time(), steps, scene.world.state())
                         .map_err(Failure::Other)?;
                 }

@@ -423,7 +423,7 @@ impl Optimiser for CmaEs {
         self.generation += 1;
         if self.restarts_left > 0 {
             let top = values[order[0]];
-            if self.run_best.map_or(true, |b| top < b) {
+            if self.run_best.is_none_or(|b| top < b) {
                 self.run_best = Some(top);
                 self.stale = 0;
             } else {

@@ -72,7 +72,7 @@ impl Ga {
         let mut winner = None::<usize>;
         for _ in 0..TOURNAMENT {
             let i = ((n as f64 * rng.uniform()) as usize).min(n - 1);
-            if winner.map_or(true, |w| self.fitness[i] > self.fitness[w]) {
+            if winner.is_none_or(|w| self.fitness[i] > self.fitness[w]) {
                 winner = Some(i);
             }
         }

@@ -104,7 +104,7 @@ impl Optimiser for HillClimber {
         let mut top: Option<(usize, f64)> = None;
         for (i, &f) in fitness.iter().enumerate() {
             let f = crate::optimiser::sane(f);
-            if top.map_or(true, |(_, t)| f > t) {
+            if top.is_none_or(|(_, t)| f > t) {
                 top = Some((i, f));
             }
         }

@@ -301,7 +301,7 @@ impl State {
         let mut top: Option<(&Lane, f64)> = None;
         for l in &self.lanes {
             if let Some(b) = &l.best {
-                if top.map_or(true, |(_, f)| b.fitness > f) {
+                if top.is_none_or(|(_, f)| b.fitness > f) {
                     top = Some((l, b.fitness));
                 }
             }
@@ -536,7 +536,7 @@ fn record(
     }
     let o = &outcomes[top];
     let f = crate::optimiser::sane(o.fitness);
-    let improved = lane.best.as_ref().map_or(true, |b| f > b.fitness);
+    let improved = lane.best.as_ref().is_none_or(|b| f > b.fitness);
     if improved {
         lane.best = Some(Best {
             genome: population[top].clone(),

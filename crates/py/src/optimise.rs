@@ -246,7 +246,7 @@ impl Evolution {
         let lanes = g
             .lanes
             .iter()
-            .flat_map(|(l, p)| std::iter::repeat(*l).take(p.len()))
+            .flat_map(|(l, p)| std::iter::repeat_n(*l, p.len()))
             .collect();
         self.pending = Some(g);
         Ok((matrix(py, &rows, d)?, lanes))

@@ -293,7 +293,7 @@ fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: boo
         let (a, b) = sp.ends();
         for i in [a.index(), b.index()] {
             load[i] += sp.stiffness;
-            if stiffest[i].map_or(true, |(kk, _)| sp.stiffness > kk) {
+            if stiffest[i].is_none_or(|(kk, _)| sp.stiffness > kk) {
                 stiffest[i] = Some((sp.stiffness, k));
             }
         }

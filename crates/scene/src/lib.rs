@@ -136,7 +136,7 @@ impl Scene {
             a.act(&mut self.world, dt);
         }
         let report = self.world.step(dt)?;
-        if self.world.stats().steps % GUARD_EVERY == 0 {
+        if self.world.stats().steps.is_multiple_of(GUARD_EVERY) {
             self.guard.check(&self.world)?;
         }
         Ok(report)

@@ -100,7 +100,7 @@ impl Fsm {
             Condition::Below { input, threshold } => inputs[input] < threshold,
             Condition::None => true,
         };
-        sensed && t.after.map_or(true, |a| in_state >= a)
+        sensed && t.after.is_none_or(|a| in_state >= a)
     }
 
     fn genes(&mut self) -> Vec<&mut f64> {

@@ -1,6 +1,13 @@
 //! Mutual gravitation among a set of bodies (the thesis's tutorial force,
-//! §4.1.2), with optional Plummer softening: every pair `i < j` attracts with
-//! `F = G mᵢ mⱼ d / (|d|² + ε²)^{3/2}`, equal and opposite. The tutorial
+//! §4.1.2), with optional Plummer softening: every pair attracts with
+//! `F = G mᵢ mⱼ d / (|d|² + ε²)^{3/2}`, equal and opposite.
+//!
+//! Evaluated as a gather (`gather.rs`): each body sums the pull of every
+//! other in a fixed order, vectorised over the others and, for large sets,
+//! bodies split among threads. Each body's sum is the same bits on any
+//! thread and any CPU (see `gather.rs`); Newton's third law then holds to
+//! rounding rather than exactly (a pairs-once loop made it exact but could
+//! neither vectorise nor split across threads). The tutorial
 //! version written outside the engine is `examples/nbody.rs`; this one is what
 //! scene files get as `[[nbody]]`.
 
@@ -9,8 +16,11 @@ use crate::force::{Force, ForceContext, Targets};
 use crate::particle::non_negative;
 use glam::DVec3;
 
+mod gather;
+use gather::Gather;
+
 /// Newtonian gravity between every pair of its bodies.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct NBodyGravity {
     /// Gravitational constant, N m²/kg².
     pub g: f64,
@@ -19,6 +29,7 @@ pub struct NBodyGravity {
     targets: Targets,
     /// The bodies' indices, resolved once (and again if `All` grows).
     indices: Vec<u32>,
+    scratch: Gather,
 }
 
 impl NBodyGravity {
@@ -36,6 +47,7 @@ impl NBodyGravity {
             softening,
             targets,
             indices,
+            scratch: Gather::default(),
         }
     }
 
@@ -63,19 +75,13 @@ impl Force for NBodyGravity {
         self.resolve(ctx.pos.len());
         let eps2 = self.softening * self.softening;
         let (pos, mass) = (ctx.pos, &ctx.particles.mass);
+        let s = &mut self.scratch;
+        s.load(&self.indices, pos, mass);
+        s.gather(eps2);
         for (k, &i) in self.indices.iter().enumerate() {
             let i = i as usize;
-            let (pi, gmi) = (pos[i], self.g * mass[i]);
-            let mut fi = DVec3::ZERO;
-            for &j in &self.indices[k + 1..] {
-                let j = j as usize;
-                let d = pos[j] - pi;
-                let r2 = d.length_squared() + eps2;
-                let f = d * (gmi * mass[j] / (r2 * r2.sqrt()));
-                fi += f;
-                forces[j] -= f;
-            }
-            forces[i] += fi;
+            let a = DVec3::new(s.ax[k], s.ay[k], s.az[k]);
+            forces[i] += a * (self.g * mass[i]);
         }
     }
 
