@@ -124,12 +124,7 @@ impl Env {
         action: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, bool, bool)> {
         let mut e = self.lock()?;
-        let a = action.as_array();
-        let t = match a.as_slice() {
-            Some(s) => e.step(s),
-            None => e.step(&a.to_vec()),
-        }
-        .map_err(value_error)?;
+        let t = e.step(&crate::elements(&action)).map_err(value_error)?;
         Ok((obs(py, &e), t.reward, t.terminated, t.truncated))
     }
 
@@ -280,14 +275,7 @@ impl VecEnv {
                 shape[1]
             )));
         }
-        let owned;
-        let a = match actions.as_slice() {
-            Ok(s) => s,
-            Err(_) => {
-                owned = actions.as_array().iter().copied().collect::<Vec<_>>();
-                &owned
-            }
-        };
+        let a = &*crate::elements(&actions);
         let env = &mut *v;
         let t = &mut *out;
         py.detach(|| env.step(a, t)).map_err(value_error)?;

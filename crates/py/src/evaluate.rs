@@ -57,14 +57,7 @@ pub(crate) fn outcomes(
             problem.dim()
         )));
     }
-    let owned;
-    let flat = match genomes.as_slice() {
-        Ok(s) => s,
-        Err(_) => {
-            owned = genomes.as_array().iter().copied().collect::<Vec<f64>>();
-            &owned
-        }
-    };
+    let flat = &*crate::elements(genomes);
     if let Some(i) = flat.iter().position(|x| !x.is_finite()) {
         return Err(value_error(format!(
             "genome {} has a gene that is not finite: {}",

@@ -53,6 +53,17 @@ pub(crate) fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>
     }
 }
 
+/// A numpy array's elements in C order: borrowed when it is contiguous,
+/// copied otherwise.
+pub(crate) fn elements<'a, D: numpy::ndarray::Dimension>(
+    a: &'a numpy::PyReadonlyArray<'_, f64, D>,
+) -> std::borrow::Cow<'a, [f64]> {
+    match a.as_slice() {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
+    }
+}
+
 /// Runs `f` on `pool` (or the global pool).
 pub(crate) fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> T + Send) -> T {
     match pool {

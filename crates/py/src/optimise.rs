@@ -174,17 +174,8 @@ impl Optimiser {
 #[pyclass(module = "animats")]
 pub struct Evolution {
     state: State,
-    problem: Option<Box<dyn animats_evolve::Problem>>,
+    problem: Box<dyn animats_evolve::Problem>,
     pending: Option<Generation>,
-}
-
-impl Evolution {
-    fn problem(&mut self) -> PyResult<&dyn animats_evolve::Problem> {
-        if self.problem.is_none() {
-            self.problem = Some(build(&self.state.config.problem)?);
-        }
-        Ok(self.problem.as_deref().expect("built above"))
-    }
 }
 
 #[pymethods]
@@ -224,10 +215,11 @@ impl Evolution {
             problem: spec,
             ..Config::thesis(lanes.unwrap_or(default_lanes), generations, seed)
         };
+        let problem = build(&config.problem)?;
         let state = State::new(config).map_err(value_error)?;
         Ok(Evolution {
             state,
-            problem: None,
+            problem,
             pending: None,
         })
     }
@@ -241,7 +233,7 @@ impl Evolution {
             ));
         }
         let g = self.state.ask();
-        let d = self.dim();
+        let d = self.problem.dim();
         let rows: Vec<Vec<f64>> = g.genomes().map(|x| x.to_vec()).collect();
         let lanes = g
             .lanes
@@ -302,8 +294,7 @@ impl Evolution {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pool = pool(threads)?;
-        let problem = self.problem()?;
-        let o = outcomes(py, problem, &genomes, &pool)?;
+        let o = outcomes(py, self.problem.as_ref(), &genomes, &pool)?;
         outcome_dict(py, &o)
     }
 
@@ -323,9 +314,8 @@ impl Evolution {
         }
         let pool = pool(threads)?;
         let n = generations.unwrap_or(self.state.config.generations);
-        self.problem()?;
         let Evolution { state, problem, .. } = self;
-        let problem = problem.as_deref().expect("built above");
+        let problem = problem.as_ref();
         py.detach(|| on(&pool, || state.advance_with(problem, n)))
             .map_err(runtime_error)
     }
@@ -351,16 +341,7 @@ impl Evolution {
     /// The genome's length.
     #[getter]
     fn dim(&self) -> usize {
-        match &self.state.config.problem {
-            ProblemSpec::Roobot { start, .. } => start.len(),
-            ProblemSpec::Scene { .. } => self
-                .state
-                .lanes
-                .first()
-                .and_then(|l| l.best.as_ref().map(|b| b.genome.len()))
-                .or_else(|| self.problem.as_ref().map(|p| p.dim()))
-                .unwrap_or_else(|| build(&self.state.config.problem).map_or(0, |p| p.dim())),
-        }
+        self.problem.dim()
     }
 
     /// The best fitness over all lanes so far, or None.

@@ -9,19 +9,15 @@
 //! rewards add up to the fitness [`crate::evaluate::evaluate`] gives the same
 //! run.
 
-use crate::def::SceneDef;
 use crate::error::SceneError;
-use crate::evaluate::EvolveSpec;
-use crate::source::Source;
+use crate::evaluate::{EvolveSpec, SceneProblem};
 use crate::Scene;
 use animats_creatures::env::{check_action, perturb, Env, Transition};
 use animats_engine::DVec3;
 
 /// A scene stepped by a program.
 pub struct SceneEnv {
-    file: String,
-    text: String,
-    def: SceneDef,
+    problem: SceneProblem,
     noise: f64,
     scene: Scene,
     spec: EvolveSpec,
@@ -38,15 +34,12 @@ impl SceneEnv {
     /// Parses a scene's text (`file` names it in errors); the start's
     /// velocities are perturbed at each reset by up to `noise` m/s.
     pub fn parse(text: &str, file: &str, noise: f64) -> Result<SceneEnv, SceneError> {
-        let src = Source { file, text };
-        let def = crate::parse_def(&src)?;
-        let scene = crate::build::build(&def, &src)?;
-        let spec = scene.evolve.clone().ok_or_else(|| {
-            SceneError::file(
-                file,
-                "the scene has no [evolve] table: an environment needs one for its reward and time limit (docs/SCENES.md)",
-            )
-        })?;
+        let problem = SceneProblem::parse(text, file)?;
+        let scene = problem.fresh().map_err(|e| SceneError::file(file, e))?;
+        let spec = scene
+            .evolve
+            .clone()
+            .ok_or_else(|| SceneError::file(file, "the scene has no [evolve] table"))?;
         if scene.nervous.actuators.is_empty() {
             return Err(SceneError::file(
                 file,
@@ -72,9 +65,7 @@ impl SceneEnv {
             .map(|(n, _)| n.clone())
             .collect();
         let mut env = SceneEnv {
-            file: file.to_string(),
-            text: text.to_string(),
-            def,
+            problem,
             noise,
             scene,
             spec,
@@ -139,11 +130,7 @@ impl Env for SceneEnv {
     }
 
     fn reset(&mut self, seed: u64) -> Result<(), String> {
-        let src = Source {
-            file: &self.file,
-            text: &self.text,
-        };
-        let mut scene = crate::build::build(&self.def, &src).map_err(|e| e.to_string())?;
+        let mut scene = self.problem.fresh()?;
         perturb(&mut scene.world, seed, self.noise)?;
         self.start = self.spec.centre(&scene.world);
         self.last = self.start;

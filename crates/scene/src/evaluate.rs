@@ -293,13 +293,18 @@ impl SceneProblem {
         &self.file
     }
 
-    /// The scene built afresh with `genome` in its `[evolve]` controller.
-    pub fn scene(&self, genome: &[f64]) -> Result<Scene, String> {
+    /// The scene built afresh, as its file has it.
+    pub fn fresh(&self) -> Result<Scene, String> {
         let src = Source {
             file: &self.file,
             text: &self.text,
         };
-        let mut scene = crate::build::build(&self.def, &src).map_err(|e| e.to_string())?;
+        crate::build::build(&self.def, &src).map_err(|e| e.to_string())
+    }
+
+    /// The scene built afresh with `genome` in its `[evolve]` controller.
+    pub fn scene(&self, genome: &[f64]) -> Result<Scene, String> {
+        let mut scene = self.fresh()?;
         let index = scene.evolve.as_ref().map_or(0, |s| s.index);
         scene.nervous.controllers[index].brain.set_genome(genome)?;
         Ok(scene)
