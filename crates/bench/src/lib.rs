@@ -487,17 +487,9 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         }
     };
     let on = |p: &rayon::ThreadPool, w: &mut animats_engine::World| p.install(|| one(w));
-    let (engine, baseline, world, base) = measure_pair(
-        runs,
-        engine_world,
-        |w| on(&p1, w),
-        Baseline::new,
-        |b| {
-            for _ in 0..steps {
-                b.step();
-            }
-        },
-    );
+    let all_pairs = |b: &mut Baseline| (0..steps).for_each(|_| b.step());
+    let (engine, baseline, world, base) =
+        measure_pair(runs, engine_world, |w| on(&p1, w), Baseline::new, all_pairs);
     let mut checks = allpairs_checks(&world.state().pos, &world.state().vel, steps);
     checks.push(Check::new(
         "E vs baseline",
@@ -546,17 +538,8 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
         vec![],
     );
     // One world, its bodies split between two threads; the same bits.
-    let (both, both_base, world2, _) = measure_pair(
-        runs,
-        engine_world,
-        |w| on(&p2, w),
-        Baseline::new,
-        |b| {
-            for _ in 0..steps {
-                b.step();
-            }
-        },
-    );
+    let (both, both_base, world2, _) =
+        measure_pair(runs, engine_world, |w| on(&p2, w), Baseline::new, all_pairs);
     let same = world2.state().pos == world.state().pos && world2.state().vel == world.state().vel;
     let speedup = one_thread / both.median;
     let shared = row(
