@@ -180,8 +180,10 @@ impl World {
         }
         let f = &mut self.forces;
         for (k, q) in s.springs.iter().enumerate() {
-            let spring = f.springs.get_mut(SpringId(k as u32));
-            (spring.stiffness, spring.damping, spring.rest_length) = (q[0], q[1], q[2]);
+            let id = SpringId(k as u32);
+            f.springs.set_stiffness(id, q[0]);
+            f.springs.set_damping(id, q[1]);
+            f.springs.set_rest_length(id, q[2]);
         }
         for (k, q) in s.angle_joints.iter().enumerate() {
             let joint = f.angle_joints.get_mut(AngleJointId(k as u32));

@@ -1,9 +1,12 @@
 //! Results are the same bits whatever the number of threads (and whatever
-//! the CPU's vector width): a world whose n-body force is split among
-//! threads ends in the same state on 1, 2 and 3 threads, and that state's
-//! hash is pinned, so a change of the numerics shows up here first.
+//! the CPU's vector width): a world whose n-body force or springs are split
+//! among threads ends in the same state on 1, 2 and 3 threads, and that
+//! state's hash is pinned, so a change of the numerics shows up here first.
 
-use animats_engine::{DVec3, IntegratorKind, NBodyGravity, ParticleDef, Targets, World};
+use animats_engine::{
+    DVec3, FloorDef, IntegratorKind, NBodyGravity, ParticleDef, ParticleId, SpringDef, Targets,
+    World,
+};
 
 /// 300 bodies of unequal masses (more than the gather's threshold for
 /// threads) spread through a unit cube by the R3 sequence.
@@ -41,19 +44,93 @@ fn hash(w: &World) -> u64 {
     h
 }
 
-fn run(threads: usize, softening: f64) -> u64 {
+/// The hash of `world` after `steps` steps of 1 ms on `threads` threads.
+fn run_world(threads: usize, world: impl FnOnce() -> World + Send, steps: usize) -> u64 {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
-        let mut w = world(softening);
-        for _ in 0..50 {
+        let mut w = world();
+        for _ in 0..steps {
             w.step(1e-3).unwrap();
         }
         hash(&w)
     })
 }
+
+fn run(threads: usize, softening: f64) -> u64 {
+    run_world(threads, || world(softening), 50)
+}
+
+/// A 64 × 64 cloth (16,002 springs, more than the springs' threshold for
+/// threads: one thread adds each spring's force to its ends in turn, several
+/// gather each particle's springs) with damping, hung by two corners above a
+/// floor it falls onto, its springs listed in a shuffled order.
+fn cloth(kind: IntegratorKind) -> World {
+    let n = 64;
+    let mut w = World::new();
+    w.set_integrator(kind);
+    w.set_gravity(DVec3::new(0.0, -9.81, 0.0));
+    for i in 0..n {
+        for j in 0..n {
+            let x = DVec3::new(
+                i as f64 * 0.02,
+                0.05 + 0.01 * ((i * j) % 5) as f64,
+                j as f64 * 0.02,
+            );
+            let mut p = ParticleDef::new(0.001 + 1e-5 * ((i + 2 * j) % 3) as f64).at(x);
+            p.fixed = (i == 0 || i == n - 1) && j == 0;
+            w.add_particle(p).unwrap();
+        }
+    }
+    let mut edges = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let p = i * n + j;
+            if j + 1 < n {
+                edges.push((p, p + 1));
+            }
+            if i + 1 < n {
+                edges.push((p + n, p));
+            }
+            if i + 1 < n && j + 1 < n {
+                edges.push((p, p + n + 1));
+            }
+            if i + 1 < n && j > 0 {
+                edges.push((p + n - 1, p));
+            }
+        }
+    }
+    // A fixed shuffle: some particles' springs listed together, most not.
+    let k = edges.len();
+    for i in (1..k).rev() {
+        if i % 4 != 0 {
+            edges.swap(i, (i * 7919) % (i + 1));
+        }
+    }
+    let id = ParticleId::from_index;
+    for (a, b) in edges {
+        w.add_spring(SpringDef::new(id(a), id(b), 100.0, 0.05))
+            .unwrap();
+    }
+    w.add_floor(FloorDef::default()).unwrap();
+    w
+}
+
+#[test]
+fn a_mass_spring_world_is_the_same_bits_on_any_number_of_threads() {
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let one = run_world(1, || cloth(kind), 100);
+        assert_eq!(run_world(2, || cloth(kind), 100), one, "2 threads, {kind}");
+        assert_eq!(run_world(3, || cloth(kind), 100), one, "3 threads, {kind}");
+    }
+    let golden = run_world(2, || cloth(IntegratorKind::Symplectic), 100);
+    assert_eq!(golden, CLOTH_GOLDEN, "{golden:#018x}");
+}
+
+/// `hash` of the symplectic cloth after 100 steps on 2 threads.
+const CLOTH_GOLDEN: u64 = 0x5fda_9dc1_3f39_8401;
 
 #[test]
 fn an_n_body_world_is_the_same_bits_on_any_number_of_threads() {

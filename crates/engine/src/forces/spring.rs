@@ -7,6 +7,9 @@ use crate::force::{Force, ForceContext};
 use crate::particle::{non_negative, ParticleId};
 use glam::DVec3;
 
+mod kernel;
+mod threads;
+
 /// Handle to one spring of a world.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct SpringId(pub(crate) u32);
@@ -52,7 +55,8 @@ impl SpringDef {
     }
 }
 
-/// One spring as the world stores it.
+/// One spring: its ends and parameters (a copy; change a world's springs
+/// with [`Springs::set_rest_length`] and the other setters).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spring {
     a: u32,
@@ -81,36 +85,128 @@ impl Spring {
     }
 }
 
-/// Every spring of a world, in one flat array so the force loop is tight.
+/// Every spring of a world, as separate arrays (ends, stiffness, damping,
+/// rest length) so the force loop reads each parameter as a vector.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Springs {
-    springs: Vec<Spring>,
+    table: Table,
+    scratch: Scratch,
+}
+
+/// The springs' arrays, all as long as each other.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Table {
+    ends: Vec<[u32; 2]>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    rest_length: Vec<f64>,
+}
+
+/// Some consecutive springs of a [`Table`], borrowed.
+#[derive(Clone, Copy)]
+struct Slice<'a> {
+    ends: &'a [[u32; 2]],
+    stiffness: &'a [f64],
+    damping: &'a [f64],
+    rest_length: &'a [f64],
+}
+
+impl Table {
+    fn all(&self) -> Slice<'_> {
+        Slice {
+            ends: &self.ends,
+            stiffness: &self.stiffness,
+            damping: &self.damping,
+            rest_length: &self.rest_length,
+        }
+    }
+}
+
+impl<'a> Slice<'a> {
+    fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// Springs `range` of this slice.
+    fn range(&self, range: std::ops::Range<usize>) -> Slice<'a> {
+        Slice {
+            ends: &self.ends[range.clone()],
+            stiffness: &self.stiffness[range.clone()],
+            damping: &self.damping[range.clone()],
+            rest_length: &self.rest_length[range],
+        }
+    }
+
+    /// The slice in pieces of at most `size` springs.
+    fn chunks(self, size: usize) -> impl Iterator<Item = Slice<'a>> {
+        (0..self.len())
+            .step_by(size)
+            .map(move |i| self.range(i..(i + size).min(self.len())))
+    }
+}
+
+/// What the force loops keep between steps, so a step neither allocates nor
+/// clears anything. It holds nothing a copy of the world needs: cloning,
+/// comparing and printing ignore it.
+#[derive(Default)]
+struct Scratch {
+    block: Option<Box<kernel::Block>>,
+    gather: threads::Gather,
+}
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Scratch::default()
+    }
+}
+
+impl PartialEq for Scratch {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl std::fmt::Debug for Scratch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Scratch")
+    }
 }
 
 impl Springs {
     /// Number of springs.
     pub fn len(&self) -> usize {
-        self.springs.len()
+        self.table.ends.len()
     }
     /// True when there are none.
     pub fn is_empty(&self) -> bool {
-        self.springs.is_empty()
+        self.table.ends.is_empty()
     }
     /// The spring `id`.
-    pub fn get(&self, id: SpringId) -> &Spring {
-        &self.springs[id.index()]
-    }
-    /// The spring `id`, to change its stiffness, damping or rest length.
-    pub fn get_mut(&mut self, id: SpringId) -> &mut Spring {
-        &mut self.springs[id.index()]
+    pub fn get(&self, id: SpringId) -> Spring {
+        let (t, i) = (&self.table, id.index());
+        Spring {
+            a: t.ends[i][0],
+            b: t.ends[i][1],
+            stiffness: t.stiffness[i],
+            damping: t.damping[i],
+            rest_length: t.rest_length[i],
+        }
     }
     /// Sets the rest length of spring `id` (the muscle's activation).
     pub fn set_rest_length(&mut self, id: SpringId, rest_length: f64) {
-        self.springs[id.index()].rest_length = rest_length;
+        self.table.rest_length[id.index()] = rest_length;
+    }
+    /// Sets the stiffness of spring `id`.
+    pub fn set_stiffness(&mut self, id: SpringId, stiffness: f64) {
+        self.table.stiffness[id.index()] = stiffness;
+    }
+    /// Sets the damping of spring `id`.
+    pub fn set_damping(&mut self, id: SpringId, damping: f64) {
+        self.table.damping[id.index()] = damping;
     }
     /// All springs, in the order they were added.
-    pub fn iter(&self) -> impl Iterator<Item = &Spring> {
-        self.springs.iter()
+    pub fn iter(&self) -> impl Iterator<Item = Spring> + '_ {
+        (0..self.len()).map(|i| self.get(SpringId(i as u32)))
     }
 
     /// Adds a spring; `pos` are the current positions (for the default rest length).
@@ -135,14 +231,12 @@ impl Springs {
         if rest_length == 0.0 {
             return Err(ModelError::new("rest_length", "must be > 0, got 0"));
         }
-        self.springs.push(Spring {
-            a: def.a.0,
-            b: def.b.0,
-            stiffness: def.stiffness,
-            damping: def.damping,
-            rest_length,
-        });
-        Ok(SpringId(self.springs.len() as u32 - 1))
+        let t = &mut self.table;
+        t.ends.push([def.a.0, def.b.0]);
+        t.stiffness.push(def.stiffness);
+        t.damping.push(def.damping);
+        t.rest_length.push(rest_length);
+        Ok(SpringId(self.len() as u32 - 1))
     }
 }
 
@@ -150,22 +244,17 @@ impl Force for Springs {
     #[inline]
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
         let (pos, vel) = (ctx.pos, ctx.vel);
-        for s in &self.springs {
-            let (a, b) = (s.a as usize, s.b as usize);
-            let d = pos[b] - pos[a];
-            let len = d.length();
-            // A spring squashed to a point has no direction: it pushes nowhere.
-            let n = d * if len > 0.0 { 1.0 / len } else { 0.0 };
-            let f =
-                n * (s.stiffness * (len - s.rest_length) + s.damping * (vel[b] - vel[a]).dot(n));
-            forces[a] += f;
-            forces[b] -= f;
+        let springs = self.table.all();
+        if springs.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1 {
+            self.scratch.gather.apply(springs, pos, vel, forces);
+        } else {
+            let block = self.scratch.block.get_or_insert_with(Box::default);
+            kernel::scatter(springs, block, pos, vel, forces);
         }
     }
 
     fn potential_energy(&self, ctx: &ForceContext) -> f64 {
-        self.springs
-            .iter()
+        self.iter()
             .map(|s| {
                 let x = (ctx.pos[s.b as usize] - ctx.pos[s.a as usize]).length() - s.rest_length;
                 0.5 * s.stiffness * x * x
@@ -174,7 +263,7 @@ impl Force for Springs {
     }
 
     fn is_conservative(&self) -> bool {
-        self.springs.iter().all(|s| s.damping == 0.0)
+        self.table.damping.iter().all(|&c| c == 0.0)
     }
 
     fn is_passive(&self) -> bool {

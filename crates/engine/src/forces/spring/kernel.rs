@@ -1,0 +1,352 @@
+//! The spring loop in blocks: gather a block of springs' end-to-end vectors
+//! and relative velocities into separate arrays, compute every spring's
+//! force with the widest vectors this CPU has, then add the forces to their
+//! ends one spring after another, in the springs' order.
+//!
+//! Reproducibility: a spring's force depends only on that spring, computed
+//! with the same operations in the same order on every path (nothing fused,
+//! no FMA; square root and division are correctly rounded on every
+//! instruction set), and the forces reach the particles in spring order, as
+//! the plain loop adds them. AVX-512, AVX2 and SSE2 therefore give the same
+//! bits, and so does the gather used on many threads (`threads.rs`), which
+//! sums each particle's springs in the same order.
+
+use super::Slice;
+use glam::DVec3;
+
+/// Springs per block: the block's arrays (9 × 64 f64, 4.5 KiB) stay in L1.
+pub const BLOCK: usize = 64;
+
+/// One block's springs, as separate arrays the force computation vectorises over.
+#[derive(Clone)]
+pub struct Block {
+    d: [[f64; BLOCK]; 3],
+    w: [[f64; BLOCK]; 3],
+    /// The force on each spring's first end (minus that on its second), N.
+    pub f: [[f64; BLOCK]; 3],
+}
+
+impl Default for Block {
+    fn default() -> Self {
+        Block {
+            d: [[0.0; BLOCK]; 3],
+            w: [[0.0; BLOCK]; 3],
+            f: [[0.0; BLOCK]; 3],
+        }
+    }
+}
+
+impl Block {
+    /// Loads up to [`BLOCK`] springs' end-to-end vectors and relative
+    /// velocities.
+    #[inline(always)]
+    fn load(&mut self, springs: Slice, pos: &[DVec3], vel: &[DVec3]) {
+        for (i, &[a, b]) in springs.ends.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let d = pos[b] - pos[a];
+            let w = vel[b] - vel[a];
+            self.d[0][i] = d.x;
+            self.d[1][i] = d.y;
+            self.d[2][i] = d.z;
+            self.w[0][i] = w.x;
+            self.w[1][i] = w.y;
+            self.w[2][i] = w.z;
+        }
+    }
+
+    /// `f = n (k (len − r) + c (w·n))` with `n = d / len` (zero for a spring
+    /// squashed to a point, which has no direction), for the springs just
+    /// loaded; the same expression, in the same order, as
+    /// [`Spring::tension`](super::Spring::tension).
+    #[inline(always)]
+    fn compute(&mut self, springs: Slice) {
+        let n = springs.len().min(BLOCK);
+        let (k, c, r) = (
+            &springs.stiffness[..n],
+            &springs.damping[..n],
+            &springs.rest_length[..n],
+        );
+        let [dx, dy, dz] = &self.d;
+        let [wx, wy, wz] = &self.w;
+        let [fx, fy, fz] = &mut self.f;
+        for i in 0..n {
+            let len = ((dx[i] * dx[i] + dy[i] * dy[i]) + dz[i] * dz[i]).sqrt();
+            let inv = if len > 0.0 { 1.0 / len } else { 0.0 };
+            let (nx, ny, nz) = (dx[i] * inv, dy[i] * inv, dz[i] * inv);
+            let s = k[i] * (len - r[i]) + c[i] * ((wx[i] * nx + wy[i] * ny) + wz[i] * nz);
+            fx[i] = nx * s;
+            fy[i] = ny * s;
+            fz[i] = nz * s;
+        }
+    }
+
+    /// The force of spring `i` of the block.
+    #[inline(always)]
+    fn force(&self, i: usize) -> DVec3 {
+        DVec3::new(self.f[0][i], self.f[1][i], self.f[2][i])
+    }
+}
+
+/// Adds every spring's force to its ends, in order: `+f` on `a`, `−f` on `b`.
+pub(super) fn scatter(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    forces: &mut [DVec3],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { scatter_avx512(springs, block, pos, vel, forces) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { scatter_avx2(springs, block, pos, vel, forces) };
+        }
+    }
+    scatter_any(springs, block, pos, vel, forces)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn scatter_avx512(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    forces: &mut [DVec3],
+) {
+    scatter_any(springs, block, pos, vel, forces)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn scatter_avx2(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    forces: &mut [DVec3],
+) {
+    scatter_any(springs, block, pos, vel, forces)
+}
+
+/// The loop itself; inlined into each instruction set's copy, where the
+/// compiler vectorises [`Block::compute`] as wide as it may.
+#[inline(always)]
+fn scatter_any(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    forces: &mut [DVec3],
+) {
+    // Consecutive springs sharing their first end (a mesh lists a particle's
+    // springs together) add to a register instead of to memory: the same
+    // additions in the same order, without waiting for each store to reach
+    // the next load. No spring of such a run has that particle as its
+    // second end (a spring's ends differ), so memory and register never
+    // disagree about it.
+    let (mut run, mut acc) = (None, DVec3::ZERO);
+    for chunk in springs.chunks(BLOCK) {
+        block.load(chunk, pos, vel);
+        block.compute(chunk);
+        for (i, &[a, b]) in chunk.ends.iter().enumerate() {
+            let f = block.force(i);
+            let a = a as usize;
+            if run != Some(a) {
+                if let Some(p) = run {
+                    forces[p] = acc;
+                }
+                run = Some(a);
+                acc = forces[a];
+            }
+            acc += f;
+            forces[b as usize] -= f;
+        }
+    }
+    if let Some(p) = run {
+        forces[p] = acc;
+    }
+}
+
+/// Writes every spring's force (on its first end) into `out`.
+pub(super) fn forces_into(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    out: &mut [DVec3],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { forces_into_avx512(springs, block, pos, vel, out) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { forces_into_avx2(springs, block, pos, vel, out) };
+        }
+    }
+    forces_into_any(springs, block, pos, vel, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn forces_into_avx512(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    out: &mut [DVec3],
+) {
+    forces_into_any(springs, block, pos, vel, out)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn forces_into_avx2(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    out: &mut [DVec3],
+) {
+    forces_into_any(springs, block, pos, vel, out)
+}
+
+#[inline(always)]
+fn forces_into_any(
+    springs: Slice,
+    block: &mut Block,
+    pos: &[DVec3],
+    vel: &[DVec3],
+    out: &mut [DVec3],
+) {
+    for (chunk, out) in springs.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+        block.load(chunk, pos, vel);
+        block.compute(chunk);
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = block.force(i);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::Table;
+    use super::*;
+
+    /// 300 springs among 120 particles, in no particular order: runs of a
+    /// shared first end, chains, repeated pairs, a spring squashed to a point,
+    /// and a length (301) that is no multiple of a block.
+    fn springs() -> (Table, Vec<DVec3>, Vec<DVec3>) {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut u = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let n = 120u64;
+        let mut pos: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(u() as f64, u() as f64, u() as f64) / u64::MAX as f64)
+            .collect();
+        let vel: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(u() as f64, u() as f64, u() as f64) / u64::MAX as f64 - 0.5)
+            .collect();
+        pos[9] = pos[10];
+        let mut t = Table::default();
+        let push = |a: u64, b: u64, t: &mut Table, r: u64| {
+            t.ends.push([a as u32, b as u32]);
+            t.stiffness.push(1.0 + (r % 1000) as f64);
+            t.damping.push((r % 7) as f64 * 0.1);
+            t.rest_length.push(0.1 + (r % 13) as f64 * 0.05);
+        };
+        push(9, 10, &mut t, 5);
+        for i in 0..300 {
+            let r = u();
+            let a = if i % 3 == 0 { r % n } else { (i / 3) % n };
+            let b = (a + 1 + (r >> 20) % (n - 1)) % n;
+            push(a, b, &mut t, r >> 8);
+        }
+        (t, pos, vel)
+    }
+
+    /// The plain loop, one spring at a time, as the engine had it before blocks.
+    fn reference(t: &Table, pos: &[DVec3], vel: &[DVec3], forces: &mut [DVec3]) {
+        for (i, &[a, b]) in t.ends.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let d = pos[b] - pos[a];
+            let len = d.length();
+            let n = d * if len > 0.0 { 1.0 / len } else { 0.0 };
+            let f = n
+                * (t.stiffness[i] * (len - t.rest_length[i])
+                    + t.damping[i] * (vel[b] - vel[a]).dot(n));
+            forces[a] += f;
+            forces[b] -= f;
+        }
+    }
+
+    fn bits(forces: &[DVec3]) -> Vec<u64> {
+        forces
+            .iter()
+            .flat_map(|f| f.to_array().map(f64::to_bits))
+            .collect()
+    }
+
+    #[test]
+    fn every_instruction_set_adds_the_same_bits_as_the_plain_loop() {
+        let (t, pos, vel) = springs();
+        let start: Vec<DVec3> = (0..pos.len()).map(|i| DVec3::splat(i as f64)).collect();
+        let mut want = start.clone();
+        reference(&t, &pos, &vel, &mut want);
+        assert!(want.iter().all(|f| f.is_finite()));
+        let run = |path: &str| {
+            let mut forces = start.clone();
+            let mut block = Block::default();
+            let s = t.all();
+            match path {
+                "any" => scatter_any(s, &mut block, &pos, &vel, &mut forces),
+                #[cfg(target_arch = "x86_64")]
+                "avx2" => unsafe { scatter_avx2(s, &mut block, &pos, &vel, &mut forces) },
+                #[cfg(target_arch = "x86_64")]
+                "avx512" => unsafe { scatter_avx512(s, &mut block, &pos, &vel, &mut forces) },
+                _ => unreachable!(),
+            }
+            bits(&forces)
+        };
+        assert_eq!(run("any"), bits(&want), "portable");
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                assert_eq!(run("avx2"), bits(&want), "avx2");
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                assert_eq!(run("avx512"), bits(&want), "avx512");
+            }
+        }
+        // Each spring's force on its own, as the threads' gather reads them.
+        let mut each = vec![DVec3::ZERO; t.ends.len()];
+        forces_into(t.all(), &mut Block::default(), &pos, &vel, &mut each);
+        for (i, f) in each.iter().enumerate() {
+            let mut one = Table::default();
+            one.ends.push(t.ends[i]);
+            one.stiffness.push(t.stiffness[i]);
+            one.damping.push(t.damping[i]);
+            one.rest_length.push(t.rest_length[i]);
+            let mut alone = vec![DVec3::ZERO; pos.len()];
+            reference(&one, &pos, &vel, &mut alone);
+            // (0 + f: a squashed spring's force is −0, which the sum makes +0.)
+            let got = DVec3::ZERO + *f;
+            assert_eq!(
+                bits(&[got]),
+                bits(&[alone[t.ends[i][0] as usize]]),
+                "spring {i}"
+            );
+        }
+    }
+}
