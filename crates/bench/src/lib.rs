@@ -339,24 +339,27 @@ fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
         _ => cloth(128),
     };
     let mut rows = Vec::new();
+    let (p1, p2) = (threads(1), threads(2));
+    let steps = |w: &mut animats_engine::World| {
+        for _ in 0..STEPS {
+            w.step(DT).expect("workload stays finite");
+        }
+    };
     for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let base_steps = |b: &mut Baseline| {
+            for _ in 0..STEPS {
+                match kind {
+                    IntegratorKind::Rk4 => b.step_rk4(),
+                    _ => b.step_symplectic(),
+                }
+            }
+        };
         let (engine, baseline, world, base) = measure_pair(
             runs,
             || engine_world(&spec, kind),
-            |w| {
-                for _ in 0..STEPS {
-                    w.step(DT).expect("workload stays finite");
-                }
-            },
+            |w| p1.install(|| steps(w)),
             || Baseline::new(&spec),
-            |b| {
-                for _ in 0..STEPS {
-                    match kind {
-                        IntegratorKind::Rk4 => b.step_rk4(),
-                        _ => b.step_symplectic(),
-                    }
-                }
-            },
+            base_steps,
         );
         let s = summarise(&world.state().pos, &world.state().vel, &spec.pinned);
         let (bx, bv) = base.state();
@@ -380,9 +383,9 @@ fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
             1.0,
             0.0,
         ));
-        rows.push(Row {
+        let row = |variant: String, engine, baseline, checks| Row {
             workload: name.into(),
-            variant: kind.name().into(),
+            variant,
             particles: spec.positions.len(),
             springs: spec.edges.len(),
             steps: STEPS,
@@ -390,9 +393,38 @@ fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
             evaluations: kind.evaluations(),
             pairs: 0,
             engine,
-            baseline: Some(("hand-written SoA loop".into(), baseline)),
+            baseline,
             checks,
-        });
+        };
+        let one_thread = engine.median;
+        rows.push(row(
+            kind.name().into(),
+            engine,
+            Some(("hand-written SoA loop".into(), baseline)),
+            checks,
+        ));
+        // One world on two threads, where the world is large enough to split
+        // (docs/DESIGN.md, "Forces on many threads"); the same bits.
+        if name == "cloth-128" {
+            let (both, both_base, world2, _) = measure_pair(
+                runs,
+                || engine_world(&spec, kind),
+                |w| p2.install(|| steps(w)),
+                || Baseline::new(&spec),
+                base_steps,
+            );
+            let same = world2.state() == world.state();
+            let speedup = one_thread / both.median;
+            rows.push(row(
+                format!("{kind}, one world, 2 threads"),
+                both,
+                Some(("hand-written SoA loop, 1 thread".into(), both_base)),
+                vec![
+                    Check::new("same bits as 1 thread", f64::from(u8::from(same)), 1.0, 0.0),
+                    Check::target("speed-up over 1 thread", speedup, 1.8),
+                ],
+            ));
+        }
     }
     rows
 }

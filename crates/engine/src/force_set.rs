@@ -97,9 +97,12 @@ impl Forces {
         // adding to zeros: one pass over the particles instead of two.
         match &mut self.gravity {
             Some(g) if g.targets == Targets::All => {
-                for (f, &m) in out.iter_mut().zip(&particles.mass) {
-                    *f = m * g.g;
-                }
+                let (g, mass) = (g.g, &particles.mass);
+                crate::parallel::by_pieces([&mut *out], |first, [out]| {
+                    for (f, &m) in out.iter_mut().zip(&mass[first..]) {
+                        *f = m * g;
+                    }
+                });
             }
             Some(g) => {
                 out.fill(DVec3::ZERO);

@@ -16,8 +16,11 @@
 //! - Integrators ([`IntegratorKind`]): explicit Euler, midpoint, RK4 and
 //!   symplectic Euler, chosen at run time.
 //!
-//! No I/O, no threads, no global state: a world is a plain value, so many can
-//! run side by side (one per evolving individual).
+//! No I/O, no global state: a world is a plain value, so many can run side
+//! by side (one per evolving individual). A large world also splits its own
+//! heaviest loops (springs, n-body gravity, the integrators' updates) among
+//! the threads of the current rayon pool, with the same bits on any number
+//! of threads.
 
 #![warn(missing_docs)]
 
@@ -29,6 +32,7 @@ pub mod force_set;
 pub mod forces;
 pub mod guard;
 pub mod integrators;
+mod parallel;
 pub mod particle;
 pub mod snapshot;
 pub mod world;

@@ -151,7 +151,7 @@ impl<'a> Slice<'a> {
 #[derive(Default)]
 struct Scratch {
     block: Option<Box<kernel::Block>>,
-    gather: threads::Gather,
+    parallel: threads::Parallel,
 }
 
 impl Clone for Scratch {
@@ -246,10 +246,10 @@ impl Force for Springs {
         let (pos, vel) = (ctx.pos, ctx.vel);
         let springs = self.table.all();
         if springs.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1 {
-            self.scratch.gather.apply(springs, pos, vel, forces);
+            self.scratch.parallel.apply(springs, pos, vel, forces);
         } else {
             let block = self.scratch.block.get_or_insert_with(Box::default);
-            kernel::scatter(springs, block, pos, vel, forces);
+            kernel::run(springs, block, pos, vel, &mut kernel::Scatter::new(forces));
         }
     }
 

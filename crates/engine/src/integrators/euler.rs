@@ -2,6 +2,7 @@
 //! First order; its energy error grows without bound on oscillators.
 
 use super::Dynamics;
+use crate::parallel::by_pieces;
 use crate::particle::State;
 
 /// One explicit Euler step of size `h` from time `t`.
@@ -9,11 +10,12 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
-    let w = &d.particles.inv_mass;
-    let new = to.pos.iter_mut().zip(to.vel.iter_mut());
-    let old = from.pos.iter().zip(&from.vel).zip(w.iter().zip(f.iter()));
-    for ((x1, v1), ((x0, v0), (w, f))) in new.zip(old) {
-        *x1 = *x0 + h * *v0;
-        *v1 = *v0 + (h * w) * *f;
-    }
+    let (w, f) = (&d.particles.inv_mass, &*f);
+    by_pieces([&mut to.pos, &mut to.vel], |first, [x1, v1]| {
+        for (k, (x1, v1)) in x1.iter_mut().zip(v1.iter_mut()).enumerate() {
+            let i = first + k;
+            *x1 = from.pos[i] + h * from.vel[i];
+            *v1 = from.vel[i] + (h * w[i]) * f[i];
+        }
+    });
 }

@@ -4,11 +4,12 @@
 //! The thesis's default integrator.
 
 use super::Dynamics;
+use crate::parallel::by_pieces;
 use crate::particle::State;
+use glam::DVec3;
 
 /// One RK4 step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
-    let n = from.pos.len();
     let w = &d.particles.inv_mass;
     let s = &mut *d.scratch;
     let (x0, v0) = (&from.pos, &from.vel);
@@ -17,34 +18,89 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     // Stage 1 at (x0, v0). Trial states live in `to`; `dx`, `dv` accumulate
     // the weighted derivatives.
     d.forces.evaluate(t, h, x0, v0, d.particles, &mut s.force);
-    for i in 0..n {
-        let a = w[i] * s.force[i];
-        s.dx[i] = v0[i];
-        s.dv[i] = a;
-        to.pos[i] = x0[i] + half * v0[i];
-        to.vel[i] = v0[i] + half * a;
-    }
+    let start = Start { x0, v0, w };
+    let f = &s.force;
+    by_pieces(
+        [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
+        |first, [x, v, dx, dv]| {
+            let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
+            let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+            for i in 0..n {
+                let a = w[i] * f[i];
+                dx[i] = v0[i];
+                dv[i] = a;
+                x[i] = x0[i] + half * v0[i];
+                v[i] = v0[i] + half * a;
+            }
+        },
+    );
     // Stages 2 and 3 at the midpoint.
     for step_to in [half, h] {
         d.forces
             .evaluate(t + half, h, &to.pos, &to.vel, d.particles, &mut s.force);
-        for i in 0..n {
-            let a = w[i] * s.force[i];
-            let v = to.vel[i];
-            s.dx[i] += 2.0 * v;
-            s.dv[i] += 2.0 * a;
-            to.pos[i] = x0[i] + step_to * v;
-            to.vel[i] = v0[i] + step_to * a;
-        }
+        let f = &s.force;
+        by_pieces(
+            [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
+            |first, [x, v, dx, dv]| {
+                let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
+                let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+                for i in 0..n {
+                    let a = w[i] * f[i];
+                    let vi = v[i];
+                    dx[i] += 2.0 * vi;
+                    dv[i] += 2.0 * a;
+                    x[i] = x0[i] + step_to * vi;
+                    v[i] = v0[i] + step_to * a;
+                }
+            },
+        );
     }
     // Stage 4 at the end of the step, then the weighted sum.
     d.forces
         .evaluate(t + h, h, &to.pos, &to.vel, d.particles, &mut s.force);
     let sixth = h / 6.0;
-    for i in 0..n {
-        let a = w[i] * s.force[i];
-        let v = to.vel[i];
-        to.pos[i] = x0[i] + sixth * (s.dx[i] + v);
-        to.vel[i] = v0[i] + sixth * (s.dv[i] + a);
+    let f = &s.force;
+    by_pieces(
+        [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
+        |first, [x, v, dx, dv]| {
+            let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
+            let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+            for i in 0..n {
+                let a = w[i] * f[i];
+                let vi = v[i];
+                x[i] = x0[i] + sixth * (dx[i] + vi);
+                v[i] = v0[i] + sixth * (dv[i] + a);
+            }
+        },
+    );
+}
+
+/// The start of the step and the inverse masses, read by every stage.
+#[derive(Clone, Copy)]
+struct Start<'a> {
+    x0: &'a [DVec3],
+    v0: &'a [DVec3],
+    w: &'a [f64],
+}
+
+impl<'a> Start<'a> {
+    /// Particles `first..first + n` of the start, the inverse masses and the
+    /// forces `f`, each exactly `n` long (so the loops need no bounds checks).
+    #[inline(always)]
+    fn piece<'f>(
+        &self,
+        first: usize,
+        n: usize,
+        f: &'f [DVec3],
+    ) -> (usize, [&'f [DVec3]; 3], &'f [f64])
+    where
+        'a: 'f,
+    {
+        let r = first..first + n;
+        (
+            n,
+            [&self.x0[r.clone()], &self.v0[r.clone()], &f[r.clone()]],
+            &self.w[r],
+        )
     }
 }

@@ -3,6 +3,7 @@
 //! energy error oscillates and stays bounded instead of drifting.
 
 use super::Dynamics;
+use crate::parallel::by_pieces;
 use crate::particle::State;
 
 /// One symplectic Euler step of size `h` from time `t`.
@@ -10,12 +11,21 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
-    let w = &d.particles.inv_mass;
-    let new = to.pos.iter_mut().zip(to.vel.iter_mut());
-    let old = from.pos.iter().zip(&from.vel).zip(w.iter().zip(f.iter()));
-    for ((x1, v1), ((x0, v0), (w, f))) in new.zip(old) {
-        let v = *v0 + (h * w) * *f;
-        *v1 = v;
-        *x1 = *x0 + h * v;
-    }
+    let (w, f) = (&d.particles.inv_mass, &*f);
+    by_pieces([&mut to.pos, &mut to.vel], |first, [x1, v1]| {
+        let r = first..first + x1.len();
+        let (x0, v0, w, f) = (
+            &from.pos[r.clone()],
+            &from.vel[r.clone()],
+            &w[r.clone()],
+            &f[r],
+        );
+        let new = x1.iter_mut().zip(v1.iter_mut());
+        let old = x0.iter().zip(v0).zip(w.iter().zip(f));
+        for ((x1, v1), ((x0, v0), (w, f))) in new.zip(old) {
+            let v = *v0 + (h * w) * *f;
+            *v1 = v;
+            *x1 = *x0 + h * v;
+        }
+    });
 }

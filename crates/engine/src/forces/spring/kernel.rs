@@ -82,80 +82,132 @@ impl Block {
 
     /// The force of spring `i` of the block.
     #[inline(always)]
-    fn force(&self, i: usize) -> DVec3 {
+    pub fn force(&self, i: usize) -> DVec3 {
         DVec3::new(self.f[0][i], self.f[1][i], self.f[2][i])
     }
 }
 
-/// Adds every spring's force to its ends, in order: `+f` on `a`, `−f` on `b`.
-pub(super) fn scatter(
+/// What becomes of each spring's force once a block is computed.
+///
+/// It takes a whole block at a time, so that what it keeps from one spring
+/// to the next can live in registers (in locals of its own loop).
+pub(super) trait Sink {
+    /// Springs `first..first + ends.len()` of the slice, with ends `ends`,
+    /// computed in `block`: spring `i` pulls its first end with
+    /// `block.force(i)` and its second with minus that. Called in order.
+    fn take(&mut self, first: usize, ends: &[[u32; 2]], block: &Block);
+    /// After the last block.
+    fn finish(&mut self) {}
+}
+
+/// Computes every spring of `springs` in blocks and hands each force to
+/// `sink`, in order, with the widest vectors this CPU has.
+pub(super) fn run<S: Sink>(
     springs: Slice,
     block: &mut Block,
     pos: &[DVec3],
     vel: &[DVec3],
-    forces: &mut [DVec3],
+    sink: &mut S,
 ) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
             // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { scatter_avx512(springs, block, pos, vel, forces) };
+            return unsafe { run_avx512(springs, block, pos, vel, sink) };
         }
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { scatter_avx2(springs, block, pos, vel, forces) };
+            return unsafe { run_avx2(springs, block, pos, vel, sink) };
         }
     }
-    scatter_any(springs, block, pos, vel, forces)
+    run_any(springs, block, pos, vel, sink)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn scatter_avx512(
+unsafe fn run_avx512<S: Sink>(
     springs: Slice,
     block: &mut Block,
     pos: &[DVec3],
     vel: &[DVec3],
-    forces: &mut [DVec3],
+    sink: &mut S,
 ) {
-    scatter_any(springs, block, pos, vel, forces)
+    run_any(springs, block, pos, vel, sink)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn scatter_avx2(
+unsafe fn run_avx2<S: Sink>(
     springs: Slice,
     block: &mut Block,
     pos: &[DVec3],
     vel: &[DVec3],
-    forces: &mut [DVec3],
+    sink: &mut S,
 ) {
-    scatter_any(springs, block, pos, vel, forces)
+    run_any(springs, block, pos, vel, sink)
 }
 
 /// The loop itself; inlined into each instruction set's copy, where the
 /// compiler vectorises [`Block::compute`] as wide as it may.
 #[inline(always)]
-fn scatter_any(
-    springs: Slice,
-    block: &mut Block,
-    pos: &[DVec3],
-    vel: &[DVec3],
-    forces: &mut [DVec3],
-) {
-    // Consecutive springs sharing their first end (a mesh lists a particle's
-    // springs together) add to a register instead of to memory: the same
-    // additions in the same order, without waiting for each store to reach
-    // the next load. No spring of such a run has that particle as its
-    // second end (a spring's ends differ), so memory and register never
-    // disagree about it.
-    let (mut run, mut acc) = (None, DVec3::ZERO);
-    for chunk in springs.chunks(BLOCK) {
+fn run_any<S: Sink>(springs: Slice, block: &mut Block, pos: &[DVec3], vel: &[DVec3], sink: &mut S) {
+    for (k, chunk) in springs.chunks(BLOCK).enumerate() {
         block.load(chunk, pos, vel);
         block.compute(chunk);
-        for (i, &[a, b]) in chunk.ends.iter().enumerate() {
+        sink.take(k * BLOCK, chunk.ends, block);
+    }
+    sink.finish();
+}
+
+/// The one-thread sink: `+f` on `a`, `−f` on `b`, straight into the forces
+/// of particles `lo..lo + forces.len()`: the whole world (`PIECE` false, `lo`
+/// zero: no subtraction in the loop), or the piece of it one thread owns.
+///
+/// Consecutive springs sharing their first end (a mesh lists a particle's
+/// springs together) add to a register instead of to memory: the same
+/// additions in the same order, without waiting for each store to reach the
+/// next load. No spring of such a run has that particle as its second end (a
+/// spring's ends differ), so memory and register never disagree about it.
+pub(super) struct Scatter<'a, const PIECE: bool> {
+    pub forces: &'a mut [DVec3],
+    pub lo: usize,
+    run: Option<usize>,
+    acc: DVec3,
+}
+
+impl<'a> Scatter<'a, false> {
+    /// A sink adding to every particle's force.
+    pub fn new(forces: &'a mut [DVec3]) -> Self {
+        Scatter {
+            forces,
+            lo: 0,
+            run: None,
+            acc: DVec3::ZERO,
+        }
+    }
+}
+
+impl<'a> Scatter<'a, true> {
+    /// A sink adding to `forces`, the forces of particles `lo..`.
+    pub fn piece(forces: &'a mut [DVec3], lo: usize) -> Self {
+        Scatter {
+            forces,
+            lo,
+            run: None,
+            acc: DVec3::ZERO,
+        }
+    }
+}
+
+impl<const PIECE: bool> Sink for Scatter<'_, PIECE> {
+    #[inline(always)]
+    fn take(&mut self, _: usize, ends: &[[u32; 2]], block: &Block) {
+        let (mut run, mut acc) = (self.run, self.acc);
+        let lo = if PIECE { self.lo } else { 0 };
+        let forces = &mut *self.forces;
+        for (i, &[a, b]) in ends.iter().enumerate() {
             let f = block.force(i);
-            let a = a as usize;
+            let a = a as usize - lo;
             if run != Some(a) {
                 if let Some(p) = run {
                     forces[p] = acc;
@@ -164,73 +216,15 @@ fn scatter_any(
                 acc = forces[a];
             }
             acc += f;
-            forces[b as usize] -= f;
+            forces[b as usize - lo] -= f;
         }
+        (self.run, self.acc) = (run, acc);
     }
-    if let Some(p) = run {
-        forces[p] = acc;
-    }
-}
 
-/// Writes every spring's force (on its first end) into `out`.
-pub(super) fn forces_into(
-    springs: Slice,
-    block: &mut Block,
-    pos: &[DVec3],
-    vel: &[DVec3],
-    out: &mut [DVec3],
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { forces_into_avx512(springs, block, pos, vel, out) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { forces_into_avx2(springs, block, pos, vel, out) };
-        }
-    }
-    forces_into_any(springs, block, pos, vel, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn forces_into_avx512(
-    springs: Slice,
-    block: &mut Block,
-    pos: &[DVec3],
-    vel: &[DVec3],
-    out: &mut [DVec3],
-) {
-    forces_into_any(springs, block, pos, vel, out)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn forces_into_avx2(
-    springs: Slice,
-    block: &mut Block,
-    pos: &[DVec3],
-    vel: &[DVec3],
-    out: &mut [DVec3],
-) {
-    forces_into_any(springs, block, pos, vel, out)
-}
-
-#[inline(always)]
-fn forces_into_any(
-    springs: Slice,
-    block: &mut Block,
-    pos: &[DVec3],
-    vel: &[DVec3],
-    out: &mut [DVec3],
-) {
-    for (chunk, out) in springs.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-        block.load(chunk, pos, vel);
-        block.compute(chunk);
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = block.force(i);
+    #[inline(always)]
+    fn finish(&mut self) {
+        if let Some(p) = self.run.take() {
+            self.forces[p] = self.acc;
         }
     }
 }
@@ -309,12 +303,13 @@ mod tests {
             let mut forces = start.clone();
             let mut block = Block::default();
             let s = t.all();
+            let mut sink = Scatter::new(&mut forces);
             match path {
-                "any" => scatter_any(s, &mut block, &pos, &vel, &mut forces),
+                "any" => run_any(s, &mut block, &pos, &vel, &mut sink),
                 #[cfg(target_arch = "x86_64")]
-                "avx2" => unsafe { scatter_avx2(s, &mut block, &pos, &vel, &mut forces) },
+                "avx2" => unsafe { run_avx2(s, &mut block, &pos, &vel, &mut sink) },
                 #[cfg(target_arch = "x86_64")]
-                "avx512" => unsafe { scatter_avx512(s, &mut block, &pos, &vel, &mut forces) },
+                "avx512" => unsafe { run_avx512(s, &mut block, &pos, &vel, &mut sink) },
                 _ => unreachable!(),
             }
             bits(&forces)
@@ -328,25 +323,6 @@ mod tests {
             if std::arch::is_x86_feature_detected!("avx512f") {
                 assert_eq!(run("avx512"), bits(&want), "avx512");
             }
-        }
-        // Each spring's force on its own, as the threads' gather reads them.
-        let mut each = vec![DVec3::ZERO; t.ends.len()];
-        forces_into(t.all(), &mut Block::default(), &pos, &vel, &mut each);
-        for (i, f) in each.iter().enumerate() {
-            let mut one = Table::default();
-            one.ends.push(t.ends[i]);
-            one.stiffness.push(t.stiffness[i]);
-            one.damping.push(t.damping[i]);
-            one.rest_length.push(t.rest_length[i]);
-            let mut alone = vec![DVec3::ZERO; pos.len()];
-            reference(&one, &pos, &vel, &mut alone);
-            // (0 + f: a squashed spring's force is −0, which the sum makes +0.)
-            let got = DVec3::ZERO + *f;
-            assert_eq!(
-                bits(&[got]),
-                bits(&[alone[t.ends[i][0] as usize]]),
-                "spring {i}"
-            );
         }
     }
 }

@@ -1,0 +1,56 @@
+//! One large world on many threads: its per-particle loops (the integrators'
+//! updates, gravity, the finiteness check) split into one contiguous piece
+//! of particles per thread of the current rayon pool. Each particle's
+//! arithmetic is the same wherever it runs, so the results are the same
+//! bits on any number of threads. The pieces line up with the ranges the
+//! springs are split into (`forces/spring/threads.rs`), so a thread mostly
+//! updates the particles whose forces it just summed, in its own cache.
+//!
+//! Small worlds stay on the calling thread: waking another costs more than
+//! their whole loop.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Worlds with fewer particles stay on one thread.
+pub const MIN_PARTICLES: usize = 4096;
+
+/// Particles per piece for a world of `n`, or `None` to stay on this thread.
+#[inline]
+pub fn piece_len(n: usize) -> Option<usize> {
+    if n < MIN_PARTICLES {
+        return None;
+    }
+    let threads = rayon::current_num_threads();
+    (threads > 1).then(|| n.div_ceil(threads))
+}
+
+/// Calls `body(first, pieces)` for contiguous pieces `first..first + len` of
+/// the `slices` (all as long as each other): once with everything for small
+/// worlds, once per thread for large ones.
+#[inline]
+pub fn by_pieces<const K: usize>(
+    slices: [&mut [DVec3]; K],
+    body: impl Fn(usize, [&mut [DVec3]; K]) + Sync,
+) {
+    let n = slices.first().map_or(0, |s| s.len());
+    let Some(len) = piece_len(n) else {
+        return body(0, slices);
+    };
+    let mut rest = slices;
+    let mut pieces = Vec::with_capacity(n.div_ceil(len));
+    let mut first = 0;
+    while first < n {
+        let take = len.min(n - first);
+        let head: [&mut [DVec3]; K] = std::array::from_fn(|k| {
+            let (head, tail) = std::mem::take(&mut rest[k]).split_at_mut(take);
+            rest[k] = tail;
+            head
+        });
+        pieces.push((first, head));
+        first += take;
+    }
+    pieces
+        .into_par_iter()
+        .for_each(|(first, piece)| body(first, piece));
+}
