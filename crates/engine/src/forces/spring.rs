@@ -247,6 +247,8 @@ impl Force for Springs {
         let springs = self.table.all();
         if springs.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1 {
             self.scratch.parallel.apply(springs, pos, vel, forces);
+        } else if springs.len() < kernel::MIN_BLOCKED {
+            kernel::plain(springs, pos, vel, forces);
         } else {
             let block = self.scratch.block.get_or_insert_with(Box::default);
             kernel::run(springs, block, pos, vel, &mut kernel::Scatter::new(forces));

@@ -87,6 +87,27 @@ impl Block {
     }
 }
 
+/// Below this many springs the plain loop is faster than blocks (a
+/// creature's few springs: nothing to vectorise over).
+pub const MIN_BLOCKED: usize = 16;
+
+/// The plain loop, one spring at a time: the same operations in the same
+/// order as a block's, so the same bits.
+#[inline]
+pub(super) fn plain(springs: Slice, pos: &[DVec3], vel: &[DVec3], forces: &mut [DVec3]) {
+    for (i, &[a, b]) in springs.ends.iter().enumerate() {
+        let (a, b) = (a as usize, b as usize);
+        let d = pos[b] - pos[a];
+        let len = d.length();
+        let n = d * if len > 0.0 { 1.0 / len } else { 0.0 };
+        let f = n
+            * (springs.stiffness[i] * (len - springs.rest_length[i])
+                + springs.damping[i] * (vel[b] - vel[a]).dot(n));
+        forces[a] += f;
+        forces[b] -= f;
+    }
+}
+
 /// What becomes of each spring's force once a block is computed.
 ///
 /// It takes a whole block at a time, so that what it keeps from one spring
@@ -270,21 +291,6 @@ mod tests {
         (t, pos, vel)
     }
 
-    /// The plain loop, one spring at a time, as the engine had it before blocks.
-    fn reference(t: &Table, pos: &[DVec3], vel: &[DVec3], forces: &mut [DVec3]) {
-        for (i, &[a, b]) in t.ends.iter().enumerate() {
-            let (a, b) = (a as usize, b as usize);
-            let d = pos[b] - pos[a];
-            let len = d.length();
-            let n = d * if len > 0.0 { 1.0 / len } else { 0.0 };
-            let f = n
-                * (t.stiffness[i] * (len - t.rest_length[i])
-                    + t.damping[i] * (vel[b] - vel[a]).dot(n));
-            forces[a] += f;
-            forces[b] -= f;
-        }
-    }
-
     fn bits(forces: &[DVec3]) -> Vec<u64> {
         forces
             .iter()
@@ -297,7 +303,7 @@ mod tests {
         let (t, pos, vel) = springs();
         let start: Vec<DVec3> = (0..pos.len()).map(|i| DVec3::splat(i as f64)).collect();
         let mut want = start.clone();
-        reference(&t, &pos, &vel, &mut want);
+        plain(t.all(), &pos, &vel, &mut want);
         assert!(want.iter().all(|f| f.is_finite()));
         let run = |path: &str| {
             let mut forces = start.clone();
