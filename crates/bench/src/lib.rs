@@ -228,6 +228,22 @@ pub struct Row {
 }
 
 impl Row {
+    /// How many threads the measurement used, and how: `"one sim"` (one
+    /// world, on one thread or split among several) or `"independent sims"`
+    /// (a world or evaluation per thread). Read from the variant, which
+    /// names its threads ("one world, 2 threads", "2 threads x 1 copy
+    /// each", "… 2 thr"); no mention means one thread.
+    pub fn threads(&self) -> (usize, &'static str) {
+        let v = &self.variant;
+        let n = if v.contains("2 thr") { 2 } else { 1 };
+        let mode = if n > 1 && !v.contains("one world") {
+            "independent sims"
+        } else {
+            "one sim"
+        };
+        (n, mode)
+    }
+
     /// Particle-steps per second (median).
     pub fn particle_steps_per_s(&self) -> f64 {
         (self.particles * self.steps) as f64 / self.engine.median
@@ -616,7 +632,30 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
 
 #[cfg(test)]
 mod target_tests {
-    use super::Check;
+    use super::{Check, Row, Timing};
+
+    #[test]
+    fn a_row_says_how_many_threads_it_used() {
+        let row = |variant: &str| Row {
+            workload: "w".into(),
+            variant: variant.into(),
+            particles: 1,
+            springs: 0,
+            steps: 1,
+            dt: 1.0,
+            evaluations: 1,
+            pairs: 0,
+            engine: Timing::from_runs(vec![1.0]),
+            baseline: None,
+            checks: vec![],
+        };
+        assert_eq!(row("rk4").threads(), (1, "one sim"));
+        assert_eq!(row("symplectic, 1 thread").threads(), (1, "one sim"));
+        assert_eq!(row("rk4, one world, 2 threads").threads(), (2, "one sim"));
+        let copies = row("symplectic, 2 threads x 1 copy each").threads();
+        assert_eq!(copies, (2, "independent sims"));
+        assert_eq!(row("evolve 6 lanes x 1000 gens, 2 thr").threads(), (2, "independent sims"));
+    }
 
     #[test]
     fn a_missed_speed_goal_is_reported_but_is_not_a_failed_check() {

@@ -72,13 +72,18 @@ fn json_row(r: &Row, quick: bool, machine: &serde_json::Value, date: &str) -> se
             serde_json::json!({ "name": c.name, "value": c.value, "kind": kind, "bound": bound, "passed": c.passed(), "target_met": c.target_met() })
         })
         .collect();
+    let (threads, mode) = r.threads();
     serde_json::json!({
         "workload": r.workload,
         "variant": r.variant,
+        "threads": threads,
+        "mode": mode,
         "particles": r.particles,
         "springs": r.springs,
         "steps": r.steps,
         "dt": r.dt,
+        "evaluations": r.evaluations,
+        "pairs": r.pairs,
         "quick": quick,
         "engine": timing(&r.engine),
         "baseline": r.baseline.as_ref().map(|(name, t)| serde_json::json!({ "name": name, "timing": timing(t) })),
