@@ -39,7 +39,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         baseline: None,
         checks: vec![
             Check::new("time upright", e.time_up, 20.0, 0.0),
-            Check::target("times real time", settings.seconds / per_eval.median, 1e4),
+            Check::target("times real time", settings.seconds / per_eval.median, 15e3),
         ],
     };
 
@@ -65,7 +65,8 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         .count();
     let mut checks = vec![Check::info("lanes hopping 20 s", stable as f64)];
     if !quick {
-        checks.push(Check::at_most("wall time, s", evo.median, 15.0));
+        // The thesis experiment on this machine's cores (issue 13's goal).
+        checks.push(Check::target_at_most("wall time, s", evo.median, 3.0));
     }
     let evo_row = Row {
         workload: "hopper".into(),

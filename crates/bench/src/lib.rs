@@ -118,6 +118,8 @@ pub enum Bound {
     /// A speed goal of at least this: reported as met or missed, never a
     /// failure (timings on a shared machine are noisy; correctness is not).
     Target(f64),
+    /// A speed goal of at most this (a wall time), reported like [`Bound::Target`].
+    TargetAtMost(f64),
     /// Reported only.
     Info,
 }
@@ -169,10 +171,19 @@ impl Check {
             bound: Bound::Target(min),
         }
     }
+    /// A speed goal of at most `max` (a wall time): reported, never a failure.
+    pub fn target_at_most(name: &str, value: f64, max: f64) -> Check {
+        Check {
+            name: name.into(),
+            value,
+            bound: Bound::TargetAtMost(max),
+        }
+    }
     /// Whether a speed goal was met (`None` for a correctness check).
     pub fn target_met(&self) -> Option<bool> {
         match self.bound {
             Bound::Target(min) => Some(self.value >= min),
+            Bound::TargetAtMost(max) => Some(self.value <= max),
             _ => None,
         }
     }
@@ -195,7 +206,7 @@ impl Check {
             } => Some((v - expected).abs() <= tolerance && v.is_finite()),
             Bound::AtLeast(min) => Some(v >= min),
             Bound::AtMost(max) => Some(v <= max),
-            Bound::Target(_) | Bound::Info => None,
+            Bound::Target(_) | Bound::TargetAtMost(_) | Bound::Info => None,
         }
     }
 }
@@ -654,7 +665,10 @@ mod target_tests {
         assert_eq!(row("rk4, one world, 2 threads").threads(), (2, "one sim"));
         let copies = row("symplectic, 2 threads x 1 copy each").threads();
         assert_eq!(copies, (2, "independent sims"));
-        assert_eq!(row("evolve 6 lanes x 1000 gens, 2 thr").threads(), (2, "independent sims"));
+        assert_eq!(
+            row("evolve 6 lanes x 1000 gens, 2 thr").threads(),
+            (2, "independent sims")
+        );
     }
 
     #[test]
@@ -663,6 +677,12 @@ mod target_tests {
         assert_eq!(missed.passed(), None, "not a correctness check");
         assert_eq!(missed.target_met(), Some(false));
         assert_eq!(Check::target("x", 2.0, 1.0).target_met(), Some(true));
+        let slow = Check::target_at_most("wall time, s", 4.8, 3.0);
+        assert_eq!((slow.passed(), slow.target_met()), (None, Some(false)));
+        assert_eq!(
+            Check::target_at_most("s", 2.0, 3.0).target_met(),
+            Some(true)
+        );
         let wrong = Check::new("com_y", 1.0, 2.0, 1e-6);
         assert_eq!(wrong.passed(), Some(false));
         assert_eq!(wrong.target_met(), None);

@@ -67,6 +67,7 @@ fn json_row(r: &Row, quick: bool, machine: &serde_json::Value, date: &str) -> se
                 Bound::AtLeast(min) => ("at_least", serde_json::json!({ "min": min })),
                 Bound::AtMost(max) => ("at_most", serde_json::json!({ "max": max })),
                 Bound::Target(min) => ("target", serde_json::json!({ "min": min })),
+                Bound::TargetAtMost(max) => ("target", serde_json::json!({ "max": max })),
                 Bound::Info => ("info", serde_json::Value::Null),
             };
             serde_json::json!({ "name": c.name, "value": c.value, "kind": kind, "bound": bound, "passed": c.passed(), "target_met": c.target_met() })
@@ -157,6 +158,7 @@ fn print_row(r: &Row) {
             Bound::AtLeast(min) => format!("at least {min}"),
             Bound::AtMost(max) => format!("at most {max}"),
             Bound::Target(min) => format!("goal at least {min}"),
+            Bound::TargetAtMost(max) => format!("goal at most {max}"),
             Bound::Info => String::new(),
         };
         println!(

@@ -10,7 +10,7 @@
 //!   addressed by copyable [`ParticleId`] handles.
 //! - Forces implement [`Force`]; the built-in ones live in [`forces`], one
 //!   file each, and in typed collections so their loops are tight. Add your
-//!   own with [`World::add_force`] (see `examples/nbody.rs`).
+//!   own with [`World::add_force`] (see `examples/nbody/gravity.rs`).
 //! - Discrete events implement [`DiscreteEvent`]; a missed event makes the
 //!   world retake the step in shorter pieces ([`World::step`]).
 //! - Integrators ([`IntegratorKind`]): explicit Euler, midpoint, RK4 and

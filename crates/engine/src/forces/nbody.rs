@@ -8,7 +8,7 @@
 //! thread and any CPU (see `gather.rs`); Newton's third law then holds to
 //! rounding rather than exactly (a pairs-once loop made it exact but could
 //! neither vectorise nor split across threads). The tutorial
-//! version written outside the engine is `examples/nbody.rs`; this one is what
+//! version written outside the engine is `examples/nbody/gravity.rs`; this one is what
 //! scene files get as `[[nbody]]`.
 
 use crate::error::ModelError;

@@ -8,8 +8,8 @@
 //! no FMA; square root and division are correctly rounded on every
 //! instruction set), and the forces reach the particles in spring order, as
 //! the plain loop adds them. AVX-512, AVX2 and SSE2 therefore give the same
-//! bits, and so does the gather used on many threads (`threads.rs`), which
-//! sums each particle's springs in the same order.
+//! bits as the plain loop, and so do many threads (`threads.rs`), where each
+//! particle still sums its springs in spring order.
 
 use super::Slice;
 use glam::DVec3;
@@ -23,7 +23,7 @@ pub struct Block {
     d: [[f64; BLOCK]; 3],
     w: [[f64; BLOCK]; 3],
     /// The force on each spring's first end (minus that on its second), N.
-    pub f: [[f64; BLOCK]; 3],
+    f: [[f64; BLOCK]; 3],
 }
 
 impl Default for Block {
@@ -56,8 +56,7 @@ impl Block {
 
     /// `f = n (k (len − r) + c (w·n))` with `n = d / len` (zero for a spring
     /// squashed to a point, which has no direction), for the springs just
-    /// loaded; the same expression, in the same order, as
-    /// [`Spring::tension`](super::Spring::tension).
+    /// loaded; the same expression, in the same order, as [`plain`].
     #[inline(always)]
     fn compute(&mut self, springs: Slice) {
         let n = springs.len().min(BLOCK);
