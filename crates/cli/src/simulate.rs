@@ -51,6 +51,26 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if let Some(kind) = args.integrator {
         scene.world.set_integrator(kind);
     }
+    // The scene's own step was checked when it loaded; a step or an
+    // integrator from the command line is checked here.
+    let limit = scene.world.step_limit(scene.world.integrator());
+    if args.dt.is_some() || args.integrator.is_some() {
+        if let Some(l) = limit.filter(|l| dt > l.dt) {
+            let (a, b) = scene.world.forces().springs.get(l.spring).ends();
+            let name = |i: usize| scene.names.get(i).map_or("?", String::as_str);
+            crate::warn(
+                &args.scene,
+                &[format!(
+                    "dt = {dt} s is {:.1} times the step at which {} can stay stable (below {:.3e} s, set by the spring `{}`–`{}`): expect a blow-up",
+                    dt / l.dt,
+                    scene.world.integrator(),
+                    l.dt,
+                    name(a.index()),
+                    name(b.index())
+                )],
+            );
+        }
+    }
     let steps = (duration / dt).round();
     if steps < 1.0 {
         return Err(Failure::Input(format!(
@@ -120,6 +140,18 @@ pub fn run(args: Args) -> Result<(), Failure> {
         world.integrator(),
         world.time()
     );
+    match limit {
+        Some(l) => {
+            println!(
+            "recommended step for {}: {:.3e} s (spring modes up to {:.1} rad/s, at particle `{}`)",
+            world.integrator(),
+            l.dt,
+            l.omega,
+            scene.names.get(l.particle.index()).map_or("?", String::as_str)
+        )
+        }
+        None => println!("recommended step: no spring limits it"),
+    }
     println!("backtracks: {}", stats.backtracks);
     println!(
         "wall time: {wall:.4} s ({:.1} simulated s per wall s)",

@@ -401,3 +401,45 @@ stiffness = 1000.0
     assert!(err.contains("dt = 0.01 s is 5.0 times"), "{err}");
     assert!(err.contains("`nail`–`bead`"), "{err}");
 }
+
+#[test]
+fn summary_gives_the_recommended_step_and_a_step_past_it_from_the_command_line_is_warned() {
+    // pendulum_chain: 50 g bobs on 400 N/m springs; a bob between two
+    // springs has ω² ≤ 2·800/0.05 = 32,000 s⁻², so symplectic Euler's step
+    // is 2/√32000 = 1.118e-2 s and RK4's 2√2/√32000 = 1.581e-2 s.
+    let ok = animats(&[
+        "simulate",
+        "scenes/pendulum_chain.toml",
+        "--duration",
+        "0.1",
+    ]);
+    let (out, err) = text(&ok);
+    assert!(ok.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let kind_line = out.lines().find(|l| l.starts_with("recommended step for"));
+    let line = kind_line.unwrap_or_default();
+    let want = |kind: &str, h: f64| format!("recommended step for {kind}: {h:.3e} s");
+    let rk4 = 2.0 * std::f64::consts::SQRT_2 / 32000f64.sqrt();
+    let symplectic = 2.0 / 32000f64.sqrt();
+    assert!(
+        line.starts_with(&want("rk4", rk4)) || line.starts_with(&want("symplectic", symplectic)),
+        "{out}"
+    );
+    let fast = animats(&[
+        "simulate",
+        "scenes/pendulum_chain.toml",
+        "--duration",
+        "0.1",
+        "--dt",
+        "0.05",
+        "--integrator",
+        "symplectic",
+    ]);
+    let (out, err) = text(&fast);
+    assert!(out.contains(&want("symplectic", symplectic)), "{out}");
+    assert!(
+        err.contains("warning") && err.contains("expect a blow-up"),
+        "{err}"
+    );
+    assert!(err.contains("set by the spring `b"), "{err}");
+}

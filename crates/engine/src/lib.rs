@@ -58,6 +58,6 @@ pub use guard::DivergenceGuard;
 pub use integrators::IntegratorKind;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
 pub use snapshot::Snapshot;
-pub use world::{Energy, FloorDef, Stats, StepReport, World};
+pub use world::{Energy, FloorDef, Stats, StepLimit, StepReport, World};
 
 pub use glam::DVec3;

@@ -47,6 +47,20 @@ pub struct Stats {
     pub unresolved: u64,
 }
 
+/// The largest step an explicit integrator can take with a world's springs
+/// ([`World::step_limit`]), and where the stiffest mode is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepLimit {
+    /// The step, s.
+    pub dt: f64,
+    /// The bound on the fastest spring mode, rad/s.
+    pub omega: f64,
+    /// The particle where that bound is reached.
+    pub particle: ParticleId,
+    /// The stiffest spring at that particle.
+    pub spring: SpringId,
+}
+
 /// Kinetic and potential energy of a world, J.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Energy {
@@ -609,6 +623,47 @@ impl World {
     }
 
     // ----- diagnostics -----------------------------------------------------
+
+    /// The largest step at which `kind` keeps every spring mode of this
+    /// world bounded, by a conservative bound: the fastest mode's ω² is at
+    /// most `2 Σ k / m` over the springs meeting at one particle
+    /// (Gershgorin's theorem on `M⁻¹K`; a nail takes none), so `kind` is
+    /// stable while `h ≤` [`IntegratorKind::stable_omega_h`]` / ω`. Exact
+    /// for two equal masses on one spring; damping, joints and contact are
+    /// not counted. `None` without springs between moving particles.
+    pub fn step_limit(&self, kind: IntegratorKind) -> Option<StepLimit> {
+        let p = &self.particles;
+        let n = self.len();
+        let mut load = vec![0.0f64; n];
+        let mut stiffest: Vec<Option<(f64, usize)>> = vec![None; n];
+        for (k, sp) in self.forces.springs.iter().enumerate() {
+            let (a, b) = sp.ends();
+            for i in [a.index(), b.index()] {
+                load[i] += sp.stiffness;
+                if stiffest[i].is_none_or(|(kk, _)| sp.stiffness > kk) {
+                    stiffest[i] = Some((sp.stiffness, k));
+                }
+            }
+        }
+        let (w2, i) = (0..n)
+            .map(|i| (2.0 * load[i] * p.inv_mass[i], i))
+            .max_by(|x, y| x.0.total_cmp(&y.0))
+            .filter(|w| w.0 > 0.0 && w.0.is_finite())?;
+        let (_, k) = stiffest[i]?;
+        let omega = w2.sqrt();
+        Some(StepLimit {
+            dt: kind.stable_omega_h() / omega,
+            omega,
+            particle: ParticleId(i as u32),
+            spring: SpringId(k as u32),
+        })
+    }
+
+    /// The step [`step_limit`](World::step_limit) allows `kind`, s (`None`
+    /// when no spring limits it).
+    pub fn recommended_dt(&self, kind: IntegratorKind) -> Option<f64> {
+        self.step_limit(kind).map(|l| l.dt)
+    }
 
     /// Kinetic and potential energy of the current state.
     pub fn energy(&self) -> Energy {

@@ -166,7 +166,10 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         },
     };
     let gravity = wat.vec3("gravity", wd.gravity)?;
-    let dt = wat.positive("dt", wd.dt)?;
+    let given_dt = match wd.dt {
+        crate::def::StepDef::Seconds(d) => Some(wat.positive("dt", d)?),
+        crate::def::StepDef::Auto => None,
+    };
     let duration = wat.positive("duration", wd.duration)?;
     world.set_integrator(wd.integrator.into());
     if gravity != DVec3::ZERO {
@@ -215,6 +218,13 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         ..
     } = cx;
 
+    // `dt = "auto"`: the recommended step now the springs are known.
+    let dt = given_dt.unwrap_or_else(|| {
+        let most = crate::def::DEFAULT_DT;
+        world
+            .recommended_dt(world.integrator())
+            .map_or(most, |r| r.min(most))
+    });
     let nervous = crate::nervous::build(def, src, &names, &handles, &mut world)?;
     let evolve = match &def.evolve {
         Some(entry) => Some(crate::evaluate::EvolveSpec::build(
@@ -250,16 +260,6 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     })
 }
 
-/// Largest ω·h at which a lone undamped spring stays bounded under each
-/// explicit integrator: symplectic Euler 2, RK4 2√2 ≈ 2.83; explicit Euler
-/// and midpoint grow at any step, and get the symplectic bound as a guide.
-fn stable_omega_h(kind: animats_engine::IntegratorKind) -> f64 {
-    match kind {
-        animats_engine::IntegratorKind::Rk4 => 2.0 * std::f64::consts::SQRT_2,
-        _ => 2.0,
-    }
-}
-
 /// What is allowed but probably a mistake: see [`Scene::warnings`].
 fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: bool) -> Vec<String> {
     let mut out = Vec::new();
@@ -283,41 +283,20 @@ fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: boo
             ));
         }
     }
-    // The fastest spring mode is bounded (Gershgorin) by the largest
-    // ω² ≤ 2 Σ k / m over the springs meeting at one particle; a nail
-    // takes none. Name that particle's stiffest spring.
-    let n = world.len();
-    let mut load = vec![0.0f64; n];
-    let mut stiffest: Vec<Option<(f64, usize)>> = vec![None; n];
-    for (k, sp) in world.forces().springs.iter().enumerate() {
-        let (a, b) = sp.ends();
-        for i in [a.index(), b.index()] {
-            load[i] += sp.stiffness;
-            if stiffest[i].is_none_or(|(kk, _)| sp.stiffness > kk) {
-                stiffest[i] = Some((sp.stiffness, k));
-            }
-        }
-    }
-    let worst = (0..n)
-        .map(|i| (2.0 * load[i] * p.inv_mass[i], i))
-        .max_by(|x, y| x.0.total_cmp(&y.0));
-    if let Some((w2, i)) = worst.filter(|w| w.0 > 0.0) {
-        let omega = w2.sqrt();
-        let kind = world.integrator();
-        let limit = stable_omega_h(kind) / omega;
-        if let (true, Some((_, k))) = (dt > limit, stiffest[i]) {
-            let (a, b) = world.forces().springs.iter().nth(k).map_or((0, 0), |sp| {
-                let (a, b) = sp.ends();
-                (a.index(), b.index())
-            });
-            out.push(format!(
-                "dt = {dt} s is {:.1} times the step at which {kind} can stay stable with the springs at particle `{}` (ω up to {omega:.1} rad/s; stable below {limit:.3e} s; the stiffest is `{}`–`{}`): expect a blow-up",
-                dt / limit,
-                names[i],
-                names[a],
-                names[b]
-            ));
-        }
+    // The fastest spring mode's bound (`World::step_limit`), naming the
+    // particle where it is reached and its stiffest spring.
+    let kind = world.integrator();
+    if let Some(limit) = world.step_limit(kind).filter(|l| dt > l.dt) {
+        let (a, b) = world.forces().springs.get(limit.spring).ends();
+        out.push(format!(
+            "dt = {dt} s is {:.1} times the step at which {kind} can stay stable with the springs at particle `{}` (ω up to {:.1} rad/s; stable below {:.3e} s; the stiffest is `{}`–`{}`): expect a blow-up",
+            dt / limit.dt,
+            names[limit.particle.index()],
+            limit.omega,
+            limit.dt,
+            names[a.index()],
+            names[b.index()]
+        ));
     }
     out
 }

@@ -107,9 +107,9 @@ pub struct WorldDef {
     /// m/s², default `[0, -9.8, 0]`.
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
-    /// Step, s, > 0; default 0.001.
+    /// Step, s, > 0, or `"auto"`; default 0.001.
     #[serde(default = "default_dt")]
-    pub dt: f64,
+    pub dt: StepDef,
     /// Integration method; default RK4.
     #[serde(default)]
     pub integrator: IntegratorName,
@@ -143,8 +143,52 @@ fn default_seed() -> u64 {
 fn default_gravity() -> [f64; 3] {
     [0.0, -9.8, 0.0]
 }
-fn default_dt() -> f64 {
-    0.001
+fn default_dt() -> StepDef {
+    StepDef::Seconds(DEFAULT_DT)
+}
+
+/// The step a scene gets when it names none, s; also the longest `"auto"` gives.
+pub const DEFAULT_DT: f64 = 0.001;
+
+/// `[world] dt`: a step in seconds, or `"auto"`: the world's recommended
+/// step for its integrator (`World::recommended_dt`), at most
+/// [`DEFAULT_DT`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StepDef {
+    /// This many seconds.
+    Seconds(f64),
+    /// The recommended step.
+    Auto,
+}
+
+impl<'de> Deserialize<'de> for StepDef {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = StepDef;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a step in seconds or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<StepDef, E> {
+                Ok(StepDef::Seconds(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<StepDef, E> {
+                Ok(StepDef::Seconds(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<StepDef, E> {
+                Ok(StepDef::Seconds(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<StepDef, E> {
+                match v {
+                    "auto" => Ok(StepDef::Auto),
+                    _ => Err(E::custom(format!(
+                        "expected a step in seconds or \"auto\", got \"{v}\""
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 fn default_duration() -> f64 {
     5.0

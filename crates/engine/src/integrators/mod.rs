@@ -75,6 +75,18 @@ impl IntegratorKind {
         }
     }
 
+    /// The largest ω·h at which this method keeps an undamped spring's
+    /// oscillation bounded: symplectic Euler 2, RK4 2√2 ≈ 2.83. Explicit
+    /// Euler and midpoint let it grow at any step; they get symplectic
+    /// Euler's 2 as a guide (their error still grows, only more slowly at
+    /// smaller steps).
+    pub fn stable_omega_h(self) -> f64 {
+        match self {
+            IntegratorKind::Rk4 => 2.0 * std::f64::consts::SQRT_2,
+            _ => 2.0,
+        }
+    }
+
     /// Force evaluations per step.
     pub fn evaluations(self) -> u32 {
         match self {
