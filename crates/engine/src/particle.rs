@@ -245,6 +245,9 @@ pub struct Properties {
     pub restitution: Vec<f64>,
     /// Nailed in place.
     pub fixed: Vec<bool>,
+    /// `inv_mass` repeated for each of x, y, z, so the integrators' updates
+    /// run over positions, velocities and forces as flat arrays.
+    pub(crate) inv_mass3: Vec<f64>,
 }
 
 impl Properties {
@@ -256,6 +259,12 @@ impl Properties {
     pub fn is_empty(&self) -> bool {
         self.mass.is_empty()
     }
+    /// Sets particle `i`'s inverse mass (and its three copies).
+    pub(crate) fn set_inv_mass(&mut self, i: usize, w: f64) {
+        self.inv_mass[i] = w;
+        self.inv_mass3[3 * i..3 * i + 3].fill(w);
+    }
+
     /// Cross-sectional area of particle `i` (a sphere).
     #[inline]
     pub fn area(&self, i: usize) -> f64 {
@@ -265,8 +274,9 @@ impl Properties {
     pub(crate) fn push(&mut self, def: &ParticleDef) {
         let (radius, volume) = def.radius_and_volume();
         self.mass.push(def.mass);
-        self.inv_mass
-            .push(if def.fixed { 0.0 } else { 1.0 / def.mass });
+        let w = if def.fixed { 0.0 } else { 1.0 / def.mass };
+        self.inv_mass.push(w);
+        self.inv_mass3.extend([w; 3]);
         self.radius.push(radius);
         self.volume.push(volume);
         self.mu_s.push(def.mu_s);

@@ -174,7 +174,7 @@ impl World {
                 DVec3::from_array(s.velocities[i])
             };
             p.mass[i] = s.masses[i];
-            p.inv_mass[i] = if p.fixed[i] { 0.0 } else { 1.0 / s.masses[i] };
+            p.set_inv_mass(i, if p.fixed[i] { 0.0 } else { 1.0 / s.masses[i] });
             p.volume[i] = s.volumes[i];
             p.radius[i] = sphere_radius(s.volumes[i]);
         }

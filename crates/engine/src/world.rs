@@ -255,7 +255,7 @@ impl World {
         crate::particle::positive("mass", mass)?;
         self.particles.mass[i] = mass;
         if !self.particles.fixed[i] {
-            self.particles.inv_mass[i] = 1.0 / mass;
+            self.particles.set_inv_mass(i, 1.0 / mass);
         }
         Ok(())
     }

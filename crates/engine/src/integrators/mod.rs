@@ -148,6 +148,22 @@ impl Scratch {
     }
 }
 
+/// A slice of vectors as one flat array, x, y, z of each in turn.
+#[inline(always)]
+pub(crate) fn flat(v: &[DVec3]) -> &[f64] {
+    // SAFETY: `DVec3` is `#[repr(C)]` with fields x, y, z: f64 (glam's
+    // scalar vector), so n of them are 3n contiguous, aligned f64s; the
+    // borrow is carried over.
+    unsafe { std::slice::from_raw_parts(v.as_ptr().cast::<f64>(), 3 * v.len()) }
+}
+
+/// [`flat`], mutably.
+#[inline(always)]
+pub(crate) fn flat_mut(v: &mut [DVec3]) -> &mut [f64] {
+    // SAFETY: as in `flat`; the exclusive borrow is carried over.
+    unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<f64>(), 3 * v.len()) }
+}
+
 /// Advances `from` by `h` into `to` with the method `kind`, starting at time `t`.
 pub fn integrate(
     kind: IntegratorKind,

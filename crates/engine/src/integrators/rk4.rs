@@ -3,14 +3,14 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::Dynamics;
+use super::{flat, flat_mut, Dynamics};
 use crate::parallel::by_pieces;
 use crate::particle::State;
 use glam::DVec3;
 
 /// One RK4 step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
-    let w = &d.particles.inv_mass;
+    let w = &d.particles.inv_mass3;
     let s = &mut *d.scratch;
     let (x0, v0) = (&from.pos, &from.vel);
     let half = 0.5 * h;
@@ -24,7 +24,8 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
         [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
         |first, [x, v, dx, dv]| {
             let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-            let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+            let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
+            let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
             for i in 0..n {
                 let a = w[i] * f[i];
                 dx[i] = v0[i];
@@ -43,7 +44,8 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
             [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
             |first, [x, v, dx, dv]| {
                 let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-                let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+                let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
+                let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
                 for i in 0..n {
                     let a = w[i] * f[i];
                     let vi = v[i];
@@ -64,7 +66,8 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
         [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
         |first, [x, v, dx, dv]| {
             let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-            let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+            let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
+            let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
             for i in 0..n {
                 let a = w[i] * f[i];
                 let vi = v[i];
@@ -75,7 +78,10 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
     );
 }
 
-/// The start of the step and the inverse masses, read by every stage.
+/// The start of the step and the inverse masses (one per coordinate), read
+/// by every stage; each stage's loop runs over every coordinate of every
+/// particle as one flat array, the same operations on each coordinate as on
+/// the vector.
 #[derive(Clone, Copy)]
 struct Start<'a> {
     x0: &'a [DVec3],
@@ -84,23 +90,28 @@ struct Start<'a> {
 }
 
 impl<'a> Start<'a> {
-    /// Particles `first..first + n` of the start, the inverse masses and the
-    /// forces `f`, each exactly `n` long (so the loops need no bounds checks).
+    /// Particles `first..first + n` of the start, the forces `f` and the
+    /// inverse masses, as flat arrays of each coordinate in turn, each
+    /// exactly `3n` long (so the loops need no bounds checks).
     #[inline(always)]
     fn piece<'f>(
         &self,
         first: usize,
         n: usize,
         f: &'f [DVec3],
-    ) -> (usize, [&'f [DVec3]; 3], &'f [f64])
+    ) -> (usize, [&'f [f64]; 3], &'f [f64])
     where
         'a: 'f,
     {
         let r = first..first + n;
         (
-            n,
-            [&self.x0[r.clone()], &self.v0[r.clone()], &f[r.clone()]],
-            &self.w[r],
+            3 * n,
+            [
+                flat(&self.x0[r.clone()]),
+                flat(&self.v0[r.clone()]),
+                flat(&f[r]),
+            ],
+            &self.w[3 * first..3 * (first + n)],
         )
     }
 }
