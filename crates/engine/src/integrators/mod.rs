@@ -173,10 +173,68 @@ pub fn integrate(
     from: &State,
     to: &mut State,
 ) {
+    if d.particles.inv_mass3.len() != 3 * d.particles.inv_mass.len() {
+        // Properties filled in by hand rather than by a World: make the
+        // per-coordinate copies of the inverse masses for this step.
+        let mut particles = d.particles.clone();
+        particles.inv_mass3 = particles.inv_mass.iter().flat_map(|&w| [w; 3]).collect();
+        let mut own = Dynamics {
+            forces: &mut *d.forces,
+            particles: &particles,
+            scratch: &mut *d.scratch,
+        };
+        return integrate(kind, &mut own, t, h, from, to);
+    }
     match kind {
         IntegratorKind::Euler => euler::step(d, t, h, from, to),
         IntegratorKind::Midpoint => midpoint::step(d, t, h, from, to),
         IntegratorKind::Rk4 => rk4::step(d, t, h, from, to),
         IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ParticleDef, SpringDef, World};
+
+    /// Properties written field by field (not by a World) lack the
+    /// per-coordinate inverse masses; `integrate` makes them, and the step is
+    /// a World's, to the bit.
+    #[test]
+    fn properties_filled_in_by_hand_step_as_a_worlds() {
+        let mut w = World::new();
+        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+        let a = w.add_particle(ParticleDef::new(2.0)).unwrap();
+        let b = w
+            .add_particle(ParticleDef::new(0.5).at(DVec3::new(0.3, 0.1, 0.0)))
+            .unwrap();
+        w.add_spring(SpringDef::new(a, b, 30.0, 0.1)).unwrap();
+        let p = w.particles();
+        let hand = Properties {
+            mass: p.mass.clone(),
+            inv_mass: p.inv_mass.clone(),
+            radius: p.radius.clone(),
+            volume: p.volume.clone(),
+            fixed: p.fixed.clone(),
+            ..Properties::default()
+        };
+        for kind in IntegratorKind::ALL {
+            let from = w.state().clone();
+            let mut forces = w.forces().clone();
+            let mut scratch = Scratch::default();
+            scratch.resize(2);
+            let mut to = from.clone();
+            let mut d = Dynamics {
+                forces: &mut forces,
+                particles: &hand,
+                scratch: &mut scratch,
+            };
+            integrate(kind, &mut d, 0.0, 1e-3, &from, &mut to);
+            let mut stepped = w.clone();
+            stepped.set_integrator(kind);
+            stepped.step(1e-3).unwrap();
+            assert_eq!(&to, stepped.state(), "{kind}");
+        }
     }
 }
