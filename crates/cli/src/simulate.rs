@@ -55,21 +55,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
     // integrator from the command line is checked here.
     let limit = scene.world.step_limit(scene.world.integrator());
     if args.dt.is_some() || args.integrator.is_some() {
-        if let Some(l) = limit.filter(|l| dt > l.dt) {
-            let (a, b) = scene.world.forces().springs.get(l.spring).ends();
-            let name = |i: usize| scene.names.get(i).map_or("?", String::as_str);
-            crate::warn(
-                &args.scene,
-                &[format!(
-                    "dt = {dt} s is {:.1} times the step at which {} can stay stable (below {:.3e} s, set by the spring `{}`–`{}`): expect a blow-up",
-                    dt / l.dt,
-                    scene.world.integrator(),
-                    l.dt,
-                    name(a.index()),
-                    name(b.index())
-                )],
-            );
-        }
+        let warning = animats_scene::build::step_warning(&scene.world, &scene.names, dt);
+        crate::warn(&args.scene, warning.as_slice());
     }
     let steps = (duration / dt).round();
     if steps < 1.0 {

@@ -260,6 +260,27 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     })
 }
 
+/// A warning when `dt` is past the step at which the world's integrator
+/// keeps its springs stable ([`World::step_limit`]), naming the particle
+/// where the bound is reached and its stiffest spring; `names` are the
+/// particles' names. The scene's own step is checked when it loads, a step
+/// or integrator from a command line by whoever takes it.
+pub fn step_warning(world: &World, names: &[String], dt: f64) -> Option<String> {
+    let kind = world.integrator();
+    let limit = world.step_limit(kind).filter(|l| dt > l.dt)?;
+    let (a, b) = world.forces().springs.get(limit.spring).ends();
+    let name = |i: usize| names.get(i).map_or("?", String::as_str);
+    Some(format!(
+        "dt = {dt} s is {:.1} times the step at which {kind} can stay stable with the springs at particle `{}` (ω up to {:.1} rad/s; stable below {:.3e} s, set by the spring `{}`–`{}`): expect a blow-up",
+        dt / limit.dt,
+        name(limit.particle.index()),
+        limit.omega,
+        limit.dt,
+        name(a.index()),
+        name(b.index())
+    ))
+}
+
 /// What is allowed but probably a mistake: see [`Scene::warnings`].
 fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: bool) -> Vec<String> {
     let mut out = Vec::new();
@@ -283,20 +304,6 @@ fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: boo
             ));
         }
     }
-    // The fastest spring mode's bound (`World::step_limit`), naming the
-    // particle where it is reached and its stiffest spring.
-    let kind = world.integrator();
-    if let Some(limit) = world.step_limit(kind).filter(|l| dt > l.dt) {
-        let (a, b) = world.forces().springs.get(limit.spring).ends();
-        out.push(format!(
-            "dt = {dt} s is {:.1} times the step at which {kind} can stay stable with the springs at particle `{}` (ω up to {:.1} rad/s; stable below {:.3e} s; the stiffest is `{}`–`{}`): expect a blow-up",
-            dt / limit.dt,
-            names[limit.particle.index()],
-            limit.omega,
-            limit.dt,
-            names[a.index()],
-            names[b.index()]
-        ));
-    }
+    out.extend(step_warning(world, names, dt));
     out
 }
