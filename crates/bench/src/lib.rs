@@ -18,6 +18,7 @@ pub mod mass_spring;
 pub mod nbody5;
 pub mod seaworld;
 pub mod stability;
+pub mod stiff;
 
 use animats_engine::{DVec3, IntegratorKind};
 use std::time::Instant;

@@ -83,8 +83,11 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if let Some(t) = trajectory.as_mut() {
         t.record_scene(&scene, 0).map_err(write_err)?;
     }
+    let mut iterations = 0u64;
     for step in 1..=steps {
-        if let Err(e) = scene.step(dt) {
+        let stepped = scene.step(dt);
+        iterations += scene.world.last_step().solver_iterations as u64;
+        if let Err(e) = stepped {
             let message = match e.blame() {
                 Some((particle, time)) => format!(
                     "{}: the simulation {} at t = {time} s (step {step} of {steps}): {}; try a smaller --dt",
@@ -137,7 +140,23 @@ pub fn run(args: Args) -> Result<(), Failure> {
             scene.names.get(l.particle.index()).map_or("?", String::as_str)
         )
         }
-        None => println!("recommended step: no spring limits it"),
+        None if world.integrator().is_explicit() => {
+            println!("recommended step: no spring limits it")
+        }
+        None => {
+            let explicit = world.recommended_dt(IntegratorKind::Symplectic);
+            println!(
+                "recommended step for implicit: any (stable at every step{})",
+                explicit.map_or(String::new(), |h| format!(
+                    "; symplectic Euler would need below {h:.3e} s"
+                ))
+            );
+            println!(
+                "linear solves: {:.1} conjugate-gradient iterations a step (tolerance {:e})",
+                iterations as f64 / steps as f64,
+                world.solver().tolerance
+            );
+        }
     }
     println!("backtracks: {}", stats.backtracks);
     println!(

@@ -6,6 +6,7 @@
 //! [`World::add_force`](crate::World::add_force) and evaluated at every trial
 //! state of the integrator, exactly like the built-in ones.
 
+use crate::jacobian::Jacobian;
 use crate::particle::{ParticleId, Properties};
 use glam::DVec3;
 
@@ -68,6 +69,15 @@ pub trait Force: Send + CloneForce {
     /// a constant push or a current is not.
     fn is_passive(&self) -> bool {
         self.is_conservative()
+    }
+
+    /// Adds this force's derivatives at `ctx` to `jac` (see
+    /// [`Jacobian`]) and returns true, so that the implicit integrator can
+    /// take it implicitly. The default adds nothing and returns false: the
+    /// implicit integrator then takes the force explicitly (it still acts,
+    /// only a stiff one limits the step as under an explicit integrator).
+    fn jacobian(&self, _ctx: &ForceContext, _jac: &mut Jacobian) -> bool {
+        false
     }
 
     /// When it is applied; see [`Stage`].

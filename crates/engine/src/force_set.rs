@@ -139,6 +139,15 @@ impl Forces {
         }
     }
 
+    /// Adds the derivatives of every force that gives them at `ctx` to
+    /// `jac` (see [`Force::jacobian`]); the others are left to be taken
+    /// explicitly.
+    pub fn jacobian(&self, ctx: &ForceContext, jac: &mut crate::Jacobian) {
+        self.for_each(|f| {
+            f.jacobian(ctx, jac);
+        });
+    }
+
     /// Calls `visit` with every force, built-in collections first.
     pub fn for_each(&self, mut visit: impl FnMut(&dyn Force)) {
         if let Some(g) = &self.gravity {

@@ -14,7 +14,8 @@
 //! - Discrete events implement [`DiscreteEvent`]; a missed event makes the
 //!   world retake the step in shorter pieces ([`World::step`]).
 //! - Integrators ([`IntegratorKind`]): explicit Euler, midpoint, RK4 and
-//!   symplectic Euler, chosen at run time.
+//!   symplectic Euler, explicit; implicit Euler for stiff bodies; chosen at
+//!   run time.
 //!
 //! No I/O, no global state: a world is a plain value, so many can run side
 //! by side (one per evolving individual). A large world also splits its own
@@ -32,6 +33,7 @@ pub mod force_set;
 pub mod forces;
 pub mod guard;
 pub mod integrators;
+pub mod jacobian;
 mod parallel;
 pub mod particle;
 pub mod snapshot;
@@ -55,7 +57,8 @@ pub use forces::{
     torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},
 };
 pub use guard::DivergenceGuard;
-pub use integrators::IntegratorKind;
+pub use integrators::{IntegratorKind, Solver};
+pub use jacobian::Jacobian;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
 pub use snapshot::Snapshot;
 pub use world::{Energy, FloorDef, Stats, StepLimit, StepReport, World};

@@ -16,7 +16,7 @@ use crate::forces::{
     spring::{SpringDef, SpringId},
     torque_joint::{TorqueJointDef, TorqueJointId},
 };
-use crate::integrators::{integrate, Dynamics, IntegratorKind, Scratch};
+use crate::integrators::{integrate, Dynamics, IntegratorKind, Scratch, Solver};
 use crate::particle::{ParticleDef, ParticleId, Properties, State};
 use glam::DVec3;
 
@@ -34,6 +34,9 @@ pub struct StepReport {
     /// Pieces accepted with an event still missed because the piece could not
     /// be split further (the event was then handled as if occurring).
     pub unresolved: u32,
+    /// Conjugate-gradient iterations of the implicit integrator, over every
+    /// trial (0 for the explicit ones).
+    pub solver_iterations: u32,
 }
 
 /// Totals since the world was created.
@@ -142,6 +145,7 @@ pub struct World {
     events: Vec<Box<dyn DiscreteEvent>>,
     event_states: Vec<EventState>,
     integrator: IntegratorKind,
+    solver: Solver,
     scratch: Scratch,
     pub(crate) time: f64,
     pub(crate) time_carry: f64,
@@ -166,6 +170,7 @@ impl World {
             events: Vec::new(),
             event_states: Vec::new(),
             integrator: IntegratorKind::default(),
+            solver: Solver::default(),
             scratch: Scratch::default(),
             time: 0.0,
             time_carry: 0.0,
@@ -452,6 +457,27 @@ impl World {
         self.integrator = kind;
     }
 
+    /// How the implicit integrator solves its linear system.
+    pub fn solver(&self) -> Solver {
+        self.solver
+    }
+
+    /// Sets the implicit integrator's tolerance and iteration limit
+    /// (a tolerance in (0, 1), at least one iteration).
+    pub fn set_solver(&mut self, solver: Solver) -> Result<(), ModelError> {
+        if !(solver.tolerance > 0.0 && solver.tolerance < 1.0) {
+            return Err(ModelError::new(
+                "tolerance",
+                format!("must be in (0, 1), got {}", solver.tolerance),
+            ));
+        }
+        if solver.max_iterations == 0 {
+            return Err(ModelError::new("max_iterations", "must be at least 1"));
+        }
+        self.solver = solver;
+        Ok(())
+    }
+
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
         self.time
@@ -490,13 +516,17 @@ impl World {
         // The whole step first; pieces only after a missed event.
         let events = self.trial(t0, dt, dt);
         let report = if events == EventState::Missed {
-            self.backtrack(t0, dt)?
+            let first = self.scratch.implicit.iterations;
+            let mut r = self.backtrack(t0, dt)?;
+            r.solver_iterations += first;
+            r
         } else {
             self.accept(events, t0 + dt)?;
             StepReport {
                 backtracks: 0,
                 pieces: 1,
                 unresolved: 0,
+                solver_iterations: self.scratch.implicit.iterations,
             }
         };
         self.advance_clock(dt);
@@ -512,10 +542,12 @@ impl World {
     /// result; returns the worst state.
     #[inline]
     fn trial(&mut self, t: f64, h: f64, step: f64) -> EventState {
+        self.scratch.implicit.iterations = 0;
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,
             scratch: &mut self.scratch,
+            solver: self.solver,
         };
         integrate(
             self.integrator,
@@ -582,6 +614,7 @@ impl World {
             let t = t0 + dt * (done as f64 / total as f64);
             let h = dt * (piece as f64 / total as f64);
             let mut worst = self.trial(t, h, dt);
+            report.solver_iterations += self.scratch.implicit.iterations;
             if worst == EventState::Missed {
                 if piece > 1 {
                     piece /= 2;
@@ -630,8 +663,12 @@ impl World {
     /// (Gershgorin's theorem on `M⁻¹K`; a nail takes none), so `kind` is
     /// stable while `h ≤` [`IntegratorKind::stable_omega_h`]` / ω`. Exact
     /// for two equal masses on one spring; damping, joints and contact are
-    /// not counted. `None` without springs between moving particles.
+    /// not counted. `None` without springs between moving particles, and for
+    /// the implicit integrator.
     pub fn step_limit(&self, kind: IntegratorKind) -> Option<StepLimit> {
+        if !kind.is_explicit() {
+            return None; // springs do not limit an implicit step
+        }
         let p = &self.particles;
         let n = self.len();
         let mut load = vec![0.0f64; n];

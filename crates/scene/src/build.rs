@@ -172,6 +172,20 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     };
     let duration = wat.positive("duration", wd.duration)?;
     world.set_integrator(wd.integrator.into());
+    let mut solver = world.solver();
+    if let Some(tol) = wd.implicit_tolerance {
+        solver.tolerance = wat.positive("implicit_tolerance", tol)?;
+    }
+    if let Some(n) = wd.implicit_max_iterations {
+        solver.max_iterations = n;
+    }
+    world.set_solver(solver).map_err(|e| {
+        let field = match e.field.as_str() {
+            "tolerance" => "implicit_tolerance",
+            _ => "implicit_max_iterations",
+        };
+        wat.err(field, e.reason)
+    })?;
     if gravity != DVec3::ZERO {
         world
             .set_gravity_force(Some(Gravity::new(gravity)))

@@ -86,6 +86,8 @@ pub enum IntegratorName {
     Rk4,
     /// Semi-implicit Euler.
     Symplectic,
+    /// Implicit (backward) Euler.
+    Implicit,
 }
 
 impl From<IntegratorName> for animats_engine::IntegratorKind {
@@ -96,6 +98,7 @@ impl From<IntegratorName> for animats_engine::IntegratorKind {
             IntegratorName::Midpoint => K::Midpoint,
             IntegratorName::Rk4 => K::Rk4,
             IntegratorName::Symplectic => K::Symplectic,
+            IntegratorName::Implicit => K::Implicit,
         }
     }
 }
@@ -118,6 +121,11 @@ pub struct WorldDef {
     pub duration: f64,
     /// Largest stable step, s: real-time mode never steps longer; default `dt`.
     pub max_dt: Option<f64>,
+    /// The implicit integrator's relative tolerance, in (0, 1); default 1e-9.
+    pub implicit_tolerance: Option<f64>,
+    /// The implicit integrator's most conjugate-gradient iterations a step;
+    /// default 2000.
+    pub implicit_max_iterations: Option<u32>,
     /// Seed of every random placement and spawn; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
@@ -131,6 +139,8 @@ impl Default for WorldDef {
             integrator: IntegratorName::default(),
             duration: default_duration(),
             max_dt: None,
+            implicit_tolerance: None,
+            implicit_max_iterations: None,
             seed: default_seed(),
         }
     }

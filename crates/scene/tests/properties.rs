@@ -20,12 +20,12 @@ fn valid_scene() -> impl Strategy<Value = String> {
         prop::collection::vec((0usize..8, 0usize..8, 0.0f64..500.0, 0.0f64..2.0), 0..10),
         prop::collection::vec((0usize..8, 0usize..8, 0usize..8, 0.0f64..5.0), 0..4),
         prop::collection::vec((0usize..8, 0usize..8, -2.0f64..2.0), 0..3),
-        (any::<bool>(), any::<bool>(), 0usize..4, 1e-4f64..5e-3),
+        (any::<bool>(), any::<bool>(), 0usize..5, 1e-4f64..5e-3),
     )
         .prop_map(|(particles, springs, angles, torques, (floor, fluid, integrator, dt))| {
             let n = particles.len();
             let mut s = String::new();
-            let kinds = ["euler", "midpoint", "rk4", "symplectic"];
+            let kinds = ["euler", "midpoint", "rk4", "symplectic", "implicit"];
             writeln!(s, "[world]\ndt = {dt}\nintegrator = \"{}\"\nduration = 0.05\n", kinds[integrator]).unwrap();
             if floor {
                 s.push_str("[floor]\n\n");

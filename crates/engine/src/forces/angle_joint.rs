@@ -218,6 +218,35 @@ impl Force for AngleJoints {
         }
     }
 
+    /// Gauss–Newton: with `g = ∂θ/∂x` over the three particles,
+    /// `∂f/∂x ≈ −k g gᵀ` (the Hessian of `½ k (θ − θ₀)²` without its
+    /// `(θ − θ₀) ∂²θ/∂x²` term, which is not definite) and `∂f/∂v = −c g gᵀ`
+    /// (exact: the damping torque is `c θ̇ = c g·v`).
+    fn jacobian(&self, ctx: &ForceContext, jac: &mut crate::Jacobian) -> bool {
+        let pos = ctx.pos;
+        for jt in &self.joints {
+            let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
+            let (ra, rb) = (pos[a] - pos[j], pos[b] - pos[j]);
+            let (la2, lb2) = (ra.length_squared(), rb.length_squared());
+            let normal = ra.cross(rb);
+            let n2 = normal.length_squared();
+            if n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0 {
+                continue; // as in `apply`: no force, no derivative
+            }
+            let nl = n2.sqrt();
+            let ga = normal.cross(ra) * (-1.0 / (nl * la2));
+            let gb = normal.cross(rb) * (1.0 / (nl * lb2));
+            let g = [(a, ga), (j, -(ga + gb)), (b, gb)];
+            for (p, gp) in g {
+                for (q, gq) in g {
+                    let outer = glam::DMat3::from_cols(gp * gq.x, gp * gq.y, gp * gq.z);
+                    jac.block(p, q, outer * -jt.stiffness, outer * -jt.damping);
+                }
+            }
+        }
+        true
+    }
+
     fn potential_energy(&self, ctx: &ForceContext) -> f64 {
         self.joints
             .iter()

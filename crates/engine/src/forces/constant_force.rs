@@ -72,6 +72,10 @@ impl ConstantForces {
 }
 
 impl Force for ConstantForces {
+    fn jacobian(&self, _ctx: &ForceContext, _jac: &mut crate::Jacobian) -> bool {
+        true // constant: its derivatives are zero
+    }
+
     fn apply(&mut self, _ctx: &ForceContext, forces: &mut [DVec3]) {
         for cf in &self.forces {
             for p in &cf.particles {

@@ -84,6 +84,31 @@ impl Force for FluidMedium {
         }
     }
 
+    /// The drag's `∂f/∂v = −½ C ρ π r² (|v| I + v vᵀ/|v|)` for the
+    /// relative velocity `v`; buoyancy is constant. The current's
+    /// dependence on position is left out (it would not be symmetric).
+    fn jacobian(&self, ctx: &ForceContext, jac: &mut crate::Jacobian) -> bool {
+        let drag = -0.5 * self.drag_coefficient * self.density * PI;
+        let still = matches!(self.current, Current::Still);
+        let mut add = |i: usize| {
+            let vr = if still {
+                ctx.vel[i]
+            } else {
+                ctx.vel[i] - self.current.velocity(ctx.pos[i], ctx.t)
+            };
+            let speed = vr.length();
+            if speed > 0.0 {
+                let r = ctx.particles.radius[i];
+                let u = vr / speed;
+                let uu = glam::DMat3::from_cols(u * u.x, u * u.y, u * u.z);
+                let dfdv = (uu + glam::DMat3::IDENTITY) * (drag * r * r * speed);
+                jac.single(i, glam::DMat3::ZERO, dfdv);
+            }
+        };
+        self.targets.for_each(ctx.pos.len(), &mut add);
+        true
+    }
+
     fn is_passive(&self) -> bool {
         // Drag in still fluid removes energy and buoyancy is conservative;
         // a current pushes.

@@ -32,6 +32,10 @@ impl Default for Gravity {
 }
 
 impl Force for Gravity {
+    fn jacobian(&self, _ctx: &ForceContext, _jac: &mut crate::Jacobian) -> bool {
+        true // constant: its derivatives are zero
+    }
+
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
         let g = self.g;
         match &self.targets {

@@ -255,6 +255,30 @@ impl Force for Springs {
         }
     }
 
+    /// With `d = x_b − x_a`, `n = d/l`: `∂f_a/∂x_a = −k (n nᵀ + (1 − r/l)
+    /// (I − n nᵀ))` and `∂f_a/∂v_a = −c n nᵀ`. Under compression (`l < r`)
+    /// the transverse term would make the system indefinite; it is dropped
+    /// there (Choi & Ko 2002), as is the damping's dependence on position.
+    fn jacobian(&self, ctx: &ForceContext, jac: &mut crate::Jacobian) -> bool {
+        let t = &self.table;
+        for (i, &[a, b]) in t.ends.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let d = ctx.pos[b] - ctx.pos[a];
+            let l = d.length();
+            if l == 0.0 {
+                continue; // no direction: the force is zero there
+            }
+            let n = d / l;
+            let nn = glam::DMat3::from_cols(n * n.x, n * n.y, n * n.z);
+            let (k, c) = (t.stiffness[i], t.damping[i]);
+            let transverse = (1.0 - t.rest_length[i] / l).max(0.0);
+            let dfdx = -(nn * (k * (1.0 - transverse))
+                + glam::DMat3::from_diagonal(DVec3::splat(k * transverse)));
+            jac.pair(a, b, dfdx, nn * -c);
+        }
+        true
+    }
+
     fn potential_energy(&self, ctx: &ForceContext) -> f64 {
         self.iter()
             .map(|s| {

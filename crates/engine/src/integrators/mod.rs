@@ -8,6 +8,7 @@
 //! rejects is thrown away without copying anything back.
 
 pub mod euler;
+pub mod implicit;
 pub mod midpoint;
 pub mod rk4;
 pub mod symplectic;
@@ -17,6 +18,8 @@ use crate::particle::{Properties, State};
 use glam::DVec3;
 use std::fmt;
 use std::str::FromStr;
+
+pub use implicit::Solver;
 
 /// The integration methods.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
@@ -31,16 +34,25 @@ pub enum IntegratorKind {
     /// Semi-implicit (symplectic) Euler: velocity first, then position with
     /// the new velocity. First order, but its energy error stays bounded.
     Symplectic,
+    /// Implicit (backward) Euler, one Newton step per step: first order,
+    /// stable at large steps on stiff springs, and damping every mode.
+    Implicit,
 }
 
 impl IntegratorKind {
     /// Every kind, in order of the names.
-    pub const ALL: [IntegratorKind; 4] = [
+    pub const ALL: [IntegratorKind; 5] = [
         IntegratorKind::Euler,
         IntegratorKind::Midpoint,
         IntegratorKind::Rk4,
         IntegratorKind::Symplectic,
+        IntegratorKind::Implicit,
     ];
+
+    /// The explicit kinds, whose step is limited by the stiffest spring.
+    pub fn is_explicit(self) -> bool {
+        self != IntegratorKind::Implicit
+    }
 
     /// The name used in scene files and on the command line.
     pub fn name(self) -> &'static str {
@@ -49,13 +61,14 @@ impl IntegratorKind {
             IntegratorKind::Midpoint => "midpoint",
             IntegratorKind::Rk4 => "rk4",
             IntegratorKind::Symplectic => "symplectic",
+            IntegratorKind::Implicit => "implicit",
         }
     }
 
     /// Order of accuracy (global error ~ h^order).
     pub fn order(self) -> u32 {
         match self {
-            IntegratorKind::Euler | IntegratorKind::Symplectic => 1,
+            IntegratorKind::Euler | IntegratorKind::Symplectic | IntegratorKind::Implicit => 1,
             IntegratorKind::Midpoint => 2,
             IntegratorKind::Rk4 => 4,
         }
@@ -64,13 +77,14 @@ impl IntegratorKind {
     /// Under a constant acceleration `a`, steps of `h` conserve
     /// `½ (v + s a h)² − a·x` exactly, where `s` is this number: −½ for
     /// explicit Euler (which gains ½ a² h² of kinetic energy a step in free
-    /// flight), +½ for symplectic Euler, 0 for midpoint and RK4 (exact for a
+    /// flight), +½ for symplectic and implicit Euler (the same step in free
+    /// flight), 0 for midpoint and RK4 (exact for a
     /// constant force). Impacts use it so as not to feed an integrator's
     /// own drift back into the bounce.
     pub fn free_flight_shift(self) -> f64 {
         match self {
             IntegratorKind::Euler => -0.5,
-            IntegratorKind::Symplectic => 0.5,
+            IntegratorKind::Symplectic | IntegratorKind::Implicit => 0.5,
             IntegratorKind::Midpoint | IntegratorKind::Rk4 => 0.0,
         }
     }
@@ -79,10 +93,11 @@ impl IntegratorKind {
     /// oscillation bounded: symplectic Euler 2, RK4 2√2 ≈ 2.83. Explicit
     /// Euler and midpoint let it grow at any step; they get symplectic
     /// Euler's 2 as a guide (their error still grows, only more slowly at
-    /// smaller steps).
+    /// smaller steps). Implicit Euler is stable at any step: infinity.
     pub fn stable_omega_h(self) -> f64 {
         match self {
             IntegratorKind::Rk4 => 2.0 * std::f64::consts::SQRT_2,
+            IntegratorKind::Implicit => f64::INFINITY,
             _ => 2.0,
         }
     }
@@ -90,7 +105,7 @@ impl IntegratorKind {
     /// Force evaluations per step.
     pub fn evaluations(self) -> u32 {
         match self {
-            IntegratorKind::Euler | IntegratorKind::Symplectic => 1,
+            IntegratorKind::Euler | IntegratorKind::Symplectic | IntegratorKind::Implicit => 1,
             IntegratorKind::Midpoint => 2,
             IntegratorKind::Rk4 => 4,
         }
@@ -110,7 +125,7 @@ impl FromStr for IntegratorKind {
             .into_iter()
             .find(|k| k.name() == s)
             .ok_or_else(|| {
-                format!("unknown integrator `{s}` (expected euler, midpoint, rk4 or symplectic)")
+                format!("unknown integrator `{s}` (expected euler, midpoint, rk4, symplectic or implicit)")
             })
     }
 }
@@ -124,6 +139,8 @@ pub struct Dynamics<'a> {
     pub particles: &'a Properties,
     /// Scratch buffers, each as long as the state.
     pub scratch: &'a mut Scratch,
+    /// How the implicit step solves its linear system.
+    pub solver: Solver,
 }
 
 /// Scratch buffers shared by the integrators.
@@ -135,6 +152,8 @@ pub struct Scratch {
     pub dx: Vec<DVec3>,
     /// Accumulated velocity increments (RK4).
     pub dv: Vec<DVec3>,
+    /// The implicit step's linear system.
+    pub implicit: implicit::Buffers,
 }
 
 impl Scratch {
@@ -182,6 +201,7 @@ pub fn integrate(
             forces: &mut *d.forces,
             particles: &particles,
             scratch: &mut *d.scratch,
+            solver: d.solver,
         };
         return integrate(kind, &mut own, t, h, from, to);
     }
@@ -190,6 +210,7 @@ pub fn integrate(
         IntegratorKind::Midpoint => midpoint::step(d, t, h, from, to),
         IntegratorKind::Rk4 => rk4::step(d, t, h, from, to),
         IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
+        IntegratorKind::Implicit => implicit::step(d, t, h, from, to),
     }
 }
 
@@ -229,6 +250,7 @@ mod tests {
                 forces: &mut forces,
                 particles: &hand,
                 scratch: &mut scratch,
+                solver: Solver::default(),
             };
             integrate(kind, &mut d, 0.0, 1e-3, &from, &mut to);
             let mut stepped = w.clone();
