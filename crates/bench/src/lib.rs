@@ -16,6 +16,7 @@ pub mod brains;
 pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
+pub mod pile;
 pub mod seaworld;
 pub mod stability;
 pub mod stiff;
@@ -35,6 +36,14 @@ pub const WORKLOADS: [&str; 9] = [
     "seaworld",
     "stability",
 ];
+
+/// Workloads run only when named (they take minutes).
+pub const ON_REQUEST: [&str; 2] = ["implicit", "contacts"];
+
+/// True when `name` is a workload, run by default or on request.
+pub fn is_workload(name: &str) -> bool {
+    WORKLOADS.contains(&name) || ON_REQUEST.contains(&name)
+}
 
 /// Options of a benchmark run.
 #[derive(Clone, Copy, Debug)]
@@ -349,14 +358,106 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "hopper" => hopper::run(opts.quick, runs),
         "brains" => brains::run(opts.quick, runs),
         "seaworld" => seaworld::run(opts.quick, runs),
+        "implicit" => Ok(run_implicit(opts.quick)),
+        "contacts" => Ok(pile::run(opts.quick)),
         "stability" => Ok(stability::run(Some(std::path::Path::new(
             "scenes/seaworld.toml",
         )))),
         _ => Err(format!(
-            "unknown workload `{name}` (expected one of: {})",
-            WORKLOADS.join(", ")
+            "unknown workload `{name}` (expected one of: {}; or on request: {})",
+            WORKLOADS.join(", "),
+            ON_REQUEST.join(", ")
         )),
     }
+}
+
+/// `implicit`: 10 s of the stiff, damped cloth-128 curtain ([`stiff::race`];
+/// cloth-32 with `--quick`), symplectic Euler at its largest stable step
+/// against implicit Euler at each step tried; the goal is implicit at its
+/// fastest run within 1 cm of the reference's final centre of mass at least
+/// 3× faster.
+fn run_implicit(quick: bool) -> Vec<Row> {
+    let n = if quick { 32 } else { 128 };
+    let mut rows = Vec::new();
+    for (drag, name) in [
+        (stiff::CURTAIN_DRAG, "with drag"),
+        (0.0, "no drag, swinging on"),
+    ] {
+        rows.extend(race_rows(&stiff::race(n, drag), name));
+    }
+    rows
+}
+
+fn race_rows(race: &stiff::Race, name: &str) -> Vec<Row> {
+    let n = race.n;
+    let springs = mass_spring::cloth(n).edges.len();
+    let row = |leg: &stiff::Leg, what: String, checks: Vec<Check>| Row {
+        workload: "implicit".into(),
+        variant: format!("curtain cloth-{n} {name}, {what}"),
+        particles: n * n,
+        springs,
+        steps: (stiff::RACE_SECONDS / leg.h).round() as usize,
+        dt: leg.h,
+        evaluations: 1,
+        pairs: 0,
+        engine: Timing::from_runs(vec![leg.seconds]),
+        baseline: None,
+        checks,
+    };
+    let error = |leg: &stiff::Leg| race.error(leg);
+    let mut rows = vec![
+        row(
+            &race.reference,
+            "reference: symplectic at 1/4 step".into(),
+            vec![Check::info(
+                "final centre of mass y, m",
+                race.reference.com.y,
+            )],
+        ),
+        row(
+            &race.symplectic,
+            "symplectic at its largest stable step".into(),
+            vec![
+                Check::info("largest stable step, s", race.symplectic_step),
+                Check::at_least("finite (1 = yes)", race.symplectic.finite as u8 as f64, 1.0),
+                Check::info(
+                    "centre of mass from the reference, m",
+                    error(&race.symplectic),
+                ),
+            ],
+        ),
+    ];
+    for leg in &race.implicit {
+        rows.push(row(
+            leg,
+            format!("implicit at {} s", leg.h),
+            vec![
+                Check::info("centre of mass from the reference, m", error(leg)),
+                Check::info("conjugate-gradient iterations a step", leg.iterations),
+                Check::at_least("finite (1 = yes)", leg.finite as u8 as f64, 1.0),
+            ],
+        ));
+    }
+    match race.best() {
+        Some(best) => rows.push(row(
+            best,
+            "implicit's fastest run within 1 cm".into(),
+            vec![
+                Check::info("step, s", best.h),
+                Check::target(
+                    "speed-up over symplectic",
+                    race.symplectic.seconds / best.seconds,
+                    3.0,
+                ),
+            ],
+        )),
+        None => rows.push(row(
+            &race.symplectic,
+            "implicit: no step tried came within 1 cm faster".into(),
+            vec![Check::target("speed-up over symplectic", 0.0, 3.0)],
+        )),
+    }
+    rows
 }
 
 fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {

@@ -72,10 +72,13 @@ fn fastest(w: &World) -> f64 {
     w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max)
 }
 
-/// Runs the search for every integrator: the frond, and (RK4, midpoint) SeaWorld.
+/// Runs the search for every explicit integrator: the frond, and SeaWorld;
+/// then implicit Euler at ten times symplectic Euler's largest stable step
+/// on the stiff bodies of [`crate::stiff`].
 pub fn run(seaworld: Option<&std::path::Path>) -> Vec<Row> {
+    let explicit = || IntegratorKind::ALL.into_iter().filter(|k| k.is_explicit());
     let mut rows = Vec::new();
-    for kind in IntegratorKind::ALL {
+    for kind in explicit() {
         let t = Instant::now();
         let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
             let mut w = frond(kind);
@@ -88,7 +91,7 @@ pub fn run(seaworld: Option<&std::path::Path>) -> Vec<Row> {
         rows.push(row("seaweed frond", kind, limit, t.elapsed().as_secs_f64()));
     }
     if let Some(path) = seaweed_scene(seaworld) {
-        for kind in IntegratorKind::ALL {
+        for kind in explicit() {
             let t = Instant::now();
             let p = path.clone();
             let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
@@ -102,6 +105,36 @@ pub fn run(seaworld: Option<&std::path::Path>) -> Vec<Row> {
             let limit = largest_stable_step(&mut make, 30.0, 5.0);
             rows.push(row("seaworld", kind, limit, t.elapsed().as_secs_f64()));
         }
+    }
+    use crate::stiff::{bent_frond, chain, hanging_cloth, ten_times};
+    let cloth = |kind| hanging_cloth(32, crate::mass_spring::STIFFNESS, kind);
+    let frond_bent = |kind| bent_frond(1.0, kind);
+    // (what, how to build it, seconds of the search, speed bound in m/s)
+    type Case<'a> = (&'a str, &'a dyn Fn(IntegratorKind) -> World, f64, f64);
+    let cases: [Case; 4] = [
+        ("hanging cloth-32", &cloth, 5.0, 50.0),
+        ("chain-64", &chain, 10.0, 50.0),
+        ("bent seaweed frond, still water", &frond_bent, 10.0, 5.0),
+        ("seaweed frond, reef current", &frond, 30.0, 1.0),
+    ];
+    for (what, make, seconds, bound) in cases {
+        let t = Instant::now();
+        let o = ten_times(make, seconds, bound, 10.0);
+        let mut r = row(
+            what,
+            IntegratorKind::Implicit,
+            o.implicit,
+            t.elapsed().as_secs_f64(),
+        );
+        r.variant = format!("{what}, implicit at 10x symplectic's step");
+        r.checks = vec![
+            Check::info("symplectic: largest stable step, s", o.symplectic),
+            Check::info("implicit: step taken, s", o.implicit),
+            Check::at_least("implicit: finite (1 = yes)", o.finite as u8 as f64, 1.0),
+            Check::at_most("implicit: fastest speed, m/s", o.fastest, bound),
+            Check::info("implicit: largest energy rise in a step, J", o.largest_rise),
+        ];
+        rows.push(r);
     }
     rows
 }

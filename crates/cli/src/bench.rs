@@ -7,9 +7,11 @@ use animats_bench::{Options, Row, WORKLOADS};
 #[derive(clap::Args)]
 pub struct Args {
     /// Workloads to run (default: all of chain-64, cloth-32, cloth-128,
-    /// nbody5, allpairs-1000, hopper, seaworld, stability).
+    /// nbody5, allpairs-1000, hopper, brains, seaworld, stability; `implicit`,
+    /// minutes long, only when named).
     workloads: Vec<String>,
-    /// Shorter n-body runs (5M and 20 steps instead of 50M and 100).
+    /// Shorter n-body runs (5M and 20 steps instead of 50M and 100); the
+    /// implicit race on cloth-32 instead of cloth-128.
     #[arg(long)]
     quick: bool,
     /// Timed runs per measurement, after one warm-up (at least 5).
@@ -176,10 +178,11 @@ pub fn run(args: Args) -> Result<(), Failure> {
         args.workloads.clone()
     };
     for n in &names {
-        if !WORKLOADS.contains(&n.as_str()) {
+        if !animats_bench::is_workload(n) {
             return Err(Failure::Input(format!(
-                "unknown workload `{n}` (expected one of: {})",
-                WORKLOADS.join(", ")
+                "unknown workload `{n}` (expected one of: {}; or on request: {})",
+                WORKLOADS.join(", "),
+                animats_bench::ON_REQUEST.join(", ")
             )));
         }
     }

@@ -443,3 +443,40 @@ fn summary_gives_the_recommended_step_and_a_step_past_it_from_the_command_line_i
     );
     assert!(err.contains("set by the spring `b"), "{err}");
 }
+
+#[test]
+fn implicit_runs_a_step_past_the_explicit_limit_without_a_warning() {
+    // The same pendulum chain at 0.05 s, 4.5× symplectic Euler's limit:
+    // implicit Euler takes it, says which step it avoids, and how hard its
+    // linear solves worked.
+    let run = animats(&[
+        "simulate",
+        "scenes/pendulum_chain.toml",
+        "--duration",
+        "2",
+        "--dt",
+        "0.05",
+        "--integrator",
+        "implicit",
+    ]);
+    let (out, err) = text(&run);
+    assert!(run.status.success(), "{err}");
+    assert!(!err.contains("warning"), "{err}");
+    let symplectic = 2.0 / 32000f64.sqrt();
+    assert!(
+        out.contains(&format!(
+            "recommended step for implicit: any (stable at every step; symplectic Euler would need below {symplectic:.3e} s)"
+        )),
+        "{out}"
+    );
+    let solves = out
+        .lines()
+        .find_map(|l| l.strip_prefix("linear solves: "))
+        .unwrap_or_default();
+    let per_step: f64 = solves
+        .split_whitespace()
+        .next()
+        .and_then(|x| x.parse().ok())
+        .unwrap_or(-1.0);
+    assert!(per_step > 0.0, "{out}");
+}

@@ -25,6 +25,16 @@ pub(crate) struct Pair {
     pub s: DMat3,
 }
 
+/// One central interaction: off-diagonal blocks `−(α n nᵀ + β I)`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Central {
+    pub a: u32,
+    pub b: u32,
+    pub n: DVec3,
+    pub alpha: f64,
+    pub beta: f64,
+}
+
 /// One general off-diagonal block `S` at (i, j).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Block {
@@ -44,6 +54,7 @@ pub struct Jacobian {
     pub(crate) rhs: Vec<DVec3>,
     /// Each particle's own block of `S`.
     pub(crate) diag: Vec<DMat3>,
+    pub(crate) central: Vec<Central>,
     pub(crate) pairs: Vec<Pair>,
     pub(crate) blocks: Vec<Block>,
 }
@@ -59,6 +70,7 @@ impl Jacobian {
         self.rhs.resize(n, DVec3::ZERO);
         self.diag.clear();
         self.diag.resize(n, DMat3::ZERO);
+        self.central.clear();
         self.pairs.clear();
         self.blocks.clear();
     }
@@ -92,6 +104,43 @@ impl Jacobian {
         });
     }
 
+    /// A central interaction along the unit vector `n` between `a` and `b`
+    /// (a spring): [`pair`](Jacobian::pair) with
+    /// `∂f_a/∂x_a = −(k_along n nᵀ + k_across (I − n nᵀ))` and
+    /// `∂f_a/∂v_a = −c_along n nᵀ`, stored and applied in that form (five
+    /// numbers instead of two 3×3 matrices).
+    #[inline]
+    pub fn central(
+        &mut self,
+        a: usize,
+        b: usize,
+        n: DVec3,
+        k_along: f64,
+        k_across: f64,
+        c_along: f64,
+    ) {
+        let h = self.h;
+        let u = self.vel[a] - self.vel[b];
+        let nu = n.dot(u);
+        // −h² ∂f/∂x u = h² (k_along n (n·u) + k_across (u − n (n·u))).
+        let kv = -(n * (nu * (k_along - k_across)) + u * k_across) * (h * h);
+        self.rhs[a] += kv;
+        self.rhs[b] -= kv;
+        let alpha = h * h * (k_along - k_across) + h * c_along;
+        let beta = h * h * k_across;
+        let s = DMat3::from_cols(n * (n.x * alpha), n * (n.y * alpha), n * (n.z * alpha))
+            + DMat3::from_diagonal(DVec3::splat(beta));
+        self.diag[a] += s;
+        self.diag[b] += s;
+        self.central.push(Central {
+            a: a as u32,
+            b: b as u32,
+            n,
+            alpha,
+            beta,
+        });
+    }
+
     /// A force on particle `i` alone (drag): `dfdx = ∂f_i/∂x_i`,
     /// `dfdv = ∂f_i/∂v_i`.
     #[inline]
@@ -121,6 +170,30 @@ impl Jacobian {
     pub(crate) fn apply(&self, mass: &[f64], p: &[DVec3], out: &mut [DVec3]) {
         for (((o, &m), d), &p) in out.iter_mut().zip(mass).zip(&self.diag).zip(p) {
             *o = p * m + d.mul_vec3(p);
+        }
+        // Springs sharing their first end come in runs (a mesh lists a
+        // particle's springs together): keep that end's sum in a register
+        // for the run instead of storing and reloading it every spring.
+        let (mut run, mut acc) = (usize::MAX, DVec3::ZERO);
+        for e in &self.central {
+            let (a, b) = (e.a as usize, e.b as usize);
+            if a != run {
+                if run != usize::MAX {
+                    out[run] = acc;
+                }
+                run = a;
+                acc = out[a];
+            }
+            let (pa, pb) = (p[a], p[b]);
+            acc -= e.n * (e.alpha * e.n.dot(pb)) + pb * e.beta;
+            if b == run {
+                acc -= e.n * (e.alpha * e.n.dot(pa)) + pa * e.beta;
+            } else {
+                out[b] -= e.n * (e.alpha * e.n.dot(pa)) + pa * e.beta;
+            }
+        }
+        if run != usize::MAX {
+            out[run] = acc;
         }
         for e in &self.pairs {
             let (a, b) = (e.a as usize, e.b as usize);

@@ -12,7 +12,8 @@
 //!   file each, and in typed collections so their loops are tight. Add your
 //!   own with [`World::add_force`] (see `examples/nbody/gravity.rs`).
 //! - Discrete events implement [`DiscreteEvent`]; a missed event makes the
-//!   world retake the step in shorter pieces ([`World::step`]).
+//!   world retake the step in shorter pieces ([`World::step`]). The floor's
+//!   collisions and sphere–sphere contact ([`SphereContact`]) are events.
 //! - Integrators ([`IntegratorKind`]): explicit Euler, midpoint, RK4 and
 //!   symplectic Euler, explicit; implicit Euler for stiff bodies; chosen at
 //!   run time.
@@ -43,6 +44,7 @@ pub use error::{ModelError, SimError};
 pub use event::{DiscreteEvent, EventContext, EventState};
 pub use events::floor_collision::{Collision, FloorCollision};
 pub use events::plane_constraint::PlaneConstraint;
+pub use events::sphere_contact::{Impact, SphereContact, SphereContactDef};
 pub use force::{Force, ForceContext, Stage, Targets};
 pub use force_set::Forces;
 pub use forces::{
@@ -52,6 +54,7 @@ pub use forces::{
     floor_contact::FloorContact,
     fluid::FluidMedium,
     gravity::Gravity,
+    linear_drag::LinearDrag,
     nbody::NBodyGravity,
     spring::{Spring, SpringDef, SpringId},
     torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},

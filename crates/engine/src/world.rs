@@ -362,6 +362,17 @@ impl World {
         Ok(self.forces.fluids.len() - 1)
     }
 
+    /// Adds linear drag (`−b v`) on its targets; returns its index among
+    /// the user forces, where it is kept.
+    pub fn add_linear_drag(
+        &mut self,
+        drag: crate::forces::linear_drag::LinearDrag,
+    ) -> Result<usize, ModelError> {
+        drag.validate()?;
+        self.check_targets(&drag.targets)?;
+        Ok(self.forces.add_user(Box::new(drag)))
+    }
+
     /// Adds mutual gravitation among a group of bodies.
     pub fn add_nbody(&mut self, nbody: NBodyGravity) -> Result<usize, ModelError> {
         nbody.validate()?;
@@ -408,6 +419,41 @@ impl World {
         }
         self.add_event(Box::new(collision));
         Ok(())
+    }
+
+    /// Adds sphere–sphere contact among `def.targets` (see
+    /// [`SphereContact`](crate::SphereContact)); the pairs joined by a
+    /// spring, an angle joint (any two of its three particles) or a torque
+    /// joint *now* are excluded, besides `def.excluded`; if the world has a
+    /// floor now, contacts never push its spheres into it. Returns the
+    /// event's index.
+    pub fn add_sphere_contact(
+        &mut self,
+        mut def: crate::SphereContactDef,
+    ) -> Result<usize, ModelError> {
+        self.check_targets(&def.targets)?;
+        for &(a, b) in &def.excluded {
+            self.check_ids("excluded", &[a, b])?;
+        }
+        def.excluded.extend(self.joined_pairs());
+        let mut contact = crate::SphereContact::new(def)?;
+        if let Some(floor) = self.event::<FloorCollision>() {
+            contact.on_floor(self.len(), &floor.targets);
+        }
+        Ok(self.add_event(Box::new(contact)))
+    }
+
+    /// Every pair of particles joined by a spring, an angle joint (any two of
+    /// its three) or a torque joint.
+    pub fn joined_pairs(&self) -> Vec<(ParticleId, ParticleId)> {
+        let f = &self.forces;
+        let mut pairs: Vec<(ParticleId, ParticleId)> = f.springs.iter().map(|s| s.ends()).collect();
+        for j in f.angle_joints.iter() {
+            let (a, m, b) = j.particles();
+            pairs.extend([(a, m), (m, b), (a, b)]);
+        }
+        pairs.extend(f.torque_joints.iter().map(|j| j.particles()));
+        pairs
     }
 
     /// Adds a user-defined force; it is evaluated at every trial state, in

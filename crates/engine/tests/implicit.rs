@@ -7,9 +7,12 @@
 //! - Internal forces (springs, angle joints) conserve linear momentum, to
 //!   the linear solver's tolerance.
 //! - A user force without a Jacobian still acts (explicitly).
+//! - Linear drag: `v` falls by exactly `1/(1 + h b/m)` a step (RK4: by its
+//!   stability polynomial).
 
 use animats_engine::{
-    AngleJointDef, Force, ForceContext, IntegratorKind, ParticleDef, Solver, SpringDef, World,
+    AngleJointDef, Force, ForceContext, IntegratorKind, LinearDrag, ParticleDef, Solver, SpringDef,
+    Targets, World,
 };
 use glam::DVec3;
 
@@ -209,4 +212,47 @@ fn a_user_force_without_a_jacobian_acts_explicitly() {
     let expected = 0.5 * a * t * t + 0.5 * a * t * h;
     assert!((w.position(p) - expected).length() < 1e-12);
     assert!((w.velocity(p) - a * t).length() < 1e-12);
+}
+
+#[test]
+fn linear_drag_slows_by_backward_eulers_factor_and_rk4s_polynomial() {
+    let (m, b, h) = (0.4, 2.0, 0.05);
+    let v0 = DVec3::new(3.0, -1.0, 0.5);
+    for kind in [IntegratorKind::Implicit, IntegratorKind::Rk4] {
+        let mut w = World::new();
+        w.set_integrator(kind);
+        let p = w
+            .add_particle(ParticleDef::new(m).with_velocity(v0))
+            .unwrap();
+        w.add_linear_drag(LinearDrag {
+            coefficient: b,
+            targets: Targets::All,
+        })
+        .unwrap();
+        for n in 1..=40 {
+            w.step(h).unwrap();
+            let expected = match kind {
+                // b h / m = 0.25: far past where explicit Euler oscillates.
+                IntegratorKind::Implicit => v0 / (1.0 + h * b / m).powi(n),
+                // RK4 on v' = −(b/m) v multiplies by its stability
+                // polynomial R(z) = 1 + z + z²/2 + z³/6 + z⁴/24, z = −bh/m.
+                _ => {
+                    let z = -h * b / m;
+                    v0 * (1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0).powi(n)
+                }
+            };
+            assert!(
+                (w.velocity(p) - expected).length() < 1e-14 * v0.length(),
+                "{kind}, step {n}: {} vs {expected}",
+                w.velocity(p)
+            );
+        }
+    }
+    let mut w = World::new();
+    assert!(w
+        .add_linear_drag(LinearDrag {
+            coefficient: -1.0,
+            targets: Targets::All
+        })
+        .is_err());
 }

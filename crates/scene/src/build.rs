@@ -222,6 +222,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     each(&def.bubble_column, "bubble_column", &mut cx)?;
     each(&def.rocks, "rocks", &mut cx)?;
     each(&def.quadruped, "quadruped", &mut cx)?;
+    one(&def.contacts, "contacts", &mut cx)?;
     let Builder {
         mut world,
         names,

@@ -59,6 +59,9 @@ pub struct SceneDef {
     /// `[[quadruped]]` entries: the thesis's three failed quadrupeds.
     #[serde(default)]
     pub quadruped: Vec<Spanned<QuadrupedEntry>>,
+    /// `[contacts]`: sphere–sphere contact (opt-in).
+    #[serde(default)]
+    pub contacts: Option<Spanned<ContactsEntry>>,
     /// `[[actuator]]` entries: levels in [0, 1] onto a named spring, joint or force.
     #[serde(default)]
     pub actuator: Vec<Spanned<ActuatorEntry>>,
@@ -270,6 +273,24 @@ fn default_static_speed() -> f64 {
 }
 fn default_rest_speed() -> f64 {
     0.05
+}
+
+/// `[contacts]`: the spheres collide with each other (not only with the
+/// floor); pairs joined by a spring or a joint never do.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsEntry {
+    /// The spheres that collide; default all.
+    pub particles: Option<Vec<String>>,
+    /// The restitution of every contact, in [0, 1]; default the product of
+    /// the two spheres' restitutions.
+    pub restitution: Option<f64>,
+    /// m: an overlap deeper than this = missed; default 0.01.
+    #[serde(default = "default_envelope")]
+    pub envelope: f64,
+    /// m/s: approaches slower than this do not bounce; default 0.05.
+    #[serde(default = "default_rest_speed")]
+    pub rest_speed: f64,
 }
 
 /// `[fluid]`: drag and buoyancy.

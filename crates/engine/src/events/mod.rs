@@ -2,3 +2,4 @@
 
 pub mod floor_collision;
 pub mod plane_constraint;
+pub mod sphere_contact;

@@ -7,6 +7,7 @@ pub mod current;
 pub mod floor_contact;
 pub mod fluid;
 pub mod gravity;
+pub mod linear_drag;
 pub mod nbody;
 pub mod spring;
 pub mod torque_joint;

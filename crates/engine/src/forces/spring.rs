@@ -268,13 +268,9 @@ impl Force for Springs {
             if l == 0.0 {
                 continue; // no direction: the force is zero there
             }
-            let n = d / l;
-            let nn = glam::DMat3::from_cols(n * n.x, n * n.y, n * n.z);
             let (k, c) = (t.stiffness[i], t.damping[i]);
-            let transverse = (1.0 - t.rest_length[i] / l).max(0.0);
-            let dfdx = -(nn * (k * (1.0 - transverse))
-                + glam::DMat3::from_diagonal(DVec3::splat(k * transverse)));
-            jac.pair(a, b, dfdx, nn * -c);
+            let across = k * (1.0 - t.rest_length[i] / l).max(0.0);
+            jac.central(a, b, d / l, k, across, c);
         }
         true
     }

@@ -8,6 +8,7 @@
 pub(crate) mod angle_joint;
 pub(crate) mod bubble_column;
 pub(crate) mod constant_force;
+pub(crate) mod contacts;
 pub(crate) mod floor;
 pub(crate) mod fluid;
 pub(crate) mod food;

@@ -1,0 +1,101 @@
+//! `contacts`: spheres falling into a pile (issue 12), the broad phase's
+//! cost against the number of spheres.
+
+use crate::{Check, Row, Timing};
+use animats_engine::{DVec3, FloorDef, IntegratorKind, ParticleDef, SphereContactDef, World};
+use std::time::Instant;
+
+/// `n` spheres of radius `r` (50 g, restitution 0.3, friction 0.6/0.4)
+/// dropped from a jittered cubic lattice (spacing 2.5 r) into a ring of
+/// nailed spheres of the same radius on the floor, around the lattice's
+/// footprint; sphere–sphere contact and the floor; symplectic Euler.
+pub fn pile(n: usize, r: f64) -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    let side = (n as f64).cbrt().ceil() as usize;
+    let ring = 0.5 * side as f64 * 2.5 * r + 4.0 * r;
+    let around = (std::f64::consts::TAU * ring / (2.0 * r)).floor() as usize;
+    for k in 0..around {
+        let a = std::f64::consts::TAU * k as f64 / around as f64;
+        let x = DVec3::new(ring * a.cos(), r, ring * a.sin());
+        w.add_particle(ParticleDef::new(1.0).with_radius(r).at(x).fixed())
+            .unwrap();
+    }
+    let mut s = 0x2545_f491_4f6c_dd1du64;
+    let mut jitter = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.2 * r
+    };
+    let start = -(side as f64 - 1.0) * 1.25 * r;
+    for i in 0..n {
+        let (a, b, c) = (i % side, (i / side) % side, i / (side * side));
+        let x = DVec3::new(
+            start + a as f64 * 2.5 * r + jitter(),
+            3.0 * r + c as f64 * 2.5 * r,
+            start + b as f64 * 2.5 * r + jitter(),
+        );
+        w.add_particle(
+            ParticleDef::new(0.05)
+                .with_radius(r)
+                .at(x)
+                .with_restitution(0.3)
+                .with_friction(0.6, 0.4),
+        )
+        .unwrap();
+    }
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    w
+}
+
+/// The step, s.
+pub const DT: f64 = 1e-3;
+/// Steps timed: the first half second of the fall, when the spheres land
+/// and pile up.
+pub const STEPS: usize = 500;
+
+/// 1,000 and 10,000 spheres (100 and 1,000 with `quick`): steps per second
+/// and the ratio of the times per step (goal: at most 12 for 10× the
+/// spheres).
+pub fn run(quick: bool) -> Vec<Row> {
+    let sizes = if quick { [100, 1000] } else { [1000, 10000] };
+    let mut per_step = Vec::new();
+    let mut rows = Vec::new();
+    for n in sizes {
+        let mut w = pile(n, 0.02);
+        let start = Instant::now();
+        for _ in 0..STEPS {
+            w.step(DT).expect("the pile stays finite");
+        }
+        let seconds = start.elapsed().as_secs_f64();
+        per_step.push(seconds / STEPS as f64);
+        rows.push(Row {
+            workload: "contacts".into(),
+            variant: format!("pile of {n} spheres"),
+            particles: w.len(),
+            springs: 0,
+            steps: STEPS,
+            dt: DT,
+            evaluations: 1,
+            pairs: 0,
+            engine: Timing::from_runs(vec![seconds]),
+            baseline: None,
+            checks: vec![
+                Check::info("steps per second", STEPS as f64 / seconds),
+                Check::info("backtracks", w.stats().backtracks as f64),
+            ],
+        });
+    }
+    let ratio = per_step[1] / per_step[0];
+    if let Some(last) = rows.last_mut() {
+        last.checks.push(Check::target_at_most(
+            "time per step against 10x fewer spheres",
+            ratio,
+            12.0,
+        ));
+    }
+    rows
+}

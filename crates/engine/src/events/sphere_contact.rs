@@ -1,0 +1,440 @@
+//! Sphere–sphere contact, as a discrete event (thesis §3.1.3: "new kinds of
+//! event, sphere–sphere collisions for instance, plug in without changing
+//! the integrator").
+//!
+//! After a trial step, two spheres that overlap are `Occurring`; an overlap
+//! deeper than `envelope` was `Missed` (they met somewhere inside the step,
+//! and it is retaken in shorter pieces). Handling takes the contacts one
+//! after another, in a fixed order (by cell of the grid, then by sphere),
+//! in up to [`PASSES`] passes:
+//! - the overlap is removed by moving the two apart along the line of
+//!   centres, in inverse proportion to their masses (the centre of mass
+//!   stays put);
+//! - if they approach, the normal relative velocity `u_n` is reversed and
+//!   scaled by the restitution `e` (the product of the two spheres', unless
+//!   the contact says otherwise; 0 below `rest_speed`, so that resting
+//!   spheres settle as on the floor) by an impulse `J = −(1 + e) u_n /
+//!   (1/m_a + 1/m_b)`: momentum is exchanged exactly, and the relative
+//!   kinetic energy along the normal keeps the factor `e²`;
+//! - Coulomb friction: a tangential impulse opposes the sliding, stopping it
+//!   if that takes at most `μ_s J` (static), else `μ_k J` (kinetic), with
+//!   each coefficient the geometric mean of the two spheres' (as Box2D mixes
+//!   them).
+//!
+//! A chain of touching spheres (Newton's cradle) passes an impulse along in
+//! one handling, since each contact is recomputed after the ones before it.
+//!
+//! Broad phase: a uniform grid of cells twice the largest radius, rebuilt at
+//! every check (sorting the spheres by cell, a hash map from cell to its
+//! run), so that each sphere is tested only against the spheres of its 27
+//! neighbouring cells: the cost grows with the number of spheres, not its
+//! square. Pairs given as excluded (the scene excludes the pairs joined by a
+//! spring or a joint) never collide.
+
+use crate::error::ModelError;
+use crate::event::{DiscreteEvent, EventContext, EventState};
+use crate::force::Targets;
+use crate::particle::{non_negative, ParticleId, Properties};
+use glam::DVec3;
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// The settings of sphere–sphere contact.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SphereContactDef {
+    /// Overlap beyond which a contact counts as missed, m.
+    pub envelope: f64,
+    /// Approaches slower than this do not bounce, m/s.
+    pub rest_speed: f64,
+    /// The restitution of every contact; `None`: the product of the two
+    /// spheres' restitutions.
+    pub restitution: Option<f64>,
+    /// The spheres that collide with each other.
+    pub targets: Targets,
+    /// Pairs that never collide.
+    pub excluded: Vec<(ParticleId, ParticleId)>,
+}
+
+impl Default for SphereContactDef {
+    fn default() -> Self {
+        SphereContactDef {
+            envelope: 0.01,
+            rest_speed: 0.05,
+            restitution: None,
+            targets: Targets::All,
+            excluded: Vec::new(),
+        }
+    }
+}
+
+/// One contact found by the last check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Pair {
+    a: u32,
+    b: u32,
+}
+
+/// One impact (an approach at `rest_speed` or faster) handled during the
+/// last step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Impact {
+    /// The two spheres.
+    pub spheres: (ParticleId, ParticleId),
+    /// When, s.
+    pub t: f64,
+    /// Their approach speed along the line of centres, m/s.
+    pub speed: f64,
+}
+
+/// A cheap, deterministic hasher for cell keys.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl Hasher for CellHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0 ^ b as u64).wrapping_mul(0x100_0000_01b3);
+        }
+    }
+    fn write_u64(&mut self, k: u64) {
+        // MurmurHash3's finaliser: every bit of the packed coordinates
+        // reaches both the low bits (the bucket) and the high bits (the
+        // table's tag), so neighbouring cells do not cluster.
+        let mut k = k;
+        k ^= k >> 33;
+        k = k.wrapping_mul(0xff51_afd7_ed55_8ccd);
+        k ^= k >> 33;
+        k = k.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        self.0 = k ^ (k >> 33);
+    }
+}
+
+/// Passes over the contacts in one handling: each pass moves apart what the
+/// one before left overlapping (a stack shares its corrections down to the
+/// floor), so overlaps shrink geometrically.
+pub const PASSES: usize = 8;
+
+/// A pass that corrected no overlap deeper than this (m) ends the handling:
+/// what is left is far below anything visible or any envelope.
+const SETTLED: f64 = 1e-6;
+
+/// How close to the floor a sphere counts as resting on it, m.
+const FLOOR_TOLERANCE: f64 = 1e-6;
+
+/// The event.
+#[derive(Clone, Debug)]
+pub struct SphereContact {
+    def: SphereContactDef,
+    /// The spheres the floor (y = 0) holds up, if there is one: contacts
+    /// never push them into it.
+    floor: Option<Vec<bool>>,
+    /// Excluded pairs as sorted keys `(min << 32) | max`.
+    excluded: Vec<u64>,
+    pairs: Vec<Pair>,
+    /// (cell key, sphere), sorted.
+    cells: Vec<(u64, u32)>,
+    /// Cell key → its run in `cells`.
+    runs: HashMap<u64, (u32, u32), BuildHasherDefault<CellHasher>>,
+    impacts: Vec<Impact>,
+}
+
+/// 21 bits per coordinate, offset so that cells from −2²⁰ to 2²⁰ pack.
+fn cell_key(c: [i64; 3]) -> u64 {
+    const OFF: i64 = 1 << 20;
+    let f = |x: i64| ((x + OFF).clamp(0, (1 << 21) - 1)) as u64;
+    (f(c[0]) << 42) | (f(c[1]) << 21) | f(c[2])
+}
+
+fn pair_key(a: u32, b: u32) -> u64 {
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    ((lo as u64) << 32) | hi as u64
+}
+
+impl SphereContact {
+    /// Sphere–sphere contact with the given settings.
+    pub fn new(def: SphereContactDef) -> Result<Self, ModelError> {
+        if def.envelope.is_nan() || def.envelope < 0.0 {
+            return Err(ModelError::new(
+                "envelope",
+                format!("must be >= 0, got {}", def.envelope),
+            ));
+        }
+        non_negative("rest_speed", def.rest_speed)?;
+        if let Some(e) = def.restitution {
+            non_negative("restitution", e)?;
+            if e > 1.0 {
+                return Err(ModelError::new(
+                    "restitution",
+                    format!("must be in [0, 1], got {e}"),
+                ));
+            }
+        }
+        let mut excluded: Vec<u64> = def
+            .excluded
+            .iter()
+            .map(|(a, b)| pair_key(a.0, b.0))
+            .collect();
+        excluded.sort_unstable();
+        excluded.dedup();
+        Ok(SphereContact {
+            def,
+            floor: None,
+            excluded,
+            pairs: Vec::new(),
+            cells: Vec::new(),
+            runs: HashMap::default(),
+            impacts: Vec::new(),
+        })
+    }
+
+    /// Makes the contacts respect the floor y = 0 for the `n` particles'
+    /// `targets`: a sphere that a contact would push below it stays on it,
+    /// and its velocity into it is removed (the floor holds up what rests
+    /// on a sphere resting on it).
+    pub fn on_floor(&mut self, n: usize, targets: &Targets) {
+        let mut held = vec![false; n];
+        targets.for_each(n, |i| held[i] = true);
+        self.floor = Some(held);
+    }
+
+    /// The settings.
+    pub fn def(&self) -> &SphereContactDef {
+        &self.def
+    }
+
+    /// The impacts of the last step (approaches at `rest_speed` or faster;
+    /// resting contacts are not listed).
+    pub fn impacts(&self) -> &[Impact] {
+        &self.impacts
+    }
+
+    /// The deepest overlap among the targets at `pos`, m (0 if none): for
+    /// tests and diagnostics; the same broad phase as a check.
+    pub fn deepest_overlap(&mut self, pos: &[DVec3], particles: &Properties) -> f64 {
+        self.find(pos, particles)
+    }
+
+    /// Fills `pairs` with the overlapping pairs at `pos`; returns the
+    /// deepest overlap.
+    fn find(&mut self, pos: &[DVec3], p: &Properties) -> f64 {
+        self.pairs.clear();
+        self.cells.clear();
+        self.runs.clear();
+        let n = pos.len();
+        let mut largest = 0.0f64;
+        self.def.targets.for_each(n, |i| {
+            if p.radius[i] > 0.0 {
+                largest = largest.max(p.radius[i]);
+            }
+        });
+        if largest <= 0.0 {
+            return 0.0;
+        }
+        let size = 2.0 * largest;
+        let cell = |x: DVec3| {
+            let c = (x / size).floor();
+            [c.x as i64, c.y as i64, c.z as i64]
+        };
+        let cells = &mut self.cells;
+        self.def.targets.for_each(n, |i| {
+            if p.radius[i] > 0.0 && pos[i].is_finite() {
+                cells.push((cell_key(cell(pos[i])), i as u32));
+            }
+        });
+        cells.sort_unstable();
+        let mut start = 0;
+        while start < cells.len() {
+            let key = cells[start].0;
+            let mut end = start + 1;
+            while end < cells.len() && cells[end].0 == key {
+                end += 1;
+            }
+            self.runs.insert(key, (start as u32, end as u32));
+            start = end;
+        }
+        // Each cell against itself and its 13 neighbours in the forward
+        // half of the 3×3×3 block: every pair of neighbouring cells once.
+        const FORWARD: [[i64; 3]; 14] = [
+            [0, 0, 0],
+            [0, 0, 1],
+            [0, 1, -1],
+            [0, 1, 0],
+            [0, 1, 1],
+            [1, -1, -1],
+            [1, -1, 0],
+            [1, -1, 1],
+            [1, 0, -1],
+            [1, 0, 0],
+            [1, 0, 1],
+            [1, 1, -1],
+            [1, 1, 0],
+            [1, 1, 1],
+        ];
+        let mut deepest = 0.0f64;
+        let (cells, runs, pairs, excluded) =
+            (&self.cells, &self.runs, &mut self.pairs, &self.excluded);
+        let mut test = |a: u32, b: u32| {
+            let (ai, bi) = (a as usize, b as usize);
+            if p.inv_mass[ai] == 0.0 && p.inv_mass[bi] == 0.0 {
+                return;
+            }
+            let reach = p.radius[ai] + p.radius[bi];
+            let d2 = (pos[bi] - pos[ai]).length_squared();
+            if d2 >= reach * reach {
+                return;
+            }
+            if !excluded.is_empty() && excluded.binary_search(&pair_key(a, b)).is_ok() {
+                return;
+            }
+            deepest = deepest.max(reach - d2.sqrt());
+            let (a, b) = if a < b { (a, b) } else { (b, a) };
+            pairs.push(Pair { a, b });
+        };
+        let mut start = 0;
+        while start < cells.len() {
+            let (key, first) = cells[start];
+            let end = runs.get(&key).map_or(start + 1, |r| r.1 as usize);
+            let here = &cells[start..end];
+            let c = cell(pos[first as usize]);
+            for (k, off) in FORWARD.iter().enumerate() {
+                if k == 0 {
+                    for (x, &(_, a)) in here.iter().enumerate() {
+                        for &(_, b) in &here[x + 1..] {
+                            test(a, b);
+                        }
+                    }
+                    continue;
+                }
+                let other = cell_key([c[0] + off[0], c[1] + off[1], c[2] + off[2]]);
+                let Some(&(s, e)) = runs.get(&other) else {
+                    continue;
+                };
+                for &(_, a) in here {
+                    for &(_, b) in &cells[s as usize..e as usize] {
+                        test(a, b);
+                    }
+                }
+            }
+            start = end;
+        }
+        deepest
+    }
+}
+
+impl DiscreteEvent for SphereContact {
+    fn check(&mut self, ctx: &EventContext) -> EventState {
+        let deepest = self.find(ctx.pos, ctx.particles);
+        if self.pairs.is_empty() {
+            EventState::None
+        } else if deepest > self.def.envelope {
+            EventState::Missed
+        } else {
+            EventState::Occurring
+        }
+    }
+
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        let held = |i: usize| {
+            self.floor
+                .as_ref()
+                .is_some_and(|f| f.get(i).copied().unwrap_or(false))
+        };
+        for pass in 0..PASSES {
+            let mut largest = 0.0f64;
+            for q in &self.pairs {
+                let (a, b) = (q.a as usize, q.b as usize);
+                let d = pos[b] - pos[a];
+                let dist = d.length();
+                let overlap = p.radius[a] + p.radius[b] - dist;
+                if overlap <= 0.0 || dist == 0.0 {
+                    continue; // parted by an earlier contact, or no direction
+                }
+                let n = d / dist;
+                // A sphere resting on the floor, pushed down into it, is
+                // held by the floor: immovable for this contact.
+                let on_floor = |i: usize| held(i) && pos[i].y <= p.radius[i] + FLOOR_TOLERANCE;
+                let wa = if n.y > 0.0 && on_floor(a) {
+                    0.0
+                } else {
+                    p.inv_mass[a]
+                };
+                let wb = if n.y < 0.0 && on_floor(b) {
+                    0.0
+                } else {
+                    p.inv_mass[b]
+                };
+                let w = wa + wb;
+                if w == 0.0 {
+                    continue;
+                }
+                largest = largest.max(overlap);
+                pos[a] -= n * (overlap * wa / w);
+                pos[b] += n * (overlap * wb / w);
+                let u = vel[b] - vel[a];
+                let un = u.dot(n);
+                if un < 0.0 {
+                    let e = if -un < self.def.rest_speed {
+                        0.0
+                    } else {
+                        self.def
+                            .restitution
+                            .unwrap_or(p.restitution[a] * p.restitution[b])
+                    };
+                    let jn = -(1.0 + e) * un / w;
+                    let mut impulse = n * jn;
+                    let ut = u - n * un;
+                    let slide = ut.length();
+                    if slide > 0.0 {
+                        // The impulse that would stop the sliding, against
+                        // what friction can give.
+                        let stop = slide / w;
+                        let mu_s = (p.mu_s[a] * p.mu_s[b]).sqrt();
+                        let mu_k = (p.mu_k[a] * p.mu_k[b]).sqrt();
+                        let jt = if stop <= mu_s * jn { stop } else { mu_k * jn };
+                        impulse -= ut * (jt / slide);
+                    }
+                    vel[a] -= impulse * wa;
+                    vel[b] += impulse * wb;
+                    if pass == 0 && -un >= self.def.rest_speed {
+                        self.impacts.push(Impact {
+                            spheres: (ParticleId(q.a), ParticleId(q.b)),
+                            t,
+                            speed: -un,
+                        });
+                    }
+                }
+                for i in [a, b] {
+                    if held(i) && pos[i].y < p.radius[i] && p.inv_mass[i] != 0.0 {
+                        pos[i].y = p.radius[i];
+                        vel[i].y = vel[i].y.max(0.0);
+                    }
+                }
+            }
+            if largest <= SETTLED {
+                break;
+            }
+        }
+    }
+
+    fn begin_step(&mut self) {
+        self.impacts.clear();
+    }
+
+    fn is_passive(&self) -> bool {
+        // Impulses with e ≤ 1 and friction never add kinetic energy; moving
+        // the spheres apart can, against a force, by at most the work over
+        // the overlap (bounded by the envelope).
+        true
+    }
+
+    fn name(&self) -> &str {
+        "sphere contact"
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}

@@ -1,0 +1,237 @@
+//! Sphere–sphere contact against the physics of impacts.
+//!
+//! - A head-on collision of unequal masses conserves momentum exactly and
+//!   keeps e² of the relative kinetic energy (the relative velocity is
+//!   reversed and scaled by e).
+//! - A glancing collision conserves momentum in both directions; without
+//!   friction the tangential relative velocity is untouched.
+//! - Newton's cradle of 5 balls with e = 1 passes the impulse to the last.
+//! - A sphere thrown at a nailed one with v·h just under the radius bounces
+//!   back instead of tunnelling (the missed overlap is backtracked).
+//! - Joined pairs never collide.
+//! - A sphere dropped on one resting on the floor comes to rest on it, with
+//!   the pair's overlap under a micrometre.
+//!
+//! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
+
+use animats_engine::{
+    FloorDef, IntegratorKind, ParticleDef, SphereContact, SphereContactDef, SpringDef, World,
+};
+use glam::DVec3;
+
+fn ball(m: f64, r: f64, x: DVec3, v: DVec3) -> ParticleDef {
+    ParticleDef::new(m).with_radius(r).at(x).with_velocity(v)
+}
+
+#[test]
+fn head_on_unequal_masses_conserve_momentum_and_keep_e_squared() {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    let a = w
+        .add_particle(ball(2.0, 0.1, DVec3::ZERO, DVec3::X).with_restitution(0.8))
+        .unwrap();
+    let b = w
+        .add_particle(
+            ball(0.5, 0.1, DVec3::new(0.5, 0.0, 0.0), -2.0 * DVec3::X).with_restitution(0.5),
+        )
+        .unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    let p0 = w.momentum();
+    let u0 = w.velocity(b) - w.velocity(a);
+    let mut hits = 0;
+    for _ in 0..300 {
+        w.step(1e-3).unwrap();
+        hits += w.event::<SphereContact>().unwrap().impacts().len();
+    }
+    assert_eq!(hits, 1);
+    let p1 = w.momentum();
+    assert!((p1 - p0).length() < 1e-14, "momentum {p0} -> {p1}");
+    // e = 0.8 × 0.5: the relative velocity reverses, scaled by 0.4, so the
+    // relative kinetic energy ½ μ u² keeps 0.16 of itself.
+    let u1 = w.velocity(b) - w.velocity(a);
+    assert!((u1 - (-0.4 * u0)).length() < 1e-14, "u {u0} -> {u1}");
+    let ratio = u1.length_squared() / u0.length_squared();
+    assert!(
+        (ratio - 0.16).abs() < 1e-14,
+        "kept {ratio} of the relative energy"
+    );
+}
+
+fn glancing(mu: f64) -> (World, DVec3, DVec3) {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Rk4);
+    w.add_particle(
+        ball(1.5, 0.1, DVec3::ZERO, DVec3::new(2.0, 0.0, 0.3))
+            .with_friction(mu, mu)
+            .with_restitution(0.9),
+    )
+    .unwrap();
+    w.add_particle(
+        ball(
+            0.7,
+            0.1,
+            DVec3::new(0.6, 0.12, 0.0),
+            DVec3::new(-1.0, 0.2, 0.0),
+        )
+        .with_friction(mu, mu)
+        .with_restitution(0.9),
+    )
+    .unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    let p0 = w.momentum();
+    let u0 = w.state().vel[1] - w.state().vel[0];
+    (w, p0, u0)
+}
+
+#[test]
+fn a_glancing_collision_conserves_momentum_in_both_directions() {
+    for mu in [0.0, 0.6] {
+        let (mut w, p0, u0) = glancing(mu);
+        let mut normal = None;
+        for _ in 0..400 {
+            w.step(1e-3).unwrap();
+            if normal.is_none() && !w.event::<SphereContact>().unwrap().impacts().is_empty() {
+                let s = w.state();
+                normal = Some((s.pos[1] - s.pos[0]).normalize());
+            }
+        }
+        let n = normal.expect("they collided");
+        let p1 = w.momentum();
+        assert!((p1 - p0).length() < 1e-14, "μ {mu}: momentum {p0} -> {p1}");
+        let u1 = w.state().vel[1] - w.state().vel[0];
+        // Along the normal: reversed and scaled by e = 0.81.
+        assert!((u1.dot(n) + 0.81 * u0.dot(n)).abs() < 1e-12, "μ {mu}");
+        let (t0, t1) = (u0 - n * u0.dot(n), u1 - n * u1.dot(n));
+        if mu == 0.0 {
+            assert!((t1 - t0).length() < 1e-12, "frictionless: {t0} -> {t1}");
+        } else {
+            // Friction slows the sliding, never reverses it.
+            assert!(
+                t1.length() < t0.length() && t1.dot(t0) >= 0.0,
+                "{t0} -> {t1}"
+            );
+        }
+    }
+}
+
+#[test]
+fn newtons_cradle_passes_the_impulse_to_the_last_ball() {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    let r = 0.05;
+    let mut balls = vec![w
+        .add_particle(ball(1.0, r, DVec3::new(-0.3, 0.0, 0.0), DVec3::X).with_restitution(1.0))
+        .unwrap()];
+    for k in 1..5 {
+        // Hanging in a row, 0.1 mm apart.
+        let x = DVec3::new(k as f64 * (2.0 * r + 1e-4), 0.0, 0.0);
+        balls.push(
+            w.add_particle(ball(1.0, r, x, DVec3::ZERO).with_restitution(1.0))
+                .unwrap(),
+        );
+    }
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    for _ in 0..500 {
+        w.step(1e-3).unwrap();
+    }
+    for (k, &b) in balls.iter().enumerate() {
+        let v = w.velocity(b);
+        let expected = if k == 4 { DVec3::X } else { DVec3::ZERO };
+        assert!((v - expected).length() < 1e-12, "ball {k}: {v}");
+    }
+}
+
+#[test]
+fn no_tunnelling_when_a_step_moves_less_than_the_radius() {
+    let r = 0.05;
+    for fraction in [0.5, 0.9, 0.99] {
+        let h = 1e-3;
+        let v = fraction * r / h;
+        let mut w = World::new();
+        w.set_integrator(IntegratorKind::Symplectic);
+        w.add_particle(ParticleDef::new(1.0).with_radius(r).fixed())
+            .unwrap();
+        let b = w
+            .add_particle(
+                ball(1.0, r, DVec3::new(-0.5, 0.0, 0.0), DVec3::new(v, 0.0, 0.0))
+                    .with_restitution(1.0),
+            )
+            .unwrap();
+        w.add_sphere_contact(SphereContactDef {
+            restitution: Some(1.0),
+            ..SphereContactDef::default()
+        })
+        .unwrap();
+        for _ in 0..(1.0 / v / h) as usize + 10 {
+            w.step(h).unwrap();
+            assert!(
+                w.position(b).x <= -2.0 * r + 0.01 + 1e-12,
+                "v h = {fraction} r: it got through"
+            );
+        }
+        assert!(
+            (w.velocity(b).x + v).abs() < 1e-9 * v,
+            "v h = {fraction} r: {}",
+            w.velocity(b)
+        );
+    }
+}
+
+#[test]
+fn joined_pairs_never_collide() {
+    let mut w = World::new();
+    let a = w
+        .add_particle(ball(1.0, 0.1, DVec3::ZERO, DVec3::ZERO))
+        .unwrap();
+    let b = w
+        .add_particle(ball(1.0, 0.1, DVec3::new(0.15, 0.0, 0.0), DVec3::ZERO))
+        .unwrap();
+    w.add_spring(SpringDef::new(a, b, 10.0, 0.0)).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    for _ in 0..10 {
+        w.step(1e-3).unwrap();
+        assert!(w.event::<SphereContact>().unwrap().impacts().is_empty());
+    }
+    assert_eq!(w.position(b), DVec3::new(0.15, 0.0, 0.0));
+}
+
+#[test]
+fn a_sphere_dropped_on_another_comes_to_rest_on_it() {
+    let r = 0.02;
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    let low = w
+        .add_particle(
+            ParticleDef::new(0.05)
+                .with_radius(r)
+                .at(DVec3::new(0.0, r, 0.0)),
+        )
+        .unwrap();
+    let high = w
+        .add_particle(
+            ParticleDef::new(0.05)
+                .with_radius(r)
+                .at(DVec3::new(0.0, 0.2, 0.0))
+                .with_restitution(0.5),
+        )
+        .unwrap();
+    // The floor first: the contacts then know to leave it holding `low`.
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    let mut bounces = 0;
+    for _ in 0..3000 {
+        w.step(1e-3).unwrap();
+        bounces += w.event::<SphereContact>().unwrap().impacts().len();
+    }
+    let gap = (w.position(high) - w.position(low)).length() - 2.0 * r;
+    println!(
+        "{bounces} impacts, gap {gap:e} m, speeds {} {}",
+        w.velocity(low),
+        w.velocity(high)
+    );
+    assert!(bounces > 1, "it bounced (e = 0.25 at the first impact)");
+    assert!(gap.abs() < 1e-6, "gap {gap}");
+    assert!(w.velocity(high).length() < 1e-9 && w.velocity(low).length() < 1e-9);
+    assert!((w.position(low).y - r).abs() < 1e-9);
+}

@@ -1,0 +1,86 @@
+//! `[contacts]`: spheres collide with each other (the two free ones here);
+//! the pair joined by a spring does not; a bad restitution is refused with
+//! the field named; and an implicit world takes `implicit_tolerance`.
+
+use animats_engine::{IntegratorKind, SphereContact};
+
+const SCENE: &str = r#"
+[world]
+gravity = [0, 0, 0]
+integrator = "implicit"
+implicit_tolerance = 1e-6
+
+[[particle]]
+name = "a"
+mass = 1.0
+radius = 0.1
+position = [0, 1, 0]
+velocity = [1, 0, 0]
+
+[[particle]]
+name = "b"
+mass = 1.0
+radius = 0.1
+position = [0.5, 1, 0]
+
+[[particle]]
+name = "c"
+mass = 1.0
+radius = 0.1
+position = [0.5, 1.15, 0]
+
+[[spring]]
+a = "b"
+b = "c"
+stiffness = 10.0
+
+[contacts]
+restitution = 1.0
+"#;
+
+#[test]
+fn spheres_collide_and_joined_ones_do_not() {
+    let mut s = animats_scene::parse(SCENE, "contacts.toml").unwrap();
+    assert_eq!(s.world.integrator(), IntegratorKind::Implicit);
+    assert_eq!(s.world.solver().tolerance, 1e-6);
+    // b and c overlap (0.15 < 0.2) but are joined: no contact between
+    // them, ever; a reaches b after 0.3 s and hands it its velocity.
+    let mut hits = Vec::new();
+    for _ in 0..500 {
+        s.step(1e-3).unwrap();
+        let c = s.world.event::<SphereContact>().unwrap();
+        hits.extend(
+            c.impacts()
+                .iter()
+                .map(|i| (i.spheres.0.index(), i.spheres.1.index())),
+        );
+    }
+    assert_eq!(hits, vec![(0, 1)]);
+    assert!(
+        s.world
+            .velocity(s.world.particle_ids().next().unwrap())
+            .x
+            .abs()
+            < 1e-9
+    );
+}
+
+#[test]
+fn a_restitution_above_one_is_refused_naming_the_field() {
+    let bad = SCENE.replace("restitution = 1.0", "restitution = 1.5");
+    let e = error(&bad);
+    assert!(
+        e.contains("bad.toml") && e.contains("restitution") && e.contains("[0, 1]"),
+        "{e}"
+    );
+    let bad = SCENE.replace("implicit_tolerance = 1e-6", "implicit_tolerance = 2.0");
+    let e = error(&bad);
+    assert!(e.contains("implicit_tolerance"), "{e}");
+}
+
+fn error(text: &str) -> String {
+    match animats_scene::parse(text, "bad.toml") {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    }
+}
