@@ -66,6 +66,15 @@ pub fn run(quick: bool) -> Vec<Row> {
     let mut rows = Vec::new();
     for n in sizes {
         let mut w = pile(n, 0.02);
+        // Outside the timing: how many pairs touch, on average.
+        let mut probe = w.clone();
+        let mut touching = 0usize;
+        for _ in 0..STEPS {
+            probe.step(DT).expect("the pile stays finite");
+            touching += probe
+                .event::<animats_engine::SphereContact>()
+                .map_or(0, |c| c.touching());
+        }
         let start = Instant::now();
         for _ in 0..STEPS {
             w.step(DT).expect("the pile stays finite");
@@ -85,6 +94,10 @@ pub fn run(quick: bool) -> Vec<Row> {
             baseline: None,
             checks: vec![
                 Check::info("steps per second", STEPS as f64 / seconds),
+                Check::info(
+                    "touching pairs per sphere, mean over the steps",
+                    touching as f64 / (STEPS * n) as f64,
+                ),
                 Check::info("backtracks", w.stats().backtracks as f64),
             ],
         });

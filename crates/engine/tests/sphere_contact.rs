@@ -235,3 +235,31 @@ fn a_sphere_dropped_on_another_comes_to_rest_on_it() {
     assert!(w.velocity(high).length() < 1e-9 && w.velocity(low).length() < 1e-9);
     assert!((w.position(low).y - r).abs() < 1e-9);
 }
+
+#[test]
+fn spheres_far_beyond_the_grid_neither_panic_nor_hide_a_collision() {
+    // Spheres 1e200 m away make the grid sparse (a hash map of occupied
+    // cells instead of a dense array): the two near the origin still meet,
+    // once, and the far ones never.
+    let mut w = World::new();
+    w.add_particle(ball(1.0, 0.1, DVec3::ZERO, DVec3::X))
+        .unwrap();
+    w.add_particle(ball(1.0, 0.1, DVec3::new(0.25, 0.0, 0.0), DVec3::ZERO))
+        .unwrap();
+    for x in [1e200, -1e200, 1e200 + 1e190] {
+        w.add_particle(ball(1.0, 0.1, DVec3::new(x, 0.0, 0.0), DVec3::ZERO))
+            .unwrap();
+    }
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    let mut impacts = Vec::new();
+    for _ in 0..200 {
+        w.step(1e-3).unwrap();
+        let c = w.event::<SphereContact>().unwrap();
+        impacts.extend(
+            c.impacts()
+                .iter()
+                .map(|i| (i.spheres.0.index(), i.spheres.1.index())),
+        );
+    }
+    assert_eq!(impacts, vec![(0, 1)]);
+}

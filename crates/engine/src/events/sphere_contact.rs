@@ -25,10 +25,12 @@
 //! one handling, since each contact is recomputed after the ones before it.
 //!
 //! Broad phase: a uniform grid of cells twice the largest radius, rebuilt at
-//! every check (sorting the spheres by cell, a hash map from cell to its
-//! run), so that each sphere is tested only against the spheres of its 27
-//! neighbouring cells: the cost grows with the number of spheres, not its
-//! square. Pairs given as excluded (the scene excludes the pairs joined by a
+//! every check, so that each sphere is tested only against the spheres of
+//! its 27 neighbouring cells (each cell against itself and 13 neighbours):
+//! the cost grows with the number of spheres, not its square. When the
+//! spheres fill their bounding box the grid is a dense array filled by a
+//! counting sort; when they are spread far apart, a hash map of the
+//! occupied cells. Pairs given as excluded (the scene excludes the pairs joined by a
 //! spring or a joint) never collide.
 
 use crate::error::ModelError;
@@ -136,6 +138,12 @@ pub struct SphereContact {
     pairs: Vec<Pair>,
     /// (cell key, sphere), sorted.
     cells: Vec<(u64, u32)>,
+    /// The same, while counting-sorting.
+    sorted: Vec<(u64, u32)>,
+    /// Dense grid: where each cell's run starts in `cells` (and one more).
+    starts: Vec<u32>,
+    /// The next free place of each cell's run, while counting-sorting.
+    next: Vec<u32>,
     /// Cell key → its run in `cells`.
     runs: HashMap<u64, (u32, u32), BuildHasherDefault<CellHasher>>,
     impacts: Vec<Impact>,
@@ -185,6 +193,9 @@ impl SphereContact {
             excluded,
             pairs: Vec::new(),
             cells: Vec::new(),
+            sorted: Vec::new(),
+            starts: Vec::new(),
+            next: Vec::new(),
             runs: HashMap::default(),
             impacts: Vec::new(),
         })
@@ -203,6 +214,11 @@ impl SphereContact {
     /// The settings.
     pub fn def(&self) -> &SphereContactDef {
         &self.def
+    }
+
+    /// How many pairs overlapped at the last check (resting contacts too).
+    pub fn touching(&self) -> usize {
+        self.pairs.len()
     }
 
     /// The impacts of the last step (approaches at `rest_speed` or faster;
@@ -234,27 +250,96 @@ impl SphereContact {
             return 0.0;
         }
         let size = 2.0 * largest;
+        // Clamped far beyond the packed range, so that a neighbour's
+        // coordinate (±1) never overflows, wherever a sphere has flown.
         let cell = |x: DVec3| {
-            let c = (x / size).floor();
+            let c = (x / size)
+                .floor()
+                .clamp(DVec3::splat(-1e12), DVec3::splat(1e12));
             [c.x as i64, c.y as i64, c.z as i64]
         };
+        // Where the spheres are: the bounds of their cells.
+        let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+        let mut count = 0usize;
+        self.def.targets.for_each(n, |i| {
+            if p.radius[i] > 0.0 && pos[i].is_finite() {
+                let c = cell(pos[i]);
+                for k in 0..3 {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+                count += 1;
+            }
+        });
+        if count == 0 {
+            return 0.0;
+        }
+        let dims = [0, 1, 2].map(|k| (hi[k] - lo[k] + 1) as f64);
+        let total = dims[0] * dims[1] * dims[2];
+        // A dense grid (an array of cell starts, filled by counting) when
+        // the spheres fill their box; a hash map of occupied cells when
+        // they are spread far apart.
+        let dense = total <= (4 * count + 4096) as f64;
+        let [_, ny, nz] = dims.map(|d| d as i64);
+        let linear =
+            |c: [i64; 3]| (((c[0] - lo[0]) * ny + (c[1] - lo[1])) * nz + (c[2] - lo[2])) as u64;
+        let key = |c: [i64; 3]| if dense { linear(c) } else { cell_key(c) };
         let cells = &mut self.cells;
         self.def.targets.for_each(n, |i| {
             if p.radius[i] > 0.0 && pos[i].is_finite() {
-                cells.push((cell_key(cell(pos[i])), i as u32));
+                cells.push((key(cell(pos[i])), i as u32));
             }
         });
-        cells.sort_unstable();
-        let mut start = 0;
-        while start < cells.len() {
-            let key = cells[start].0;
-            let mut end = start + 1;
-            while end < cells.len() && cells[end].0 == key {
-                end += 1;
+        if dense {
+            // Counting sort: by cell, and by sphere within a cell.
+            let starts = &mut self.starts;
+            starts.clear();
+            starts.resize(total as usize + 1, 0);
+            for &(k, _) in cells.iter() {
+                starts[k as usize + 1] += 1;
             }
-            self.runs.insert(key, (start as u32, end as u32));
-            start = end;
+            for k in 1..starts.len() {
+                starts[k] += starts[k - 1];
+            }
+            let next = &mut self.next;
+            next.clear();
+            next.extend_from_slice(starts);
+            self.sorted.clear();
+            self.sorted.resize(cells.len(), (0, 0));
+            for &(k, i) in cells.iter() {
+                let at = &mut next[k as usize];
+                self.sorted[*at as usize] = (k, i);
+                *at += 1;
+            }
+            std::mem::swap(cells, &mut self.sorted);
+        } else {
+            cells.sort_unstable();
+            let mut start = 0;
+            while start < cells.len() {
+                let key = cells[start].0;
+                let mut end = start + 1;
+                while end < cells.len() && cells[end].0 == key {
+                    end += 1;
+                }
+                self.runs.insert(key, (start as u32, end as u32));
+                start = end;
+            }
         }
+        let (starts, runs) = (&self.starts, &self.runs);
+        // The spheres of cell `c`, as a range of `cells`.
+        let run_of = |c: [i64; 3]| -> Option<(usize, usize)> {
+            if dense {
+                if (0..3).any(|k| c[k] < lo[k] || c[k] > hi[k]) {
+                    return None;
+                }
+                let k = linear(c) as usize;
+                let (s, e) = (starts[k] as usize, starts[k + 1] as usize);
+                (e > s).then_some((s, e))
+            } else {
+                runs.get(&cell_key(c))
+                    .map(|&(s, e)| (s as usize, e as usize))
+            }
+        };
         // Each cell against itself and its 13 neighbours in the forward
         // half of the 3×3×3 block: every pair of neighbouring cells once.
         const FORWARD: [[i64; 3]; 14] = [
@@ -274,8 +359,7 @@ impl SphereContact {
             [1, 1, 1],
         ];
         let mut deepest = 0.0f64;
-        let (cells, runs, pairs, excluded) =
-            (&self.cells, &self.runs, &mut self.pairs, &self.excluded);
+        let (cells, pairs, excluded) = (&self.cells, &mut self.pairs, &self.excluded);
         let mut test = |a: u32, b: u32| {
             let (ai, bi) = (a as usize, b as usize);
             if p.inv_mass[ai] == 0.0 && p.inv_mass[bi] == 0.0 {
@@ -295,10 +379,10 @@ impl SphereContact {
         };
         let mut start = 0;
         while start < cells.len() {
-            let (key, first) = cells[start];
-            let end = runs.get(&key).map_or(start + 1, |r| r.1 as usize);
-            let here = &cells[start..end];
+            let (_, first) = cells[start];
             let c = cell(pos[first as usize]);
+            let end = run_of(c).map_or(start + 1, |r| r.1);
+            let here = &cells[start..end];
             for (k, off) in FORWARD.iter().enumerate() {
                 if k == 0 {
                     for (x, &(_, a)) in here.iter().enumerate() {
@@ -308,12 +392,11 @@ impl SphereContact {
                     }
                     continue;
                 }
-                let other = cell_key([c[0] + off[0], c[1] + off[1], c[2] + off[2]]);
-                let Some(&(s, e)) = runs.get(&other) else {
+                let Some((s, e)) = run_of([c[0] + off[0], c[1] + off[1], c[2] + off[2]]) else {
                     continue;
                 };
                 for &(_, a) in here {
-                    for &(_, b) in &cells[s as usize..e as usize] {
+                    for &(_, b) in &cells[s..e] {
                         test(a, b);
                     }
                 }
