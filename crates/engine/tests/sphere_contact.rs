@@ -10,7 +10,9 @@
 //!   back instead of tunnelling (the missed overlap is backtracked).
 //! - Joined pairs never collide.
 //! - A sphere dropped on one resting on the floor comes to rest on it, with
-//!   the pair's overlap under a micrometre.
+//!   the pair's overlap under a micrometre; one set in the pocket of three
+//!   rests at the height of the tetrahedron, the base held by friction.
+//! - Spheres flung far away neither break the grid nor hide a collision.
 //!
 //! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
 
@@ -262,4 +264,53 @@ fn spheres_far_beyond_the_grid_neither_panic_nor_hide_a_collision() {
         );
     }
     assert_eq!(impacts, vec![(0, 1)]);
+}
+
+#[test]
+fn a_sphere_rests_in_the_pocket_of_three_at_the_height_of_a_tetrahedron() {
+    // Three touching spheres on the floor, a fourth set down 1 mm above the
+    // pocket between them: it settles at r + √(4r² − d²) (d: the base's
+    // circumradius), and friction keeps the base from spreading.
+    let r = 0.02;
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    let d = 2.0 * r / 3f64.sqrt();
+    let sphere = |x: DVec3| {
+        ParticleDef::new(0.05)
+            .with_radius(r)
+            .at(x)
+            .with_restitution(0.3)
+            .with_friction(0.6, 0.4)
+    };
+    for k in 0..3 {
+        let a = std::f64::consts::TAU * k as f64 / 3.0;
+        w.add_particle(sphere(DVec3::new(d * a.cos(), r, d * a.sin())))
+            .unwrap();
+    }
+    let height = r + (4.0 * r * r - d * d).sqrt();
+    let top = w
+        .add_particle(sphere(DVec3::new(0.0, height + 0.001, 0.0)))
+        .unwrap();
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    for _ in 0..3000 {
+        w.step(1e-3).unwrap();
+    }
+    let s = w.state();
+    // Within what one step of gravity moves it, g h² ≈ 1e-5 m.
+    assert!(
+        (w.position(top).y - height).abs() < 9.8e-6,
+        "top at {}, expected {height}",
+        w.position(top).y
+    );
+    for k in 0..3 {
+        let side = (s.pos[k] - s.pos[(k + 1) % 3]).length();
+        assert!(
+            (side - 2.0 * r).abs() < 1e-9,
+            "the base spread: side {side}"
+        );
+    }
+    // What is left of the velocity is less than one step of gravity.
+    assert!(s.vel.iter().all(|v| v.length() < 9.8e-3));
 }
