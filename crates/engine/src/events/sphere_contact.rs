@@ -23,6 +23,9 @@
 //!
 //! A chain of touching spheres (Newton's cradle) passes an impulse along in
 //! one handling, since each contact is recomputed after the ones before it.
+//! With a floor, a sphere resting on it that a contact pushes down is held
+//! by the floor (immovable for that contact), and no contact moves it below
+//! the plane.
 //!
 //! Broad phase: a uniform grid of cells twice the largest radius, rebuilt at
 //! every check, so that each sphere is tested only against the spheres of
@@ -30,8 +33,8 @@
 //! the cost grows with the number of spheres, not its square. When the
 //! spheres fill their bounding box the grid is a dense array filled by a
 //! counting sort; when they are spread far apart, a hash map of the
-//! occupied cells. Pairs given as excluded (the scene excludes the pairs joined by a
-//! spring or a joint) never collide.
+//! occupied cells. Pairs given as excluded (the scene excludes the pairs
+//! joined by a spring or a joint) never collide.
 
 use crate::error::ModelError;
 use crate::event::{DiscreteEvent, EventContext, EventState};
