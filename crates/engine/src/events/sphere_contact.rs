@@ -147,6 +147,8 @@ pub struct SphereContact {
     starts: Vec<u32>,
     /// The next free place of each cell's run, while counting-sorting.
     next: Vec<u32>,
+    /// (centre, radius, nailed) of each entry of `cells`, in its order.
+    near: Vec<(DVec3, f64, bool)>,
     /// Cell key → its run in `cells`.
     runs: HashMap<u64, (u32, u32), BuildHasherDefault<CellHasher>>,
     impacts: Vec<Impact>,
@@ -199,6 +201,7 @@ impl SphereContact {
             sorted: Vec::new(),
             starts: Vec::new(),
             next: Vec::new(),
+            near: Vec::new(),
             runs: HashMap::default(),
             impacts: Vec::new(),
         })
@@ -362,17 +365,26 @@ impl SphereContact {
             [1, 1, 1],
         ];
         let mut deepest = 0.0f64;
-        let (cells, pairs, excluded) = (&self.cells, &mut self.pairs, &self.excluded);
-        let mut test = |a: u32, b: u32| {
-            let (ai, bi) = (a as usize, b as usize);
-            if p.inv_mass[ai] == 0.0 && p.inv_mass[bi] == 0.0 {
+        // The spheres' centres, radii and mobility copied in cell order, so
+        // that the tests below read neighbours side by side.
+        self.near.clear();
+        self.near.extend(self.cells.iter().map(|&(_, i)| {
+            let i = i as usize;
+            (pos[i], p.radius[i], p.inv_mass[i] == 0.0)
+        }));
+        let (cells, near, pairs, excluded) =
+            (&self.cells, &self.near, &mut self.pairs, &self.excluded);
+        let mut test = |x: usize, y: usize| {
+            let ((pa, ra, fa), (pb, rb, fb)) = (near[x], near[y]);
+            if fa && fb {
                 return;
             }
-            let reach = p.radius[ai] + p.radius[bi];
-            let d2 = (pos[bi] - pos[ai]).length_squared();
+            let reach = ra + rb;
+            let d2 = (pb - pa).length_squared();
             if d2 >= reach * reach {
                 return;
             }
+            let (a, b) = (cells[x].1, cells[y].1);
             if !excluded.is_empty() && excluded.binary_search(&pair_key(a, b)).is_ok() {
                 return;
             }
@@ -382,15 +394,13 @@ impl SphereContact {
         };
         let mut start = 0;
         while start < cells.len() {
-            let (_, first) = cells[start];
-            let c = cell(pos[first as usize]);
+            let c = cell(near[start].0);
             let end = run_of(c).map_or(start + 1, |r| r.1);
-            let here = &cells[start..end];
             for (k, off) in FORWARD.iter().enumerate() {
                 if k == 0 {
-                    for (x, &(_, a)) in here.iter().enumerate() {
-                        for &(_, b) in &here[x + 1..] {
-                            test(a, b);
+                    for x in start..end {
+                        for y in x + 1..end {
+                            test(x, y);
                         }
                     }
                     continue;
@@ -398,9 +408,9 @@ impl SphereContact {
                 let Some((s, e)) = run_of([c[0] + off[0], c[1] + off[1], c[2] + off[2]]) else {
                     continue;
                 };
-                for &(_, a) in here {
-                    for &(_, b) in &cells[s..e] {
-                        test(a, b);
+                for x in start..end {
+                    for y in s..e {
+                        test(x, y);
                     }
                 }
             }
