@@ -86,10 +86,10 @@ pub fn chain64() -> Spec {
     }
 }
 
-/// The workload as a world, through the public API: point particles, damped
-/// springs at rest, gravity, and a floor that only collides (no friction, no
-/// envelope: the workload's floor rule, applied after each full step).
-pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
+/// A spec as a world, through the public API: point particles of the
+/// workloads' mass and restitution, springs of stiffness `k` and damping `c`
+/// at rest, gravity; no floor.
+pub fn spring_world(spec: &Spec, k: f64, c: f64, kind: IntegratorKind) -> World {
     let mut w = World::new();
     w.set_integrator(kind);
     w.set_gravity(DVec3::new(0.0, -GRAVITY, 0.0));
@@ -105,11 +105,19 @@ pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
         let def = SpringDef::new(
             ParticleId::from_index(a as usize),
             ParticleId::from_index(b as usize),
-            STIFFNESS,
-            DAMPING,
+            k,
+            c,
         );
         w.add_spring(def).expect("valid workload spring");
     }
+    w
+}
+
+/// The workload as a world: [`spring_world`] with the workload's springs,
+/// and a floor that only collides (no friction, no envelope: the workload's
+/// floor rule, applied after each full step).
+pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
+    let mut w = spring_world(spec, STIFFNESS, DAMPING, kind);
     w.add_event(Box::new(WorkloadFloor::default()));
     w
 }

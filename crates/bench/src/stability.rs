@@ -68,8 +68,22 @@ pub fn largest_stable_step(
     lo
 }
 
-fn fastest(w: &World) -> f64 {
+/// The speed of the fastest particle, m/s.
+pub fn fastest(w: &World) -> f64 {
     w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max)
+}
+
+/// [`largest_stable_step`] for the worlds `make` builds, judged by their
+/// fastest particle.
+pub fn largest_stable_world_step(make: &dyn Fn() -> World, seconds: f64, bound: f64) -> f64 {
+    let mut search = || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
+        let mut w = make();
+        Box::new(move |h| {
+            w.step(h).map_err(|_| ())?;
+            Ok(fastest(&w))
+        })
+    };
+    largest_stable_step(&mut search, seconds, bound)
 }
 
 /// Runs the search for every explicit integrator: the frond, and SeaWorld;
@@ -80,14 +94,7 @@ pub fn run(seaworld: Option<&std::path::Path>) -> Vec<Row> {
     let mut rows = Vec::new();
     for kind in explicit() {
         let t = Instant::now();
-        let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
-            let mut w = frond(kind);
-            Box::new(move |h| {
-                w.step(h).map_err(|_| ())?;
-                Ok(fastest(&w))
-            })
-        };
-        let limit = largest_stable_step(&mut make, 30.0, 1.0);
+        let limit = largest_stable_world_step(&|| frond(kind), 30.0, 1.0);
         rows.push(row("seaweed frond", kind, limit, t.elapsed().as_secs_f64()));
     }
     if let Some(path) = seaweed_scene(seaworld) {

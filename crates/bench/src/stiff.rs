@@ -6,64 +6,28 @@
 //! largest step at which symplectic Euler is stable; and the race of the
 //! two on a stiff, damped curtain of cloth-128 ([`race`]).
 
-use crate::mass_spring::{self, DAMPING, GRAVITY, MASS, SPACING, STIFFNESS};
-use crate::stability::largest_stable_step;
+use crate::mass_spring::{self, spring_world, DAMPING, SPACING, STIFFNESS};
+use crate::stability::{self, largest_stable_world_step};
 use animats_creatures::seaworld::{seaweed, SeaweedConstants};
-use animats_engine::{
-    DVec3, FluidMedium, IntegratorKind, LinearDrag, ParticleDef, ParticleId, Solver, SpringDef,
-    Targets, World,
-};
+use animats_engine::{DVec3, FluidMedium, IntegratorKind, LinearDrag, Solver, Targets, World};
 use std::time::Instant;
 
 /// The cloth-N grid (structural and shear springs of the workload's
 /// stiffness `k` and damping), flat at height 1 m, pinned at the two corners
 /// of its first row, falling under gravity; no floor.
 pub fn hanging_cloth(n: usize, k: f64, kind: IntegratorKind) -> World {
-    let spec = mass_spring::cloth(n);
-    let mut w = World::new();
-    w.set_integrator(kind);
-    w.set_gravity(DVec3::new(0.0, -GRAVITY, 0.0));
-    for i in 0..n {
-        for j in 0..n {
-            let mut def = ParticleDef::new(MASS)
-                .at(DVec3::new(i as f64 * SPACING, 1.0, j as f64 * SPACING))
-                .with_radius(0.0);
-            def.fixed = i == 0 && (j == 0 || j == n - 1);
-            w.add_particle(def).expect("valid cloth particle");
-        }
+    let mut spec = mass_spring::cloth(n);
+    for (p, x) in spec.positions.iter_mut().enumerate() {
+        x.y = 1.0; // flat
+        spec.pinned[p] = p == 0 || p == n - 1;
     }
-    for &(a, b) in &spec.edges {
-        let (a, b) = (
-            ParticleId::from_index(a as usize),
-            ParticleId::from_index(b as usize),
-        );
-        w.add_spring(SpringDef::new(a, b, k, DAMPING))
-            .expect("valid cloth spring");
-    }
-    w
+    spring_world(&spec, k, DAMPING, kind)
 }
 
 /// chain-64 (the workload's chain, pinned at one end, swinging down) without
 /// the workload's floor.
 pub fn chain(kind: IntegratorKind) -> World {
-    let spec = mass_spring::chain64();
-    let mut w = World::new();
-    w.set_integrator(kind);
-    w.set_gravity(DVec3::new(0.0, -GRAVITY, 0.0));
-    for (x, &pinned) in spec.positions.iter().zip(&spec.pinned) {
-        let mut def = ParticleDef::new(MASS).at(*x).with_radius(0.0);
-        def.fixed = pinned;
-        w.add_particle(def).expect("valid chain particle");
-    }
-    for &(a, b) in &spec.edges {
-        let (a, b) = (
-            ParticleId::from_index(a as usize),
-            ParticleId::from_index(b as usize),
-        );
-        w.add_spring(SpringDef::new(a, b, STIFFNESS, DAMPING))
-            .expect("valid chain spring");
-    }
-    w
+    spring_world(&mass_spring::chain64(), STIFFNESS, DAMPING, kind)
 }
 
 /// The default seaweed frond (SeaWorld's) in still water, bent over by
@@ -127,14 +91,8 @@ pub fn ten_times(
     bound: f64,
     factor: f64,
 ) -> Outcome {
-    let mut search = || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
-        let mut w = make(IntegratorKind::Symplectic);
-        Box::new(move |h| {
-            w.step(h).map_err(|_| ())?;
-            Ok(w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max))
-        })
-    };
-    let symplectic = largest_stable_step(&mut search, seconds, bound);
+    let symplectic =
+        largest_stable_world_step(&|| make(IntegratorKind::Symplectic), seconds, bound);
     let h = factor * symplectic;
     let mut w = make(IntegratorKind::Implicit);
     let e0 = mechanical_energy(&w);
@@ -145,12 +103,7 @@ pub fn ten_times(
             finite = false;
             break;
         }
-        fastest = w
-            .state()
-            .vel
-            .iter()
-            .map(|v| v.length())
-            .fold(fastest, f64::max);
+        fastest = fastest.max(stability::fastest(&w));
         let e = mechanical_energy(&w);
         largest_rise = largest_rise.max(e - last);
         last = e;
@@ -189,32 +142,14 @@ pub const RACE_SOLVER_TOLERANCE: f64 = 1e-3;
 /// `c` and linear drag `drag` (N s/m) on every particle. It stays in its
 /// plane (nothing pushes it out).
 pub fn curtain(n: usize, k: f64, c: f64, drag: f64, kind: IntegratorKind) -> World {
-    let spec = mass_spring::cloth(n);
-    let mut w = World::new();
-    w.set_integrator(kind);
-    w.set_gravity(DVec3::new(0.0, -GRAVITY, 0.0));
+    let mut spec = mass_spring::cloth(n);
     let top = 1.0 + n as f64 * SPACING;
-    for i in 0..n {
-        for j in 0..n {
-            let mut def = ParticleDef::new(MASS)
-                .at(DVec3::new(
-                    j as f64 * SPACING,
-                    top - i as f64 * SPACING,
-                    0.0,
-                ))
-                .with_radius(0.0);
-            def.fixed = i == 0 && (j == 0 || j == n - 1);
-            w.add_particle(def).expect("valid curtain particle");
-        }
+    for (p, x) in spec.positions.iter_mut().enumerate() {
+        let (i, j) = (p / n, p % n);
+        *x = DVec3::new(j as f64 * SPACING, top - i as f64 * SPACING, 0.0);
+        spec.pinned[p] = p == 0 || p == n - 1;
     }
-    for &(a, b) in &spec.edges {
-        let (a, b) = (
-            ParticleId::from_index(a as usize),
-            ParticleId::from_index(b as usize),
-        );
-        w.add_spring(SpringDef::new(a, b, k, c))
-            .expect("valid curtain spring");
-    }
+    let mut w = spring_world(&spec, k, c, kind);
     if drag > 0.0 {
         w.add_linear_drag(LinearDrag {
             coefficient: drag,
@@ -320,20 +255,16 @@ impl Race {
 /// (its grid comes closer to the bound of an infinite one), so the search
 /// runs on the cloth itself.
 pub fn symplectic_step(n: usize, drag: f64) -> f64 {
-    let mut search = || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
-        let mut w = curtain(
+    let make = || {
+        curtain(
             n,
             CURTAIN_STIFFNESS,
             CURTAIN_DAMPING,
             drag,
             IntegratorKind::Symplectic,
-        );
-        Box::new(move |h| {
-            w.step(h).map_err(|_| ())?;
-            Ok(w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max))
-        })
+        )
     };
-    largest_stable_step(&mut search, 1.0, 50.0)
+    largest_stable_world_step(&make, 1.0, 50.0)
 }
 
 /// Symplectic Euler's run at its largest stable step ([`symplectic_step`],

@@ -3,18 +3,11 @@
 //! allow longer steps, and RK4's limit is what `scenes/seaworld.toml`'s
 //! `max_dt` is chosen under.
 
-use animats_bench::stability::{frond, largest_stable_step};
-use animats_engine::{IntegratorKind, World};
+use animats_bench::stability::{frond, largest_stable_world_step};
+use animats_engine::IntegratorKind;
 
 fn limit(kind: IntegratorKind) -> f64 {
-    let mut make = move || -> Box<dyn FnMut(f64) -> Result<f64, ()>> {
-        let mut w: World = frond(kind);
-        Box::new(move |h| {
-            w.step(h).map_err(|_| ())?;
-            Ok(w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max))
-        })
-    };
-    largest_stable_step(&mut make, 30.0, 1.0)
+    largest_stable_world_step(&|| frond(kind), 30.0, 1.0)
 }
 
 #[test]

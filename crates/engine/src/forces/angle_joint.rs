@@ -111,6 +111,43 @@ impl AngleJoint {
     }
 }
 
+/// A joint's arms and their plane of bending at some positions.
+#[derive(Clone, Copy)]
+struct Bend {
+    /// The arms, from the joint to each end.
+    ra: DVec3,
+    rb: DVec3,
+    /// Their squared lengths.
+    la2: f64,
+    lb2: f64,
+    /// `ra × rb` and its length.
+    normal: DVec3,
+    nl: f64,
+}
+
+impl AngleJoint {
+    /// The arms and their plane, or `None` when the arms are collinear or
+    /// one has no length (no plane of bending: no force, no derivative).
+    fn bend(&self, pos: &[DVec3]) -> Option<Bend> {
+        let j = pos[self.joint as usize];
+        let (ra, rb) = (pos[self.a as usize] - j, pos[self.b as usize] - j);
+        let (la2, lb2) = (ra.length_squared(), rb.length_squared());
+        let normal = ra.cross(rb);
+        let n2 = normal.length_squared();
+        if n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0 {
+            return None;
+        }
+        Some(Bend {
+            ra,
+            rb,
+            la2,
+            lb2,
+            normal,
+            nl: n2.sqrt(),
+        })
+    }
+}
+
 /// Every angle joint of a world.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct AngleJoints {
@@ -192,15 +229,18 @@ impl Force for AngleJoints {
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
         let (pos, vel) = (ctx.pos, ctx.vel);
         for jt in &self.joints {
-            let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
-            let (ra, rb) = (pos[a] - pos[j], pos[b] - pos[j]);
-            let (la2, lb2) = (ra.length_squared(), rb.length_squared());
-            let normal = ra.cross(rb);
-            let n2 = normal.length_squared();
-            if n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0 {
+            let Some(Bend {
+                ra,
+                rb,
+                la2,
+                lb2,
+                normal,
+                nl,
+            }) = jt.bend(pos)
+            else {
                 continue; // collinear or degenerate: no plane of bending
-            }
-            let nl = n2.sqrt();
+            };
+            let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
             let theta = libm::atan2(nl, ra.dot(rb));
             // With ĵ = n/|n|: ĵ × â = (n × a)/(|n||a|), since n ⊥ a. The
             // force on an end is T/|arm| along that unit vector, so
@@ -225,15 +265,18 @@ impl Force for AngleJoints {
     fn jacobian(&self, ctx: &ForceContext, jac: &mut crate::Jacobian) -> bool {
         let pos = ctx.pos;
         for jt in &self.joints {
-            let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
-            let (ra, rb) = (pos[a] - pos[j], pos[b] - pos[j]);
-            let (la2, lb2) = (ra.length_squared(), rb.length_squared());
-            let normal = ra.cross(rb);
-            let n2 = normal.length_squared();
-            if n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0 {
+            let Some(Bend {
+                ra,
+                rb,
+                la2,
+                lb2,
+                normal,
+                nl,
+            }) = jt.bend(pos)
+            else {
                 continue; // as in `apply`: no force, no derivative
-            }
-            let nl = n2.sqrt();
+            };
+            let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
             let ga = normal.cross(ra) * (-1.0 / (nl * la2));
             let gb = normal.cross(rb) * (1.0 / (nl * lb2));
             let g = [(a, ga), (j, -(ga + gb)), (b, gb)];
