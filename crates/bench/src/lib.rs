@@ -359,7 +359,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "brains" => brains::run(opts.quick, runs),
         "seaworld" => seaworld::run(opts.quick, runs),
         "implicit" => Ok(run_implicit(opts.quick)),
-        "contacts" => Ok(pile::run(opts.quick)),
+        "contacts" => Ok(pile::run(opts.quick, runs)),
         "stability" => Ok(stability::run(Some(std::path::Path::new(
             "scenes/seaworld.toml",
         )))),

@@ -1,10 +1,11 @@
 //! A thousand spheres poured onto the floor inside a ring of nailed spheres:
 //! no overlap ever deeper than the envelope, none below the floor, and the
 //! pile loses nearly all the kinetic energy of the fall. It does not come
-//! fully to rest: resting spheres end each step with the velocity g·h of the
-//! step's gravity, and the pile keeps spreading slowly over the ring (a
-//! known gap: one pass of impulses per contact cannot hold a slope; see
-//! docs/DESIGN.md "Sphere–sphere contact").
+//! fully to rest: resting spheres end each step with up to the velocity g·h
+//! of the step's gravity, and the heap keeps compacting and spreading
+//! slowly over the ring (a known gap; an ordered pyramid does rest, see
+//! `crates/engine/tests/sphere_contact.rs` and docs/DESIGN.md
+//! "Sphere–sphere contact").
 
 use animats_bench::pile::pile;
 use animats_engine::{SphereContact, SphereContactDef};

@@ -11,7 +11,8 @@
 //! - Joined pairs never collide.
 //! - A sphere dropped on one resting on the floor comes to rest on it, with
 //!   the pair's overlap under a micrometre; one set in the pocket of three
-//!   rests at the height of the tetrahedron, the base held by friction.
+//!   rests at the height of the tetrahedron, the base held by friction; a
+//!   square pyramid of 30 comes to rest and stays.
 //! - Spheres flung far away neither break the grid nor hide a collision.
 //!
 //! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
@@ -313,4 +314,77 @@ fn a_sphere_rests_in_the_pocket_of_three_at_the_height_of_a_tetrahedron() {
     }
     // What is left of the velocity is less than one step of gravity.
     assert!(s.vel.iter().all(|v| v.length() < 9.8e-3));
+}
+
+/// A square pyramid of 30 spheres (4×4, 3×3, 2×2 and one on top), each
+/// layer set in the pockets of the one below, touching, on the floor.
+fn pyramid(r: f64) -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    // Over a square of four touching spheres the one above sits √2 r
+    // higher (its centre √2 r from each of theirs horizontally, 2r apart).
+    let rise = 2f64.sqrt() * r;
+    for (layer, side) in [4usize, 3, 2, 1].into_iter().enumerate() {
+        let first = -(side as f64 - 1.0) * r;
+        for i in 0..side {
+            for j in 0..side {
+                let x = DVec3::new(
+                    first + 2.0 * r * i as f64,
+                    r + rise * layer as f64,
+                    first + 2.0 * r * j as f64,
+                );
+                w.add_particle(
+                    ParticleDef::new(0.05)
+                        .with_radius(r)
+                        .at(x)
+                        .with_restitution(0.3)
+                        .with_friction(0.6, 0.4),
+                )
+                .unwrap();
+            }
+        }
+    }
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    w
+}
+
+#[test]
+fn a_pyramid_of_spheres_comes_to_rest_and_stays() {
+    // Resting contact between spheres settles as the floor's does: within
+    // a few steps the pyramid reaches a state it returns to after every
+    // step, having sunk by at most one step of gravity per layer (g h²,
+    // the overlap a step's fall makes before the contact removes it).
+    let (r, h) = (0.02, 1e-3);
+    let mut w = pyramid(r);
+    let start = w.state().pos.clone();
+    for _ in 0..1000 {
+        w.step(h).unwrap();
+    }
+    let settled = w.state().clone();
+    for _ in 0..4000 {
+        w.step(h).unwrap();
+    }
+    let drift = w
+        .state()
+        .pos
+        .iter()
+        .zip(&settled.pos)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max);
+    let sag = w
+        .state()
+        .pos
+        .iter()
+        .zip(&start)
+        .map(|(a, b)| (*a - *b).length())
+        .fold(0.0, f64::max);
+    let speed = w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max);
+    println!("drift over 4 s {drift:e} m, sag {sag:e} m, fastest {speed:e} m/s");
+    assert!(drift < 1e-12, "still moving: {drift} m in 4 s");
+    assert!(sag < 4.0 * 9.8 * h * h, "sank {sag} m");
+    // What a step's end still carries of that step's gravity (the passes
+    // stop before every contact has taken it back), never more.
+    assert!(speed <= 9.8 * h, "fastest {speed} m/s");
 }
