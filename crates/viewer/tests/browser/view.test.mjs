@@ -3,7 +3,8 @@
 // checks what a person watching would: something is drawn, frames arrive at
 // 20 Hz or more, pause stops time and resume restarts it, the overlay shows
 // every jellyfish's FSM state, a second tab watches the same run, and a
-// click on the floor moves the food and a jellyfish heads for it.
+// click on the floor moves the food and a jellyfish heads for it; then
+// `view scenes/pile.toml` (sphere contact) and `evolve --view`.
 //
 //   cd crates/viewer/tests/browser && npm ci && node view.test.mjs
 //
@@ -46,6 +47,27 @@ function serve(args = ['view', resolve(root, 'scenes/seaworld.toml'), '--port', 
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+/** Luminance variance and distinct colours of the page's 3-D canvas. */
+function canvasStats(page) {
+  return page.evaluate(() => {
+    const src = document.getElementById('view');
+    const c = document.createElement('canvas');
+    c.width = 220; c.height = 140;
+    const g = c.getContext('2d');
+    g.drawImage(src, 0, 0, c.width, c.height);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    let sum = 0, sum2 = 0;
+    const colours = new Set();
+    for (let i = 0; i < d.length; i += 4) {
+      const y = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
+      sum += y; sum2 += y * y;
+      colours.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | (d[i + 2] >> 3));
+    }
+    const n = d.length / 4;
+    return { variance: sum2 / n - (sum / n) ** 2, colours: colours.size };
+  });
+}
+
 const { child, url } = await serve();
 console.log(`serving at ${url}`);
 const browser = await chromium.launch({
@@ -70,23 +92,7 @@ try {
   check(rate >= 20, 'WebSocket frames arrive at 20 Hz or more', `${rate.toFixed(1)} Hz`);
 
   // Something is drawn: the canvas has pixel variance.
-  const pixels = await v(() => {
-    const src = document.getElementById('view');
-    const c = document.createElement('canvas');
-    c.width = 220; c.height = 140;
-    const g = c.getContext('2d');
-    g.drawImage(src, 0, 0, c.width, c.height);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    let sum = 0, sum2 = 0;
-    const colours = new Set();
-    for (let i = 0; i < d.length; i += 4) {
-      const y = 0.299 * d[i] + 0.587 * d[i + 1] + 0.114 * d[i + 2];
-      sum += y; sum2 += y * y;
-      colours.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | (d[i + 2] >> 3));
-    }
-    const n = d.length / 4;
-    return { variance: sum2 / n - (sum / n) ** 2, colours: colours.size };
-  });
+  const pixels = await canvasStats(page);
   check(pixels.variance > 50 && pixels.colours > 100, 'the canvas is not blank',
     `luminance variance ${pixels.variance.toFixed(0)}, ${pixels.colours} colours`);
 
@@ -168,6 +174,56 @@ try {
   await page.screenshot({ path: screenshot });
   console.log(`screenshot: ${screenshot}`);
   check(errors.length === 0, 'no script errors on the page', errors.join('; '));
+
+
+  // Sphere–sphere contact (issue 12): `animats view scenes/pile.toml` pours
+  // its rocks onto the boulder and the floor; after three simulated
+  // seconds they have fallen, no two overlap deeper than the contacts'
+  // envelope (1 cm) and none is below the floor.
+  const heap = await serve(['view', resolve(root, 'scenes/pile.toml'), '--port', '0']);
+  try {
+    const tab = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    const tabErrors = [];
+    tab.on('pageerror', (e) => tabErrors.push(e.message));
+    await tab.goto(heap.url);
+    await tab.waitForFunction(() => window.__viewer && window.__viewer.frames > 5, null, { timeout: 30000 });
+    const meanY = () => tab.evaluate(() => {
+      const p = window.__viewer.frame.p;
+      let y = 0;
+      for (let i = 1; i < p.length; i += 3) y += p[i];
+      return y / (p.length / 3);
+    });
+    await tab.waitForFunction(() => window.__viewer.frame.t > 3, null, { timeout: 30000 });
+    const after = await meanY();
+    const contact = await tab.evaluate(() => {
+      const { scene, frame } = window.__viewer;
+      const r = scene.particles.map((q) => q.radius);
+      const p = frame.p;
+      let deepest = 0, lowest = Infinity;
+      for (let i = 0; i < r.length; i++) {
+        lowest = Math.min(lowest, p[3 * i + 1] - r[i]);
+        for (let j = i + 1; j < r.length; j++) {
+          const d = Math.hypot(p[3 * j] - p[3 * i], p[3 * j + 1] - p[3 * i + 1], p[3 * j + 2] - p[3 * i + 2]);
+          deepest = Math.max(deepest, r[i] + r[j] - d);
+        }
+      }
+      return { n: r.length, deepest, lowest, t: frame.t };
+    });
+    // They start 0.4 to 1.4 m up (0.9 m on average); a heap is lower.
+    check(contact.n === 201 && after < 0.3,
+      'view pile.toml: the 200 rocks have fallen', `${contact.n} spheres, mean height ${after.toFixed(3)} m at t ${contact.t.toFixed(2)} s`);
+    // Positions arrive in single precision: 1e-6 m is far below either bound.
+    check(contact.deepest <= 0.01 + 1e-6 && contact.lowest >= -1e-6,
+      'view pile.toml: no overlap deeper than the envelope, none below the floor',
+      `deepest overlap ${(1000 * contact.deepest).toFixed(2)} mm, lowest sphere bottom ${contact.lowest.toExponential(2)} m`);
+    const drawn = await canvasStats(tab);
+    check(drawn.variance > 50 && drawn.colours > 100 && tabErrors.length === 0, 'view pile.toml: drawn, no script errors',
+      `luminance variance ${drawn.variance.toFixed(0)}, ${drawn.colours} colours; ${tabErrors.join('; ')}`);
+    await tab.screenshot({ path: join(dirname(screenshot), 'pile.png') });
+    await tab.close();
+  } finally {
+    heap.child.kill('SIGINT');
+  }
 
   // `evolve --view`: every lane's roobot is labelled in the 3-D view, on
   // screen, above its own hip.
