@@ -560,14 +560,14 @@ impl World {
         }
         let t0 = self.time;
         // The whole step first; pieces only after a missed event.
-        let events = self.trial(t0, dt, dt);
+        let (events, finite) = self.trial(t0, dt, dt);
         let report = if events == EventState::Missed {
             let first = self.scratch.implicit.iterations;
             let mut r = self.backtrack(t0, dt)?;
             r.solver_iterations += first;
             r
         } else {
-            self.accept(events, t0 + dt)?;
+            self.accept(events, finite, t0 + dt)?;
             StepReport {
                 backtracks: 0,
                 pieces: 1,
@@ -585,9 +585,10 @@ impl World {
 
     /// Integrates from the current state over `[t, t + h]` (part of a step
     /// of `step`) into the trial buffer and asks every event about the
-    /// result; returns the worst state.
+    /// result; returns the worst state, and whether the integrator knows
+    /// the trial to be finite.
     #[inline]
-    fn trial(&mut self, t: f64, h: f64, step: f64) -> EventState {
+    fn trial(&mut self, t: f64, h: f64, step: f64) -> (EventState, bool) {
         self.scratch.implicit.iterations = 0;
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
@@ -595,7 +596,7 @@ impl World {
             scratch: &mut self.scratch,
             solver: self.solver,
         };
-        integrate(
+        let finite = integrate(
             self.integrator,
             &mut dynamics,
             t,
@@ -621,21 +622,28 @@ impl World {
                 worst = worst.max(*s);
             }
         }
-        worst
+        (worst, finite)
     }
 
     /// Handles the events of the trial ending at `t`, checks it is finite and
-    /// makes it the current state.
+    /// makes it the current state. `finite`: the integrator knows it wrote
+    /// only finite numbers (then the state is read again only if an event
+    /// changed it).
     #[inline]
-    fn accept(&mut self, worst: EventState, t: f64) -> Result<(), SimError> {
+    fn accept(&mut self, worst: EventState, finite: bool, t: f64) -> Result<(), SimError> {
+        let mut known = finite;
         if worst != EventState::None {
             for (e, s) in self.events.iter_mut().zip(&self.event_states) {
                 if *s != EventState::None {
                     e.handle(t, &mut self.next.pos, &mut self.next.vel, &self.particles);
                 }
             }
+            known = false;
         }
-        if let Some(i) = first_non_finite(&self.next, &self.particles.fixed) {
+        if let Some(i) = (!known)
+            .then(|| first_non_finite(&self.next, &self.particles.fixed))
+            .flatten()
+        {
             // The world stays at its last finite state.
             return Err(SimError::NonFinite {
                 particle: ParticleId(i as u32),
@@ -659,7 +667,7 @@ impl World {
         while done < total {
             let t = t0 + dt * (done as f64 / total as f64);
             let h = dt * (piece as f64 / total as f64);
-            let mut worst = self.trial(t, h, dt);
+            let (mut worst, finite) = self.trial(t, h, dt);
             report.solver_iterations += self.scratch.implicit.iterations;
             if worst == EventState::Missed {
                 if piece > 1 {
@@ -671,7 +679,7 @@ impl World {
                 report.unresolved += 1;
                 worst = EventState::Occurring;
             }
-            if let Err(e) = self.accept(worst, t + h) {
+            if let Err(e) = self.accept(worst, finite, t + h) {
                 // The pieces already accepted moved the state: move the
                 // clock with them, so time and state still agree.
                 self.advance_clock(dt * (done as f64 / total as f64));

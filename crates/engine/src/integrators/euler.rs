@@ -6,7 +6,7 @@ use crate::parallel::by_pieces;
 use crate::particle::State;
 
 /// One explicit Euler step of size `h` from time `t`.
-pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
+pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
@@ -18,4 +18,5 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
             *v1 = from.vel[i] + (h * w[i]) * f[i];
         }
     });
+    false
 }

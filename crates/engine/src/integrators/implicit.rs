@@ -74,7 +74,7 @@ fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
 }
 
 /// One implicit Euler step of size `h` from time `t`.
-pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
+pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
     let n = from.len();
     let f = &mut d.scratch.force;
     d.forces
@@ -115,6 +115,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
         to.vel[i] = v;
         to.pos[i] = from.pos[i] + h * v;
     }
+    false
 }
 
 /// Solves `(M + S) x = b` for the moving particles; returns the iterations.

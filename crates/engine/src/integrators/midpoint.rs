@@ -7,7 +7,7 @@ use crate::parallel::by_pieces;
 use crate::particle::State;
 
 /// One midpoint step of size `h` from time `t`.
-pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
+pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
     let f = &mut d.scratch.force;
     let w = &d.particles.inv_mass;
     d.forces
@@ -33,4 +33,5 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
             *v = from.vel[i] + (h * w[i]) * fr[i];
         }
     });
+    false
 }

@@ -183,7 +183,10 @@ pub(crate) fn flat_mut(v: &mut [DVec3]) -> &mut [f64] {
     unsafe { std::slice::from_raw_parts_mut(v.as_mut_ptr().cast::<f64>(), 3 * v.len()) }
 }
 
-/// Advances `from` by `h` into `to` with the method `kind`, starting at time `t`.
+/// Advances `from` by `h` into `to` with the method `kind`, starting at time
+/// `t`. True if the integrator knows every coordinate of `to` to be finite
+/// (a small world's update checks as it writes); false if it does not know,
+/// and the caller must look.
 pub fn integrate(
     kind: IntegratorKind,
     d: &mut Dynamics,
@@ -191,7 +194,7 @@ pub fn integrate(
     h: f64,
     from: &State,
     to: &mut State,
-) {
+) -> bool {
     if d.particles.inv_mass3.len() != 3 * d.particles.inv_mass.len() {
         // Properties filled in by hand rather than by a World: make the
         // per-coordinate copies of the inverse masses for this step.

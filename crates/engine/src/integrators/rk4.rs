@@ -8,8 +8,12 @@ use crate::parallel::by_pieces;
 use crate::particle::State;
 use glam::DVec3;
 
-/// One RK4 step of size `h` from time `t`.
-pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
+/// One RK4 step of size `h` from time `t`; true if it knows every new
+/// coordinate to be finite (see [`super::integrate`]).
+pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    if from.pos.len() < super::symplectic::SMALL {
+        return small(d, t, h, from, to);
+    }
     let w = &d.particles.inv_mass3;
     let s = &mut *d.scratch;
     let (x0, v0) = (&from.pos, &from.vel);
@@ -76,6 +80,58 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
             }
         },
     );
+    false
+}
+
+/// [`step`] for a small world: particle by particle, as vectors (see
+/// `symplectic::SMALL`), the same operations on each coordinate, so the
+/// same bits; the last stage checks finiteness as it writes.
+fn small(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    let s = &mut *d.scratch;
+    let n = from.pos.len();
+    let (x0, v0, w) = (&from.pos[..n], &from.vel[..n], &d.particles.inv_mass[..n]);
+    let half = 0.5 * h;
+    d.forces.evaluate(t, h, x0, v0, d.particles, &mut s.force);
+    {
+        let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
+        let (dx, dv) = (&mut s.dx[..n], &mut s.dv[..n]);
+        for i in 0..n {
+            let a = f[i] * w[i];
+            dx[i] = v0[i];
+            dv[i] = a;
+            x[i] = x0[i] + v0[i] * half;
+            v[i] = v0[i] + a * half;
+        }
+    }
+    for step_to in [half, h] {
+        d.forces
+            .evaluate(t + half, h, &to.pos, &to.vel, d.particles, &mut s.force);
+        let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
+        let (dx, dv) = (&mut s.dx[..n], &mut s.dv[..n]);
+        for i in 0..n {
+            let a = f[i] * w[i];
+            let vi = v[i];
+            dx[i] += vi * 2.0;
+            dv[i] += a * 2.0;
+            x[i] = x0[i] + vi * step_to;
+            v[i] = v0[i] + a * step_to;
+        }
+    }
+    d.forces
+        .evaluate(t + h, h, &to.pos, &to.vel, d.particles, &mut s.force);
+    let sixth = h / 6.0;
+    let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
+    let (dx, dv) = (&s.dx[..n], &s.dv[..n]);
+    let mut finite = true;
+    for i in 0..n {
+        let a = f[i] * w[i];
+        let x1 = x0[i] + (dx[i] + v[i]) * sixth;
+        let v1 = v0[i] + (dv[i] + a) * sixth;
+        x[i] = x1;
+        v[i] = v1;
+        finite &= x1.is_finite() & v1.is_finite();
+    }
+    finite
 }
 
 /// The start of the step and the inverse masses (one per coordinate), read

@@ -6,12 +6,39 @@ use super::{flat, flat_mut, Dynamics};
 use crate::parallel::by_pieces;
 use crate::particle::State;
 
-/// One symplectic Euler step of size `h` from time `t`.
-pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
+/// Worlds with fewer particles take the particle-by-particle loops (here
+/// and in RK4); from about this size the flat loops, which the compiler
+/// vectorises, are faster (chain-64: 0.55-0.59 ms flat, 0.65 ms by particle).
+pub(crate) const SMALL: usize = 16;
+
+/// One symplectic Euler step of size `h` from time `t`; true if it knows
+/// every new coordinate to be finite (see [`super::integrate`]).
+pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
     let (w3, f) = (&d.particles.inv_mass3, &*f);
+    if crate::parallel::piece_len(from.pos.len()).is_none() && from.pos.len() < SMALL {
+        // A small world: particle by particle, as vectors, so that the
+        // positions are stored as the force loops read them (x and y
+        // together, then z) and each read is served from the store just
+        // made instead of waiting for it to reach the cache; and checked
+        // for finiteness here, where the values are in registers. The
+        // same operations on each coordinate as below, so the same bits.
+        let w = &d.particles.inv_mass;
+        let n = from.pos.len();
+        let (x0, v0, f, w) = (&from.pos[..n], &from.vel[..n], &f[..n], &w[..n]);
+        let (x1, v1) = (&mut to.pos[..n], &mut to.vel[..n]);
+        let mut finite = true;
+        for i in 0..n {
+            let v = v0[i] + f[i] * (h * w[i]);
+            let x = x0[i] + v * h;
+            v1[i] = v;
+            x1[i] = x;
+            finite &= v.is_finite() & x.is_finite();
+        }
+        return finite;
+    }
     // Each coordinate on its own, as one flat loop the compiler vectorises:
     // the same operations on each as on the vector (v + (h w) f).
     by_pieces([&mut to.pos, &mut to.vel], |first, [x1, v1]| {
@@ -31,4 +58,5 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) {
             *x1 = *x0 + h * v;
         }
     });
+    false
 }
