@@ -77,7 +77,7 @@ pub fn run(quick: bool, runs: usize) -> Vec<Row> {
         (
             large,
             pile_layers(large, 0.02, depth),
-            format!("pile of {large} spheres, {depth} deep as the {small}"),
+            format!("pile of {large}, {depth} layers deep"),
         ),
     ];
     let mut per_step = Vec::new();

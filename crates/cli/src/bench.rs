@@ -121,12 +121,15 @@ fn print_row(r: &Row) {
             si(r.particle_steps_per_s()),
             si(r.spring_evals_per_s())
         )
-    } else {
+    } else if r.pairs > 0 {
         format!(
             "{}/s pstep, {}/s pairs",
             si(r.particle_steps_per_s()),
             si(r.pairs_per_s())
         )
+    } else {
+        // Neither springs nor force pairs (the contact piles).
+        format!("{}/s pstep", si(r.particle_steps_per_s()))
     };
     let base = match (&r.baseline, r.ratio()) {
         (Some((name, b)), Some(ratio)) => format!("{} ms {name}, ratio {ratio:.2}", ms(b.median)),
