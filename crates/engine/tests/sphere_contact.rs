@@ -181,6 +181,81 @@ fn no_tunnelling_when_a_step_moves_less_than_the_radius() {
 }
 
 #[test]
+fn no_tunnelling_when_a_step_moves_several_diameters() {
+    // A swept test: a step that carries a sphere right through another
+    // (nothing overlaps at either end) is missed and retaken in pieces.
+    let r = 0.05;
+    let h = 1e-3;
+    for per_step in [3.0, 10.0, 40.0] {
+        for phase in 0..8 {
+            let v = per_step * r / h;
+            let start = -0.5 - per_step * r * phase as f64 / 8.0;
+            let mut w = World::new();
+            w.set_integrator(IntegratorKind::Symplectic);
+            w.add_particle(ParticleDef::new(1.0).with_radius(r).fixed())
+                .unwrap();
+            let b = w
+                .add_particle(ball(
+                    1.0,
+                    r,
+                    DVec3::new(start, 0.0, 0.0),
+                    DVec3::new(v, 0.0, 0.0),
+                ))
+                .unwrap();
+            w.add_sphere_contact(SphereContactDef {
+                restitution: Some(1.0),
+                ..SphereContactDef::default()
+            })
+            .unwrap();
+            for _ in 0..20 {
+                w.step(h).unwrap();
+                assert!(
+                    w.position(b).x < 0.0,
+                    "{per_step} r a step, from {start}: through to {}",
+                    w.position(b)
+                );
+            }
+            assert!(
+                w.velocity(b).x < 0.0,
+                "{per_step} r, from {start}: did not bounce"
+            );
+        }
+    }
+    // Two free spheres crossing head on, each 4 r a step, and one
+    // overtaking another in the same direction.
+    for (va, vb) in [(4.0, -4.0), (12.0, 2.0)] {
+        let mut w = World::new();
+        w.set_integrator(IntegratorKind::Symplectic);
+        let a = w
+            .add_particle(ball(
+                1.0,
+                r,
+                DVec3::new(-0.47, 0.0, 0.0),
+                DVec3::X * (va * r / h),
+            ))
+            .unwrap();
+        let b = w
+            .add_particle(ball(
+                1.0,
+                r,
+                DVec3::new(0.33, 0.0, 0.0),
+                DVec3::X * (vb * r / h),
+            ))
+            .unwrap();
+        w.add_sphere_contact(SphereContactDef::default()).unwrap();
+        let p0 = w.momentum();
+        for _ in 0..40 {
+            w.step(h).unwrap();
+            assert!(
+                w.position(a).x < w.position(b).x,
+                "{va}, {vb}: they passed through"
+            );
+        }
+        assert!((w.momentum() - p0).length() < 1e-12 * p0.length().max(1.0));
+    }
+}
+
+#[test]
 fn joined_pairs_never_collide() {
     let mut w = World::new();
     let a = w
