@@ -18,7 +18,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
     let (w3, f) = (&d.particles.inv_mass3, &*f);
-    if crate::parallel::piece_len(from.pos.len()).is_none() && from.pos.len() < SMALL {
+    if from.pos.len() < SMALL {
         // A small world: particle by particle, as vectors, so that the
         // positions are stored as the force loops read them (x and y
         // together, then z) and each read is served from the store just
