@@ -1,6 +1,6 @@
 //! `animats render`: pictures of the right size, not blank, with the floor
 //! and the creatures where the camera puts them, the same bytes every run,
-//! and clear refusals.
+//! clear refusals, and the contact pile where its rocks came to lie.
 
 mod common;
 use animats_engine::DVec3;
@@ -374,4 +374,66 @@ fn walkers_stay_in_the_picture_by_default() {
         "{}",
         text(&o).1
     );
+}
+
+/// Sphere contact in the renderer (issue 12): `render scenes/pile.toml`
+/// seen from above after 3 s shows the rocks where the library puts them:
+/// the highest rocks (nothing above them to hide them) are drawn in the
+/// rocks' grey-brown at their projected centres, not the floor's green or
+/// the boulder's blue.
+#[test]
+fn the_pile_renders_its_rocks_where_they_came_to_lie() {
+    let dir = scratch("render-pile");
+    let out = dir.join("pile.png");
+    let (eye, target) = (DVec3::new(0.0, 2.5, 0.001), DVec3::ZERO);
+    run_ok(&[
+        "render",
+        "scenes/pile.toml",
+        "--seconds",
+        "3",
+        "--width",
+        "320",
+        "--height",
+        "320",
+        "--camera",
+        "0,2.5,0.001:0,0,0",
+        "--no-caption",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let img = decode_png(&out);
+    let mut scene = animats_scene::load(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/pile.toml"
+    )))
+    .expect("scene");
+    for _ in 0..3000 {
+        scene.step(0.001).expect("step");
+    }
+    let mut rocks: Vec<DVec3> = (0..200)
+        .map(|k| {
+            let id = scene.particle(&format!("rock{k}")).expect("rock");
+            scene.world.position(id)
+        })
+        .collect();
+    rocks.sort_by(|a, b| b.y.total_cmp(&a.y));
+    let view = View::new(
+        &Camera {
+            eye,
+            target,
+            fov_y: 50.0,
+        },
+        320,
+        320,
+    );
+    for rock in &rocks[..5] {
+        let (x, y, _) = view.project(*rock).expect("in view");
+        let p = img.pixel(x as u32, y as u32);
+        // 0x7d7468, shaded: red over blue; the floor is green over red, the
+        // boulder blue over red.
+        assert!(
+            p[0] > p[2] + 8 && p[0] >= p[1],
+            "the rock at {rock}, pixel ({x:.0}, {y:.0}): {p:?}"
+        );
+    }
 }
