@@ -167,6 +167,40 @@ impl Scratch {
     }
 }
 
+/// Worlds with fewer particles update particle by particle, as vectors
+/// (`DVec3`), in symplectic Euler and RK4: the positions are then stored as
+/// the force loops read them (x and y together, then z), so each read is
+/// served from the store just made instead of waiting for it to reach the
+/// cache, and finiteness is checked as they are written. From about this
+/// size the flat loops over coordinates, which the compiler vectorises, are
+/// faster (chain-64: 0.55-0.59 ms flat, 0.65 ms by particle).
+pub(crate) const SMALL: usize = 16;
+
+/// What the integrators' update loops need of what they update: one
+/// coordinate (`f64`, the flat loops) or a whole vector (`DVec3`, small
+/// worlds). The loops are written once over it, with the same operations
+/// on each coordinate either way, so both give the same bits.
+pub(crate) trait Coord:
+    Copy + std::ops::Add<Output = Self> + std::ops::AddAssign + std::ops::Mul<f64, Output = Self>
+{
+    /// No coordinate infinite or NaN.
+    fn finite(self) -> bool;
+}
+
+impl Coord for f64 {
+    #[inline(always)]
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Coord for DVec3 {
+    #[inline(always)]
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+}
+
 /// A slice of vectors as one flat array, x, y, z of each in turn.
 #[inline(always)]
 pub(crate) fn flat(v: &[DVec3]) -> &[f64] {

@@ -3,7 +3,7 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::{flat, flat_mut, Dynamics};
+use super::{flat, flat_mut, Coord, Dynamics, SMALL};
 use crate::parallel::by_pieces;
 use crate::particle::State;
 use glam::DVec3;
@@ -11,163 +11,127 @@ use glam::DVec3;
 /// One RK4 step of size `h` from time `t`; true if it knows every new
 /// coordinate to be finite (see [`super::integrate`]).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    if from.pos.len() < super::symplectic::SMALL {
-        return small(d, t, h, from, to);
-    }
-    let w = &d.particles.inv_mass3;
     let s = &mut *d.scratch;
     let (x0, v0) = (&from.pos, &from.vel);
     let half = 0.5 * h;
-
+    let start = Start {
+        x0,
+        v0,
+        w: &d.particles.inv_mass,
+        w3: &d.particles.inv_mass3,
+    };
     // Stage 1 at (x0, v0). Trial states live in `to`; `dx`, `dv` accumulate
     // the weighted derivatives.
     d.forces.evaluate(t, h, x0, v0, d.particles, &mut s.force);
-    let start = Start { x0, v0, w };
-    let f = &s.force;
-    by_pieces(
-        [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
-        |first, [x, v, dx, dv]| {
-            let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-            let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
-            let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
-            for i in 0..n {
-                let a = w[i] * f[i];
-                dx[i] = v0[i];
-                dv[i] = a;
-                x[i] = x0[i] + half * v0[i];
-                v[i] = v0[i] + half * a;
-            }
-        },
-    );
+    let mut trial = [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv];
+    start.run::<FIRST>(half, &s.force, &mut trial);
     // Stages 2 and 3 at the midpoint.
     for step_to in [half, h] {
+        let [x, v, ..] = &trial;
         d.forces
-            .evaluate(t + half, h, &to.pos, &to.vel, d.particles, &mut s.force);
-        let f = &s.force;
-        by_pieces(
-            [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
-            |first, [x, v, dx, dv]| {
-                let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-                let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
-                let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
-                for i in 0..n {
-                    let a = w[i] * f[i];
-                    let vi = v[i];
-                    dx[i] += 2.0 * vi;
-                    dv[i] += 2.0 * a;
-                    x[i] = x0[i] + step_to * vi;
-                    v[i] = v0[i] + step_to * a;
-                }
-            },
-        );
+            .evaluate(t + half, h, x, v, d.particles, &mut s.force);
+        start.run::<MIDDLE>(step_to, &s.force, &mut trial);
     }
     // Stage 4 at the end of the step, then the weighted sum.
-    d.forces
-        .evaluate(t + h, h, &to.pos, &to.vel, d.particles, &mut s.force);
-    let sixth = h / 6.0;
-    let f = &s.force;
-    by_pieces(
-        [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv],
-        |first, [x, v, dx, dv]| {
-            let (n, [x0, v0, f], w) = start.piece(first, x.len(), f);
-            let (x, v) = (&mut flat_mut(x)[..n], &mut flat_mut(v)[..n]);
-            let (dx, dv) = (&mut flat_mut(dx)[..n], &mut flat_mut(dv)[..n]);
+    let [x, v, ..] = &trial;
+    d.forces.evaluate(t + h, h, x, v, d.particles, &mut s.force);
+    start.run::<LAST>(h / 6.0, &s.force, &mut trial)
+}
+
+/// The stages' updates (a constant parameter, so that each is compiled on
+/// its own): the first and middle stages set the trial state to `x0 + v·s`
+/// with their step `s`, the last takes the weighted sum with `s = h/6`.
+const FIRST: u8 = 0;
+const MIDDLE: u8 = 1;
+const LAST: u8 = 2;
+
+/// One stage's update of the trial state `x`, `v` and the sums `dx`, `dv`
+/// from the start `x0`, `v0`, the forces `f` and each element's inverse
+/// mass `w`; the last stage answers whether everything it wrote is finite
+/// (the flat loops drop the answer, and with it the test).
+#[inline(always)]
+fn stage<T: Coord, const STAGE: u8>(
+    s: f64,
+    [x0, v0, f]: [&[T]; 3],
+    w: &[f64],
+    [x, v, dx, dv]: [&mut [T]; 4],
+) -> bool {
+    let n = x.len();
+    let (x0, v0, f, w) = (&x0[..n], &v0[..n], &f[..n], &w[..n]);
+    let (v, dx, dv) = (&mut v[..n], &mut dx[..n], &mut dv[..n]);
+    match STAGE {
+        FIRST => {
+            let half = s;
             for i in 0..n {
-                let a = w[i] * f[i];
-                let vi = v[i];
-                x[i] = x0[i] + sixth * (dx[i] + vi);
-                v[i] = v0[i] + sixth * (dv[i] + a);
+                let a = f[i] * w[i];
+                dx[i] = v0[i];
+                dv[i] = a;
+                x[i] = x0[i] + v0[i] * half;
+                v[i] = v0[i] + a * half;
             }
-        },
-    );
-    false
-}
-
-/// [`step`] for a small world: particle by particle, as vectors (see
-/// `symplectic::SMALL`), the same operations on each coordinate, so the
-/// same bits; the last stage checks finiteness as it writes.
-fn small(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    let s = &mut *d.scratch;
-    let n = from.pos.len();
-    let (x0, v0, w) = (&from.pos[..n], &from.vel[..n], &d.particles.inv_mass[..n]);
-    let half = 0.5 * h;
-    d.forces.evaluate(t, h, x0, v0, d.particles, &mut s.force);
-    {
-        let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
-        let (dx, dv) = (&mut s.dx[..n], &mut s.dv[..n]);
-        for i in 0..n {
-            let a = f[i] * w[i];
-            dx[i] = v0[i];
-            dv[i] = a;
-            x[i] = x0[i] + v0[i] * half;
-            v[i] = v0[i] + a * half;
+            false
+        }
+        MIDDLE => {
+            let step_to = s;
+            for i in 0..n {
+                let a = f[i] * w[i];
+                let vi = v[i];
+                dx[i] += vi * 2.0;
+                dv[i] += a * 2.0;
+                x[i] = x0[i] + vi * step_to;
+                v[i] = v0[i] + a * step_to;
+            }
+            false
+        }
+        _ => {
+            let sixth = s;
+            let mut finite = true;
+            for i in 0..n {
+                let a = f[i] * w[i];
+                let x1 = x0[i] + (dx[i] + v[i]) * sixth;
+                let v1 = v0[i] + (dv[i] + a) * sixth;
+                x[i] = x1;
+                v[i] = v1;
+                finite &= x1.finite() & v1.finite();
+            }
+            finite
         }
     }
-    for step_to in [half, h] {
-        d.forces
-            .evaluate(t + half, h, &to.pos, &to.vel, d.particles, &mut s.force);
-        let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
-        let (dx, dv) = (&mut s.dx[..n], &mut s.dv[..n]);
-        for i in 0..n {
-            let a = f[i] * w[i];
-            let vi = v[i];
-            dx[i] += vi * 2.0;
-            dv[i] += a * 2.0;
-            x[i] = x0[i] + vi * step_to;
-            v[i] = v0[i] + a * step_to;
-        }
-    }
-    d.forces
-        .evaluate(t + h, h, &to.pos, &to.vel, d.particles, &mut s.force);
-    let sixth = h / 6.0;
-    let (f, x, v) = (&s.force[..n], &mut to.pos[..n], &mut to.vel[..n]);
-    let (dx, dv) = (&s.dx[..n], &s.dv[..n]);
-    let mut finite = true;
-    for i in 0..n {
-        let a = f[i] * w[i];
-        let x1 = x0[i] + (dx[i] + v[i]) * sixth;
-        let v1 = v0[i] + (dv[i] + a) * sixth;
-        x[i] = x1;
-        v[i] = v1;
-        finite &= x1.is_finite() & v1.is_finite();
-    }
-    finite
 }
 
-/// The start of the step and the inverse masses (one per coordinate), read
-/// by every stage; each stage's loop runs over every coordinate of every
-/// particle as one flat array, the same operations on each coordinate as on
-/// the vector.
+/// The start of the step and the inverse masses (one per particle, and
+/// one per coordinate), read by every stage.
 #[derive(Clone, Copy)]
 struct Start<'a> {
     x0: &'a [DVec3],
     v0: &'a [DVec3],
     w: &'a [f64],
+    w3: &'a [f64],
 }
 
-impl<'a> Start<'a> {
-    /// Particles `first..first + n` of the start, the forces `f` and the
-    /// inverse masses, as flat arrays of each coordinate in turn, each
-    /// exactly `3n` long (so the loops need no bounds checks).
+impl Start<'_> {
+    /// Runs stage `STAGE` with its step `s` over the `trial` state (x, v,
+    /// dx, dv) with the forces `f`: particle by particle in a small world,
+    /// else as flat arrays of every coordinate of every particle in turn,
+    /// in pieces (one per thread for a large world). True if the last stage
+    /// of a small world wrote only finite numbers.
     #[inline(always)]
-    fn piece<'f>(
-        &self,
-        first: usize,
-        n: usize,
-        f: &'f [DVec3],
-    ) -> (usize, [&'f [f64]; 3], &'f [f64])
-    where
-        'a: 'f,
-    {
-        let r = first..first + n;
-        (
-            3 * n,
-            [
+    fn run<const STAGE: u8>(&self, s: f64, f: &[DVec3], trial: &mut [&mut Vec<DVec3>; 4]) -> bool {
+        let [x, v, dx, dv] = trial;
+        if self.x0.len() < SMALL {
+            return stage::<_, STAGE>(s, [self.x0, self.v0, f], self.w, [x, v, dx, dv]);
+        }
+        by_pieces([x, v, dx, dv], |first, [x, v, dx, dv]| {
+            let r = first..first + x.len();
+            let start = [
                 flat(&self.x0[r.clone()]),
                 flat(&self.v0[r.clone()]),
                 flat(&f[r]),
-            ],
-            &self.w[3 * first..3 * (first + n)],
-        )
+            ];
+            let w = &self.w3[3 * first..3 * first + 3 * x.len()];
+            let trial = [flat_mut(x), flat_mut(v), flat_mut(dx), flat_mut(dv)];
+            stage::<_, STAGE>(s, start, w, trial);
+        });
+        false
     }
 }
