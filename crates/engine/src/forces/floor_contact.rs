@@ -57,7 +57,9 @@ impl FloorContact {
         Ok(())
     }
 
-    #[inline]
+    /// Always inlined into the loop over particles, so that `f` stays in
+    /// registers (about 1 % of a roobot evaluation).
+    #[inline(always)]
     fn contact(&self, ctx: &ForceContext, i: usize, f: &mut DVec3) {
         let p = &ctx.particles;
         if p.inv_mass[i] == 0.0 || ctx.pos[i].y - p.radius[i] > self.contact_tolerance {
