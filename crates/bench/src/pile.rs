@@ -16,17 +16,26 @@ pub fn pile(n: usize, r: f64) -> World {
 /// [`pile`] from a lattice `layers` deep (and as wide as it takes): the
 /// same depth, and so about the same contacts per sphere, for any `n`.
 pub fn pile_layers(n: usize, r: f64, layers: usize) -> World {
+    pile_walled(n, r, layers, 1)
+}
+
+/// [`pile_layers`] inside a ring `rows` spheres tall (nailed spheres
+/// stacked in columns): with one row the heap of 1,000 (about five layers
+/// deep once fallen) spills over the ring; with eight none can.
+pub fn pile_walled(n: usize, r: f64, layers: usize, rows: usize) -> World {
     let mut w = World::new();
     w.set_integrator(IntegratorKind::Symplectic);
     w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
     let side = (n as f64 / layers.max(1) as f64).sqrt().ceil() as usize;
     let ring = 0.5 * side as f64 * 2.5 * r + 4.0 * r;
     let around = (std::f64::consts::TAU * ring / (2.0 * r)).floor() as usize;
-    for k in 0..around {
-        let a = std::f64::consts::TAU * k as f64 / around as f64;
-        let x = DVec3::new(ring * a.cos(), r, ring * a.sin());
-        w.add_particle(ParticleDef::new(1.0).with_radius(r).at(x).fixed())
-            .unwrap();
+    for row in 0..rows {
+        for k in 0..around {
+            let a = std::f64::consts::TAU * k as f64 / around as f64;
+            let x = DVec3::new(ring * a.cos(), r + 2.0 * r * row as f64, ring * a.sin());
+            w.add_particle(ParticleDef::new(1.0).with_radius(r).at(x).fixed())
+                .unwrap();
+        }
     }
     let mut s = 0x2545_f491_4f6c_dd1du64;
     let mut jitter = || {

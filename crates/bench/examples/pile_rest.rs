@@ -1,0 +1,64 @@
+//! Does a heap come to rest? 1,000 spheres poured into the ring of
+//! [`animats_bench::pile`], the ring `--rows` spheres tall (default 1, the
+//! benchmark's; 8 holds the whole heap in), simulated for `--seconds`
+//! (default 12) at 1 ms; each second it prints the kinetic energy, how far
+//! the spheres moved in that second (mean and largest), how many moved
+//! more than 1 mm, the fastest sphere's speed at the step's end, and the
+//! deepest overlap the contacts' passes left at a step's end.
+//!
+//! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
+
+use animats_bench::pile::pile_walled;
+use animats_engine::{SphereContact, SphereContactDef};
+
+fn main() {
+    let (mut rows, mut seconds) = (1usize, 12usize);
+    let mut args = std::env::args().skip(1);
+    while let Some(flag) = args.next() {
+        let value = args.next().and_then(|v| v.parse::<usize>().ok());
+        match (flag.as_str(), value) {
+            ("--rows", Some(v)) if v >= 1 => rows = v,
+            ("--seconds", Some(v)) if v >= 1 => seconds = v,
+            _ => {
+                eprintln!(
+                    "pile_rest: expected --rows N (>= 1) and --seconds S (>= 1), got {flag:?}"
+                );
+                std::process::exit(2);
+            }
+        }
+    }
+    let (r, h) = (0.02, 1e-3);
+    let mut w = pile_walled(1000, r, 10, rows);
+    let free: Vec<usize> = (0..w.len())
+        .filter(|&i| w.particles().inv_mass[i] > 0.0)
+        .collect();
+    let mut before = w.state().pos.clone();
+    let Ok(mut probe) = SphereContact::new(SphereContactDef::default()) else {
+        unreachable!("the default contact settings are valid")
+    };
+    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, fastest at a step's end, deepest overlap left");
+    for s in 1..=seconds {
+        let mut left = 0.0f64;
+        for _ in 0..1000 {
+            if let Err(e) = w.step(h) {
+                eprintln!("pile_rest: {e}");
+                std::process::exit(1);
+            }
+            left = left.max(probe.deepest_overlap(&w.state().pos, w.particles()));
+        }
+        let st = w.state();
+        let moved: Vec<f64> = free
+            .iter()
+            .map(|&i| (st.pos[i] - before[i]).length())
+            .collect();
+        let mean = moved.iter().sum::<f64>() / moved.len() as f64;
+        let largest = moved.iter().copied().fold(0.0, f64::max);
+        let over = moved.iter().filter(|&&d| d > 1e-3).count();
+        let fastest = free.iter().map(|&i| st.vel[i].length()).fold(0.0, f64::max);
+        println!(
+            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  fastest {fastest:.2e} m/s  overlap {left:.1e} m",
+            w.energy().kinetic
+        );
+        before = st.pos.clone();
+    }
+}
