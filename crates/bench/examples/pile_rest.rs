@@ -4,7 +4,8 @@
 //! (default 12) at 1 ms; each second it prints the kinetic energy, how far
 //! the spheres moved in that second (mean and largest), how many moved
 //! more than 1 mm, the fastest sphere's speed at the step's end, and the
-//! deepest overlap the contacts' passes left at a step's end.
+//! deepest overlap the contacts' passes left at a step's end, and how many
+//! spheres are outside the ring.
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
@@ -32,11 +33,17 @@ fn main() {
     let free: Vec<usize> = (0..w.len())
         .filter(|&i| w.particles().inv_mass[i] > 0.0)
         .collect();
+    let across = |x: animats_engine::DVec3| (x.x * x.x + x.z * x.z).sqrt();
+    // The ring's radius: where its nailed spheres stand.
+    let ring = (0..w.len())
+        .filter(|&i| w.particles().inv_mass[i] == 0.0)
+        .map(|i| across(w.state().pos[i]))
+        .fold(0.0, f64::max);
     let mut before = w.state().pos.clone();
     let Ok(mut probe) = SphereContact::new(SphereContactDef::default()) else {
         unreachable!("the default contact settings are valid")
     };
-    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, fastest at a step's end, deepest overlap left");
+    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, fastest at a step's end, deepest overlap left, outside the ring");
     for s in 1..=seconds {
         let mut left = 0.0f64;
         for _ in 0..1000 {
@@ -55,8 +62,9 @@ fn main() {
         let largest = moved.iter().copied().fold(0.0, f64::max);
         let over = moved.iter().filter(|&&d| d > 1e-3).count();
         let fastest = free.iter().map(|&i| st.vel[i].length()).fold(0.0, f64::max);
+        let outside = free.iter().filter(|&&i| across(st.pos[i]) > ring).count();
         println!(
-            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  fastest {fastest:.2e} m/s  overlap {left:.1e} m",
+            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
             w.energy().kinetic
         );
         before = st.pos.clone();
