@@ -1,10 +1,10 @@
 //! Does a heap come to rest? 1,000 spheres poured into the ring of
 //! [`animats_bench::pile`], the ring `--rows` spheres tall (default 1, the
 //! benchmark's; 8 holds the whole heap in), simulated for `--seconds`
-//! (default 12) at 1 ms; each second it prints the kinetic energy, how far
-//! the spheres moved in that second (mean and largest), how many moved
-//! more than 1 mm, the fastest sphere's speed at the step's end, and the
-//! deepest overlap the contacts' passes left at a step's end, and how many
+//! (default 12) at 1 ms. Each second it prints the kinetic energy; how far
+//! the spheres moved in that second (mean and largest) and how many moved
+//! more than 1 mm; the fastest sphere's speed at the step's end; the
+//! deepest overlap the contacts' passes left at a step's end; and how many
 //! spheres are outside the ring.
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
