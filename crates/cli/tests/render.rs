@@ -31,51 +31,67 @@ fn run_ok(args: &[&str]) -> String {
     out
 }
 
-#[test]
-fn a_png_shows_the_ball_and_the_floor_where_the_camera_puts_them() {
-    let dir = scratch("render-png");
-    let out = dir.join("ball.png");
-    let (eye, target) = (DVec3::new(0.0, 0.8, 2.0), DVec3::new(0.0, 0.4, 0.0));
+/// `animats render scene --seconds t` to a PNG in `dir`, `size` pixels,
+/// seen from `eye` towards `target`, without a caption; with the picture,
+/// the scene as the library has it at the same time (1 ms steps, the
+/// scenes' own) and the camera's projection, to say where things must be.
+fn still(
+    dir: &std::path::Path,
+    scene: &str,
+    seconds: f64,
+    size: (u32, u32),
+    eye: DVec3,
+    target: DVec3,
+) -> (Image, animats_scene::Scene, View) {
+    let out = dir.join("still.png");
+    let camera = format!(
+        "{},{},{}:{},{},{}",
+        eye.x, eye.y, eye.z, target.x, target.y, target.z
+    );
     run_ok(&[
         "render",
-        "scenes/bouncing_ball.toml",
+        scene,
         "--seconds",
-        "0.2",
+        &seconds.to_string(),
         "--width",
-        "320",
+        &size.0.to_string(),
         "--height",
-        "200",
+        &size.1.to_string(),
         "--camera",
-        "0,0.8,2:0,0.4,0",
+        &camera,
         "--no-caption",
         "--out",
-        out.to_str().unwrap(),
+        out.to_str().expect("a UTF-8 scratch path"),
     ]);
     let img = decode_png(&out);
-    assert_eq!((img.width, img.height), (320, 200));
-
-    // Where the ball is at t = 0.2 s, from the library.
-    let mut scene = animats_scene::load(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/bouncing_ball.toml"
-    )))
-    .expect("scene");
-    for _ in 0..200 {
-        scene.step(0.001).expect("step");
+    assert_eq!((img.width, img.height), size);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(scene);
+    let mut lib = animats_scene::load(&path).expect("scene");
+    for _ in 0..(seconds * 1000.0).round() as usize {
+        lib.step(0.001).expect("step");
     }
+    let fov_y = 50.0;
+    let view = View::new(&Camera { eye, target, fov_y }, size.0, size.1);
+    (img, lib, view)
+}
+
+#[test]
+fn a_png_shows_the_ball_and_the_floor_where_the_camera_puts_them() {
+    let (img, scene, view) = still(
+        &scratch("render-png"),
+        "scenes/bouncing_ball.toml",
+        0.2,
+        (320, 200),
+        DVec3::new(0.0, 0.8, 2.0),
+        DVec3::new(0.0, 0.4, 0.0),
+    );
+    // Where the ball is at t = 0.2 s, from the library.
     let ball = scene.world.position(scene.particle("ball").expect("ball"));
     assert!(
         (ball.y - (1.05 - 0.5 * 9.8 * 0.04)).abs() < 1e-3,
         "free fall: {ball}"
-    );
-    let view = View::new(
-        &Camera {
-            eye,
-            target,
-            fov_y: 50.0,
-        },
-        320,
-        200,
     );
     let (x, y, _) = view.project(ball).expect("in view");
     let p = img.pixel(x as u32, y as u32);
@@ -383,33 +399,14 @@ fn walkers_stay_in_the_picture_by_default() {
 /// the boulder's blue.
 #[test]
 fn the_pile_renders_its_rocks_where_they_came_to_lie() {
-    let dir = scratch("render-pile");
-    let out = dir.join("pile.png");
-    let (eye, target) = (DVec3::new(0.0, 2.5, 0.001), DVec3::ZERO);
-    run_ok(&[
-        "render",
+    let (img, scene, view) = still(
+        &scratch("render-pile"),
         "scenes/pile.toml",
-        "--seconds",
-        "3",
-        "--width",
-        "320",
-        "--height",
-        "320",
-        "--camera",
-        "0,2.5,0.001:0,0,0",
-        "--no-caption",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let img = decode_png(&out);
-    let mut scene = animats_scene::load(std::path::Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/pile.toml"
-    )))
-    .expect("scene");
-    for _ in 0..3000 {
-        scene.step(0.001).expect("step");
-    }
+        3.0,
+        (320, 320),
+        DVec3::new(0.0, 2.5, 0.001),
+        DVec3::ZERO,
+    );
     let mut rocks: Vec<DVec3> = (0..200)
         .map(|k| {
             let id = scene.particle(&format!("rock{k}")).expect("rock");
@@ -417,15 +414,6 @@ fn the_pile_renders_its_rocks_where_they_came_to_lie() {
         })
         .collect();
     rocks.sort_by(|a, b| b.y.total_cmp(&a.y));
-    let view = View::new(
-        &Camera {
-            eye,
-            target,
-            fov_y: 50.0,
-        },
-        320,
-        320,
-    );
     for rock in &rocks[..5] {
         let (x, y, _) = view.project(*rock).expect("in view");
         let p = img.pixel(x as u32, y as u32);
