@@ -640,10 +640,12 @@ impl World {
             }
             known = false;
         }
-        if let Some(i) = (!known)
-            .then(|| first_non_finite(&self.next, &self.particles.fixed))
-            .flatten()
-        {
+        let bad = if known {
+            None
+        } else {
+            first_non_finite(&self.next, &self.particles.fixed)
+        };
+        if let Some(i) = bad {
             // The world stays at its last finite state.
             return Err(SimError::NonFinite {
                 particle: ParticleId(i as u32),
