@@ -9,7 +9,7 @@
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
-use animats_bench::pile::pile_walled;
+use animats_bench::pile::{outside_ring, pile_walled};
 use animats_engine::{SphereContact, SphereContactDef};
 
 fn main() {
@@ -33,12 +33,6 @@ fn main() {
     let free: Vec<usize> = (0..w.len())
         .filter(|&i| w.particles().inv_mass[i] > 0.0)
         .collect();
-    let across = |x: animats_engine::DVec3| (x.x * x.x + x.z * x.z).sqrt();
-    // The ring's radius: where its nailed spheres stand.
-    let ring = (0..w.len())
-        .filter(|&i| w.particles().inv_mass[i] == 0.0)
-        .map(|i| across(w.state().pos[i]))
-        .fold(0.0, f64::max);
     let mut before = w.state().pos.clone();
     let Ok(mut probe) = SphereContact::new(SphereContactDef::default()) else {
         unreachable!("the default contact settings are valid")
@@ -62,7 +56,7 @@ fn main() {
         let largest = moved.iter().copied().fold(0.0, f64::max);
         let over = moved.iter().filter(|&&d| d > 1e-3).count();
         let fastest = free.iter().map(|&i| st.vel[i].length()).fold(0.0, f64::max);
-        let outside = free.iter().filter(|&&i| across(st.pos[i]) > ring).count();
+        let outside = outside_ring(&w);
         println!(
             "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
             w.energy().kinetic

@@ -66,6 +66,19 @@ pub fn pile_walled(n: usize, r: f64, layers: usize, rows: usize) -> World {
     w
 }
 
+/// How many particles of a [`pile_walled`] world lie further from the
+/// vertical axis than the ring's nailed spheres' centres: the spheres that
+/// got out.
+pub fn outside_ring(w: &World) -> usize {
+    let across = |x: DVec3| (x.x * x.x + x.z * x.z).sqrt();
+    let pos = &w.state().pos;
+    let ring = (0..w.len())
+        .filter(|&i| w.particles().inv_mass[i] == 0.0)
+        .map(|i| across(pos[i]))
+        .fold(0.0, f64::max);
+    pos.iter().filter(|&&x| across(x) > ring).count()
+}
+
 /// The step, s.
 pub const DT: f64 = 1e-3;
 /// Steps timed: the first half second of the fall, when the spheres land

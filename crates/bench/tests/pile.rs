@@ -9,7 +9,7 @@
 //! `crates/engine/tests/sphere_contact.rs` and docs/DESIGN.md
 //! "Sphere–sphere contact").
 
-use animats_bench::pile::pile_walled;
+use animats_bench::pile::{outside_ring, pile_walled};
 use animats_engine::{SphereContact, SphereContactDef};
 
 #[test]
@@ -18,11 +18,6 @@ fn a_thousand_spheres_poured_into_a_ring_lose_their_energy_without_deep_overlaps
     // A ring eight spheres tall holds the whole heap (the benchmark's, one
     // tall, lets 171 of the 1,000 out within these 4 s: `pile_rest`).
     let mut w = pile_walled(1000, r, 10, 8);
-    let across = |x: animats_engine::DVec3| (x.x * x.x + x.z * x.z).sqrt();
-    let ring = (0..w.len())
-        .filter(|&i| w.particles().inv_mass[i] == 0.0)
-        .map(|i| across(w.state().pos[i]))
-        .fold(0.0, f64::max);
     let envelope = SphereContactDef::default().envelope;
     let h = 1e-3;
     let (mut deepest, mut peak, mut lowest) = (0.0f64, 0.0f64, f64::INFINITY);
@@ -35,7 +30,7 @@ fn a_thousand_spheres_poured_into_a_ring_lose_their_energy_without_deep_overlaps
         lowest = s.pos.iter().map(|x| x.y).fold(lowest, f64::min);
     }
     let left = w.energy().kinetic;
-    let outside = w.state().pos.iter().filter(|&&x| across(x) > ring).count();
+    let outside = outside_ring(&w);
     let mean = w.state().vel.iter().map(|v| v.length()).sum::<f64>() / w.len() as f64;
     println!(
         "deepest overlap {deepest:e} m, lowest centre {lowest} m, kinetic energy {peak:.3e} -> {left:.3e} J, mean speed {mean:.3e} m/s, outside the ring {outside}"
