@@ -3,7 +3,8 @@
 //! benchmark's; 8 holds the whole heap in), simulated for `--seconds`
 //! (default 12) at 1 ms. Each second it prints the kinetic energy; how far
 //! the spheres moved in that second (mean and largest) and how many moved
-//! more than 1 mm; the fastest sphere's speed at the step's end; the
+//! more than 1 mm; how far they travelled step by step (mean) and how far
+//! they sank (mean fall of the centres); the fastest sphere's speed at the step's end; the
 //! deepest overlap the contacts' passes left at a step's end; and how many
 //! spheres are outside the ring.
 //!
@@ -37,13 +38,19 @@ fn main() {
     let Ok(mut probe) = SphereContact::new(SphereContactDef::default()) else {
         unreachable!("the default contact settings are valid")
     };
-    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, fastest at a step's end, deepest overlap left, outside the ring");
+    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, travelled step by step (mean), sank (mean), fastest at a step's end, deepest overlap left, outside the ring");
+    let mut path = vec![0.0f64; w.len()];
     for s in 1..=seconds {
         let mut left = 0.0f64;
+        path.iter_mut().for_each(|p| *p = 0.0);
         for _ in 0..1000 {
+            let last = w.state().pos.clone();
             if let Err(e) = w.step(h) {
                 eprintln!("pile_rest: {e}");
                 std::process::exit(1);
+            }
+            for ((p, x), x0) in path.iter_mut().zip(&w.state().pos).zip(&last) {
+                *p += (*x - *x0).length();
             }
             left = left.max(probe.deepest_overlap(&w.state().pos, w.particles()));
         }
@@ -55,10 +62,14 @@ fn main() {
         let mean = moved.iter().sum::<f64>() / moved.len() as f64;
         let largest = moved.iter().copied().fold(0.0, f64::max);
         let over = moved.iter().filter(|&&d| d > 1e-3).count();
+        // The distance travelled step by step, against `mean`, the distance
+        // from where the second began: much larger means back and forth.
+        let travelled = free.iter().map(|&i| path[i]).sum::<f64>() / free.len() as f64;
+        let sank = free.iter().map(|&i| before[i].y - st.pos[i].y).sum::<f64>() / free.len() as f64;
         let fastest = free.iter().map(|&i| st.vel[i].length()).fold(0.0, f64::max);
         let outside = outside_ring(&w);
         println!(
-            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
+            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  travelled {travelled:.2e} m  sank {sank:+.1e} m  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
             w.energy().kinetic
         );
         before = st.pos.clone();
