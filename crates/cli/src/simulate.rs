@@ -66,7 +66,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     if steps > 1e12 {
         return Err(Failure::Input(format!(
-            "{steps} steps is too many: raise --dt or lower --duration"
+            "{steps:.1e} steps is too many (at most 1e12): raise --dt or lower --duration"
         )));
     }
     let steps = steps as u64;

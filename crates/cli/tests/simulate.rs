@@ -277,6 +277,15 @@ fn missing_files_bad_options_and_unwritable_outputs_exit_2() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o).1);
         assert!(!text(&o).1.contains("panicked"));
     }
+    // A huge step count is refused at once, in one readable line.
+    let o = animats(&["simulate", "scenes/oscillator.toml", "--duration", "1e300"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o).1;
+    assert!(
+        err.contains("1.0e302 steps") && err.contains("too many"),
+        "{err}"
+    );
+    assert!(err.len() < 200, "{err}");
 }
 
 #[test]
