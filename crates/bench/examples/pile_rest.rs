@@ -4,9 +4,9 @@
 //! (default 12) at 1 ms. Each second it prints the kinetic energy; how far
 //! the spheres moved in that second (mean and largest) and how many moved
 //! more than 1 mm; how far they travelled step by step (mean) and how far
-//! they sank (mean fall of the centres); the fastest sphere's speed at the step's end; the
-//! deepest overlap the contacts' passes left at a step's end; and how many
-//! spheres are outside the ring.
+//! they sank (mean fall of the centres); the fastest sphere's speed at the
+//! step's end; the deepest overlap the contacts' passes left at a step's
+//! end; and how many spheres are outside the ring.
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
@@ -40,11 +40,12 @@ fn main() {
     };
     println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, travelled step by step (mean), sank (mean), fastest at a step's end, deepest overlap left, outside the ring");
     let mut path = vec![0.0f64; w.len()];
+    let mut last = w.state().pos.clone();
     for s in 1..=seconds {
         let mut left = 0.0f64;
         path.iter_mut().for_each(|p| *p = 0.0);
         for _ in 0..1000 {
-            let last = w.state().pos.clone();
+            last.clone_from(&w.state().pos);
             if let Err(e) = w.step(h) {
                 eprintln!("pile_rest: {e}");
                 std::process::exit(1);
