@@ -7,6 +7,7 @@ use animats_engine::{
     Properties, SpringDef, World,
 };
 use std::f64::consts::PI;
+use std::ops::Range;
 
 /// Particle mass, kg.
 pub const MASS: f64 = 0.001;
@@ -144,6 +145,41 @@ impl DiscreteEvent for WorkloadFloor {
             EventState::None
         } else {
             EventState::Occurring
+        }
+    }
+
+    fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
+        let below = ctx.pos[range.clone()]
+            .iter()
+            .zip(&ctx.particles.inv_mass[range])
+            .any(|(x, &w)| x.y < 0.0 && w != 0.0);
+        Some(if below {
+            EventState::Occurring
+        } else {
+            EventState::None
+        })
+    }
+
+    fn handles_pieces(&self) -> bool {
+        true
+    }
+
+    fn handle_piece(
+        &self,
+        _t: f64,
+        first: usize,
+        pos: &mut [DVec3],
+        vel: &mut [DVec3],
+        p: &Properties,
+    ) {
+        // As `check` and `handle` do it, particle by particle.
+        for (i, (x, v)) in pos.iter_mut().zip(vel.iter_mut()).enumerate() {
+            if x.y < 0.0 && p.inv_mass[first + i] != 0.0 {
+                if v.y < 0.0 {
+                    v.y *= -p.restitution[first + i];
+                }
+                x.y = 0.0;
+            }
         }
     }
 

@@ -14,6 +14,7 @@
 
 use crate::particle::Properties;
 use glam::DVec3;
+use std::ops::Range;
 
 /// What an event reports about a trial step. Ordered by severity.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Default)]
@@ -53,10 +54,50 @@ pub struct EventContext<'a> {
 }
 
 /// A discrete event: detected after a trial step, handled by changing the state.
-/// Events are `Clone` (derive it), so that a world can be cloned whole.
-pub trait DiscreteEvent: Send + CloneEvent {
+/// Events are `Clone` (derive it), so that a world can be cloned whole, and
+/// `Sync`, so that the threads of a large world can ask
+/// [`check_piece`](Self::check_piece) at once.
+pub trait DiscreteEvent: Send + Sync + CloneEvent {
     /// Inspects the trial state. May remember what it found for `handle`.
     fn check(&mut self, ctx: &EventContext) -> EventState;
+
+    /// [`check`](Self::check) for the particles `range` alone, without
+    /// keeping records, for an event that concerns each particle on its own
+    /// (a floor, a wall); `None`, the default, for the others (events that
+    /// look at pairs, or must keep records in `check`).
+    ///
+    /// A large world on many threads asks each thread about the piece of
+    /// particles it has just integrated, still in its cache (one thread
+    /// reading every particle would pull half the world across cores). The
+    /// event's state is then the worst of its pieces', and `check` is not
+    /// called. An answer must be the state `check` would give if these were
+    /// the only particles.
+    fn check_piece(&self, _ctx: &EventContext, _range: Range<usize>) -> Option<EventState> {
+        None
+    }
+
+    /// True if [`handle_piece`](Self::handle_piece) can stand in for
+    /// [`handle`](Self::handle) (after `check_piece`); false, the default,
+    /// makes a world that found this event occurring call `check` and
+    /// `handle` on one thread.
+    fn handles_pieces(&self) -> bool {
+        false
+    }
+
+    /// [`handle`](Self::handle) for the particles `first..first + pos.len()`
+    /// alone (`pos` and `vel` are theirs; `particles` is the whole world's),
+    /// for events whose [`handles_pieces`](Self::handles_pieces) is true.
+    /// Called for every piece of a trial in which some piece was
+    /// `Occurring`: a piece in which nothing occurs is left as it is.
+    fn handle_piece(
+        &self,
+        _t: f64,
+        _first: usize,
+        _pos: &mut [DVec3],
+        _vel: &mut [DVec3],
+        _particles: &Properties,
+    ) {
+    }
 
     /// Handles the event found by the last `check` (called only after
     /// `Occurring`, or after `Missed` once the step cannot be split further).

@@ -11,6 +11,7 @@
 
 use glam::DVec3;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Worlds with fewer particles stay on one thread.
 pub const MIN_PARTICLES: usize = 4096;
@@ -33,6 +34,19 @@ pub fn by_pieces<const K: usize>(
     slices: [&mut [DVec3]; K],
     body: impl Fn(usize, [&mut [DVec3]; K]) + Sync,
 ) {
+    all_by_pieces(slices, |first, piece| {
+        body(first, piece);
+        true
+    });
+}
+
+/// [`by_pieces`] with a question answered of each piece: true if every
+/// piece's answer was true.
+#[inline]
+pub fn all_by_pieces<const K: usize>(
+    slices: [&mut [DVec3]; K],
+    body: impl Fn(usize, [&mut [DVec3]; K]) -> bool + Sync,
+) -> bool {
     let n = slices.first().map_or(0, |s| s.len());
     let Some(len) = piece_len(n) else {
         return body(0, slices);
@@ -52,5 +66,26 @@ pub fn by_pieces<const K: usize>(
     }
     pieces
         .into_par_iter()
-        .for_each(|(first, piece)| body(first, piece));
+        .map(|(first, piece)| body(first, piece))
+        .reduce(|| true, |a, b| a & b)
+}
+
+/// `body` of each piece `first..first + len` of a world of `n` particles
+/// (the pieces of [`by_pieces`], so each is usually read by the thread that
+/// has just written it), combined in piece order by `combine`, which must
+/// be associative.
+#[inline]
+pub fn map_pieces<R: Send>(
+    n: usize,
+    body: impl Fn(Range<usize>) -> R + Sync,
+    combine: impl Fn(R, R) -> R + Sync + Send,
+) -> R {
+    let Some(len) = piece_len(n) else {
+        return body(0..n);
+    };
+    (0..n.div_ceil(len))
+        .into_par_iter()
+        .map(|k| body(k * len..n.min((k + 1) * len)))
+        .reduce_with(combine)
+        .unwrap_or_else(|| body(0..0))
 }

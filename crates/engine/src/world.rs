@@ -24,6 +24,14 @@ use glam::DVec3;
 /// never shorter than `dt / 2^10`.
 pub const MAX_BACKTRACK_DEPTH: u32 = 10;
 
+/// A large world on many threads checks its events piece by piece when it
+/// has at most this many (each event's answers take three bits of a `u128`).
+const PIECE_EVENTS: usize = 42;
+/// Those bits: some piece occurring, some piece missed, no answer by pieces.
+const OCCURRING: u128 = 1;
+const MISSED: u128 = 2;
+const UNANSWERED: u128 = 4;
+
 /// What happened during one call of [`World::step`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StepReport {
@@ -144,6 +152,9 @@ pub struct World {
     pub(crate) forces: Forces,
     events: Vec<Box<dyn DiscreteEvent>>,
     event_states: Vec<EventState>,
+    /// The last trial's events were checked piece by piece, and those
+    /// occurring can be handled so (see [`DiscreteEvent::check_piece`]).
+    handle_by_pieces: bool,
     integrator: IntegratorKind,
     solver: Solver,
     scratch: Scratch,
@@ -169,6 +180,7 @@ impl World {
             forces: Forces::default(),
             events: Vec::new(),
             event_states: Vec::new(),
+            handle_by_pieces: false,
             integrator: IntegratorKind::default(),
             solver: Solver::default(),
             scratch: Scratch::default(),
@@ -587,7 +599,7 @@ impl World {
     /// of `step`) into the trial buffer and asks every event about the
     /// result; returns the worst state, and whether the integrator knows
     /// the trial to be finite.
-    #[inline]
+    #[inline(always)]
     fn trial(&mut self, t: f64, h: f64, step: f64) -> (EventState, bool) {
         self.scratch.implicit.iterations = 0;
         let mut dynamics = Dynamics {
@@ -596,7 +608,7 @@ impl World {
             scratch: &mut self.scratch,
             solver: self.solver,
         };
-        let finite = integrate(
+        let mut finite = integrate(
             self.integrator,
             &mut dynamics,
             t,
@@ -604,23 +616,35 @@ impl World {
             &self.state,
             &mut self.next,
         );
-        let mut worst = EventState::None;
-        if !self.events.is_empty() {
-            let ctx = EventContext {
-                t: t + h,
-                h,
-                step,
-                flight_shift: self.integrator.free_flight_shift(),
-                pos: &self.next.pos,
-                vel: &self.next.vel,
-                start_pos: &self.state.pos,
-                start_vel: &self.state.vel,
-                particles: &self.particles,
-            };
-            for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
-                *s = e.check(&ctx);
-                worst = worst.max(*s);
+        self.handle_by_pieces = false;
+        let large =
+            crate::parallel::piece_len(self.len()).is_some() && self.events.len() <= PIECE_EVENTS;
+        if self.events.is_empty() && !large {
+            return (EventState::None, finite);
+        }
+        let ctx = EventContext {
+            t: t + h,
+            h,
+            step,
+            flight_shift: self.integrator.free_flight_shift(),
+            pos: &self.next.pos,
+            vel: &self.next.vel,
+            start_pos: &self.state.pos,
+            start_vel: &self.state.vel,
+            particles: &self.particles,
+        };
+        if large {
+            let worst;
+            (finite, worst) = check_by_pieces(&self.events, &mut self.event_states, &ctx, finite);
+            if let Some(worst) = worst {
+                self.handle_by_pieces = true;
+                return (worst, finite);
             }
+        }
+        let mut worst = EventState::None;
+        for (e, s) in self.events.iter_mut().zip(&mut self.event_states) {
+            *s = e.check(&ctx);
+            worst = worst.max(*s);
         }
         (worst, finite)
     }
@@ -632,7 +656,15 @@ impl World {
     #[inline]
     fn accept(&mut self, worst: EventState, finite: bool, t: f64) -> Result<(), SimError> {
         let mut known = finite;
-        if worst != EventState::None {
+        if worst != EventState::None && self.handle_by_pieces {
+            known = handle_by_pieces(
+                &self.events,
+                &self.event_states,
+                t,
+                &mut self.next,
+                &self.particles,
+            );
+        } else if worst != EventState::None {
             for (e, s) in self.events.iter_mut().zip(&self.event_states) {
                 if *s != EventState::None {
                     e.handle(t, &mut self.next.pos, &mut self.next.vel, &self.particles);
@@ -814,16 +846,105 @@ impl World {
     }
 }
 
+/// A large world on many threads checks its trial piece by piece, each
+/// thread the piece it has just written, still in its cache: one thread
+/// reading every particle (as `check` and the serial finiteness scan do)
+/// would pull half the world across cores, and the other thread would then
+/// have to take those lines back to write the next step. Returns whether
+/// the trial is finite (`finite`: already known to be) and, if every event
+/// answered by pieces and those occurring can be handled so, the worst
+/// state (with `states` set); `None` leaves the events to `check`.
+#[inline(never)]
+fn check_by_pieces(
+    events: &[Box<dyn DiscreteEvent>],
+    states: &mut [EventState],
+    ctx: &EventContext,
+    finite: bool,
+) -> (bool, Option<EventState>) {
+    let (finite, flags) = crate::parallel::map_pieces(
+        ctx.pos.len(),
+        |r| {
+            let mut flags = 0u128;
+            for (k, e) in events.iter().enumerate() {
+                let code = match e.check_piece(ctx, r.clone()) {
+                    Some(EventState::None) => 0,
+                    Some(EventState::Occurring) => OCCURRING,
+                    Some(EventState::Missed) => MISSED,
+                    None => UNANSWERED,
+                };
+                flags |= code << (3 * k);
+            }
+            (finite || all_finite(&ctx.pos[r.clone()], &ctx.vel[r]), flags)
+        },
+        |a, b| (a.0 & b.0, a.1 | b.1),
+    );
+    if (0..events.len()).any(|k| flags >> (3 * k) & UNANSWERED != 0) {
+        return (finite, None);
+    }
+    let (mut worst, mut by_pieces) = (EventState::None, true);
+    for (k, (e, s)) in events.iter().zip(states.iter_mut()).enumerate() {
+        let f = flags >> (3 * k);
+        *s = if f & MISSED != 0 {
+            EventState::Missed
+        } else if f & OCCURRING != 0 {
+            EventState::Occurring
+        } else {
+            EventState::None
+        };
+        worst = worst.max(*s);
+        by_pieces &= *s == EventState::None || e.handles_pieces();
+    }
+    // An event handled on one thread needs the records of its `check`.
+    let handled = worst == EventState::None || by_pieces;
+    (finite, handled.then_some(worst))
+}
+
+/// Handles the events of a trial that [`check_by_pieces`] found occurring,
+/// each thread the piece it checked, and looks at it again: true if it is
+/// then finite.
+#[inline(never)]
+fn handle_by_pieces(
+    events: &[Box<dyn DiscreteEvent>],
+    states: &[EventState],
+    t: f64,
+    next: &mut State,
+    particles: &Properties,
+) -> bool {
+    crate::parallel::all_by_pieces([&mut next.pos, &mut next.vel], |first, [pos, vel]| {
+        for (e, s) in events.iter().zip(states) {
+            if *s != EventState::None {
+                e.handle_piece(t, first, pos, vel, particles);
+            }
+        }
+        all_finite(pos, vel)
+    })
+}
+
 /// The index of the first particle with a non-finite position or velocity,
 /// preferring a moving one: a nail next to an overflowing spring goes NaN
 /// only because 0 × ∞ is NaN, and is not the one to blame.
 fn first_non_finite(s: &State, fixed: &[bool]) -> Option<usize> {
-    // A sum of finite numbers is finite (unless it overflows, which the
-    // confirming scan below tells apart) and any inf or NaN makes it
-    // non-finite. Four independent lanes keep the pass short next to the
-    // force loops.
     let n = s.pos.len().min(s.vel.len());
     let (pos, vel) = (&s.pos[..n], &s.vel[..n]);
+    if all_finite(pos, vel) {
+        return None;
+    }
+    let bad = |i: &usize| !(pos[*i].is_finite() && vel[*i].is_finite());
+    (0..n)
+        .filter(|&i| !fixed[i])
+        .find(bad)
+        .or_else(|| (0..n).find(bad))
+}
+
+/// True if every coordinate of `pos` and `vel` (as long as each other) is
+/// finite.
+fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
+    let n = pos.len().min(vel.len());
+    let (pos, vel) = (&pos[..n], &vel[..n]);
+    // A sum of finite numbers is finite (unless it overflows, which the
+    // confirming scan at the end tells apart) and any inf or NaN makes it
+    // non-finite. Four independent lanes keep the pass short next to the
+    // force loops.
     let sum = |p: &DVec3, v: &DVec3| ((p.x + p.y) + (p.z + v.x)) + (v.y + v.z);
     let (mut a, mut b, mut c, mut d) = (0.0, 0.0, 0.0, 0.0);
     let (pc, vc) = (pos.chunks_exact(4), vel.chunks_exact(4));
@@ -837,13 +958,11 @@ fn first_non_finite(s: &State, fixed: &[bool]) -> Option<usize> {
     for (p, v) in pr.iter().zip(vr) {
         a += sum(p, v);
     }
-    let lanes = [a, b, c, d];
-    if lanes.iter().all(|l| l.is_finite()) {
-        return None;
+    if [a, b, c, d].iter().all(|l| l.is_finite()) {
+        return true;
     }
-    let bad = |i: &usize| !(pos[*i].is_finite() && vel[*i].is_finite());
-    (0..n)
-        .filter(|&i| !fixed[i])
-        .find(bad)
-        .or_else(|| (0..n).find(bad))
+    // A sum may overflow with every term finite: look at each.
+    pos.iter()
+        .zip(vel)
+        .all(|(p, v)| p.is_finite() && v.is_finite())
 }

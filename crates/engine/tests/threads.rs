@@ -4,9 +4,11 @@
 //! state's hash is pinned, so a change of the numerics shows up here first.
 
 use animats_engine::{
-    DVec3, FloorDef, IntegratorKind, NBodyGravity, ParticleDef, ParticleId, SpringDef, Targets,
-    World,
+    DVec3, DiscreteEvent, EventContext, EventState, FloorCollision, FloorDef, IntegratorKind,
+    NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SpringDef, Targets, World,
 };
+use std::ops::Range;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// 300 bodies of unequal masses (more than the gather's threshold for
 /// threads) spread through a unit cube by the R3 sequence.
@@ -70,6 +72,13 @@ fn run(threads: usize, softening: f64) -> u64 {
 /// its springs listed in mesh order (most particles belong to one thread) or
 /// shuffled (most are shared).
 fn cloth(kind: IntegratorKind, shuffle: bool) -> World {
+    let mut w = bare_cloth(kind, shuffle);
+    w.add_floor(FloorDef::default()).unwrap();
+    w
+}
+
+/// [`cloth`] without its floor.
+fn bare_cloth(kind: IntegratorKind, shuffle: bool) -> World {
     let n = 64;
     let mut w = World::new();
     w.set_integrator(kind);
@@ -116,7 +125,6 @@ fn cloth(kind: IntegratorKind, shuffle: bool) -> World {
         w.add_spring(SpringDef::new(id(a), id(b), 100.0, 0.05))
             .unwrap();
     }
-    w.add_floor(FloorDef::default()).unwrap();
     w
 }
 
@@ -158,3 +166,182 @@ fn an_n_body_world_is_the_same_bits_on_any_number_of_threads() {
 /// `hash` after 50 steps on 2 threads, softening 0.01 (first measured on an
 /// AVX-512 machine; the kernel test shows AVX2 and SSE2 give the same bits).
 const GOLDEN: u64 = 0x550e_2088_816d_8ecb;
+
+/// Pieces handled by every [`Clamp`] so far.
+static PIECES_HANDLED: AtomicUsize = AtomicUsize::new(0);
+
+/// The peer kit's floor rule at a height (`if y < h { if v_y < 0 { v_y ←
+/// −e v_y }; y ← h }`), a user event written for one thread only, or also
+/// piece by piece.
+#[derive(Clone)]
+struct Clamp {
+    height: f64,
+    by_pieces: bool,
+    below: Vec<usize>,
+}
+
+impl Clamp {
+    fn below(&self, x: DVec3, w: f64) -> bool {
+        x.y < self.height && w != 0.0
+    }
+
+    fn bounce(&self, x: &mut DVec3, v: &mut DVec3, e: f64) {
+        if v.y < 0.0 {
+            v.y *= -e;
+        }
+        x.y = self.height;
+    }
+}
+
+impl DiscreteEvent for Clamp {
+    fn check(&mut self, ctx: &EventContext) -> EventState {
+        self.below = (0..ctx.pos.len())
+            .filter(|&i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]))
+            .collect();
+        if self.below.is_empty() {
+            EventState::None
+        } else {
+            EventState::Occurring
+        }
+    }
+
+    fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
+        let hit = range
+            .clone()
+            .any(|i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]));
+        self.by_pieces.then_some(if hit {
+            EventState::Occurring
+        } else {
+            EventState::None
+        })
+    }
+
+    fn handles_pieces(&self) -> bool {
+        self.by_pieces
+    }
+
+    fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        for &i in &self.below {
+            self.bounce(&mut pos[i], &mut vel[i], p.restitution[i]);
+        }
+    }
+
+    fn handle_piece(
+        &self,
+        _t: f64,
+        first: usize,
+        pos: &mut [DVec3],
+        vel: &mut [DVec3],
+        p: &Properties,
+    ) {
+        PIECES_HANDLED.fetch_add(1, Ordering::Relaxed);
+        for (i, (x, v)) in pos.iter_mut().zip(vel.iter_mut()).enumerate() {
+            if self.below(*x, p.inv_mass[first + i]) {
+                self.bounce(x, v, p.restitution[first + i]);
+            }
+        }
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// A large world checks and handles events piece by piece on many threads
+/// where they allow it, and on one thread where any does not (the engine's
+/// floor keeps records of its bounces): the same bits either way, and as on
+/// one thread.
+#[test]
+fn events_checked_and_handled_by_pieces_are_the_same_bits() {
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        // Above the floor, the clamp alone catches the cloth; at the
+        // floor's height both act, the floor bouncing first.
+        for (floor, height, steps) in [(false, 0.04, 100), (true, 0.0, 150)] {
+            let world = |by_pieces: bool| {
+                move || {
+                    let mut w = if floor {
+                        cloth(kind, true)
+                    } else {
+                        bare_cloth(kind, true)
+                    };
+                    w.add_event(Box::new(Clamp {
+                        height,
+                        by_pieces,
+                        below: Vec::new(),
+                    }));
+                    w
+                }
+            };
+            let one = run_world(1, world(false), steps);
+            let handled = PIECES_HANDLED.load(Ordering::Relaxed);
+            for threads in [2, 3] {
+                let why = format!("{kind}, {threads} threads, floor {floor}");
+                assert_eq!(run_world(threads, world(true), steps), one, "{why}");
+                assert_eq!(run_world(threads, world(false), steps), one, "{why}");
+            }
+            if floor {
+                // The floor did bounce particles.
+                let mut w = world(true)();
+                let mut bounces = 0;
+                for _ in 0..steps {
+                    w.step(1e-3).unwrap();
+                    bounces += w.event::<FloorCollision>().unwrap().collisions().len();
+                }
+                assert!(bounces > 10, "{bounces} bounces");
+            } else {
+                // The pieces were handled apart (this test alone uses the
+                // counter).
+                assert!(PIECES_HANDLED.load(Ordering::Relaxed) > handled);
+            }
+        }
+    }
+    // The clamp did act: particles rest on it, none below.
+    let mut w = bare_cloth(IntegratorKind::Symplectic, true);
+    w.add_event(Box::new(Clamp {
+        height: 0.04,
+        by_pieces: true,
+        below: Vec::new(),
+    }));
+    for _ in 0..100 {
+        w.step(1e-3).unwrap();
+    }
+    let on = w.state().pos.iter().filter(|x| x.y == 0.04).count();
+    let under = w.state().pos.iter().filter(|x| x.y < 0.04).count();
+    assert!(
+        on > 100 && under == 0,
+        "{on} particles on the clamp, {under} below"
+    );
+}
+
+/// A large world that blows up names the same particle at the same time on
+/// any number of threads (each thread looks at its own piece first).
+#[test]
+fn a_blow_up_is_named_alike_on_any_number_of_threads() {
+    let blow_up = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut w = bare_cloth(IntegratorKind::Symplectic, true);
+            w.set_velocity(ParticleId::from_index(3000), DVec3::new(0.0, 1e300, 0.0))
+                .unwrap();
+            for k in 0..1000 {
+                if let Err(e) = w.step(1e-3) {
+                    return (k, e, w.time());
+                }
+            }
+            panic!("no blow-up on {threads} threads");
+        })
+    };
+    let (k, e, t) = blow_up(1);
+    assert!(matches!(e, SimError::NonFinite { .. }), "{e}");
+    for threads in [2, 3] {
+        let (k2, e2, t2) = blow_up(threads);
+        assert_eq!(
+            (k2, e2.to_string(), t2),
+            (k, e.to_string(), t),
+            "{threads} threads"
+        );
+    }
+}

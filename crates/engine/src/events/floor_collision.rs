@@ -37,6 +37,7 @@ use crate::event::{DiscreteEvent, EventContext, EventState};
 use crate::force::Targets;
 use crate::particle::{non_negative, ParticleId, Properties};
 use glam::DVec3;
+use std::ops::Range;
 
 /// One bounce recorded during the last step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -154,6 +155,29 @@ impl DiscreteEvent for FloorCollision {
         } else {
             EventState::Occurring
         }
+    }
+
+    fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
+        if self.targets != Targets::All {
+            return None;
+        }
+        // As `check`: the deepest moving sphere below the plane.
+        let p = ctx.particles;
+        let deepest = ctx.pos[range.clone()]
+            .iter()
+            .zip(&p.radius[range.clone()])
+            .zip(&p.inv_mass[range])
+            .filter(|&(_, &w)| w != 0.0)
+            .map(|((x, r), _)| x.y - r)
+            .filter(|&gap| gap < 0.0)
+            .fold(None, |d: Option<f64>, gap| {
+                Some(d.map_or(gap, |d| d.min(gap)))
+            });
+        Some(match deepest {
+            None => EventState::None,
+            Some(d) if d < -self.envelope => EventState::Missed,
+            Some(_) => EventState::Occurring,
+        })
     }
 
     fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
