@@ -95,7 +95,12 @@ impl Forces {
         };
         // Gravity on every particle starts the accumulator (m g) instead of
         // adding to zeros: one pass over the particles instead of two.
+        let mut springs_done = false;
         match &mut self.gravity {
+            Some(g) if g.targets == Targets::All && self.springs.on_threads() => {
+                self.springs.apply_from(g.g, &particles.mass, &ctx, out);
+                springs_done = true;
+            }
             Some(g) if g.targets == Targets::All => {
                 let (g, mass) = (g.g, &particles.mass);
                 crate::parallel::by_pieces([&mut *out], |first, [out]| {
@@ -110,7 +115,7 @@ impl Forces {
             }
             None => out.fill(DVec3::ZERO),
         }
-        if !self.springs.is_empty() {
+        if !self.springs.is_empty() && !springs_done {
             self.springs.apply(&ctx, out);
         }
         if !self.angle_joints.is_empty() {

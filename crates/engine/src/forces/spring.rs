@@ -240,13 +240,39 @@ impl Springs {
     }
 }
 
+impl Springs {
+    /// True if the springs are split among threads ([`Self::apply_from`]
+    /// can then set gravity in the same fork).
+    #[inline]
+    pub(crate) fn on_threads(&self) -> bool {
+        self.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1
+    }
+
+    /// [`Force::apply`] for springs on threads ([`Self::on_threads`]), each
+    /// thread first setting its particles' forces to `m g`: one fork-join a
+    /// step instead of two. `forces` need not be initialised.
+    #[inline]
+    pub(crate) fn apply_from(
+        &mut self,
+        g: DVec3,
+        mass: &[f64],
+        ctx: &ForceContext,
+        forces: &mut [DVec3],
+    ) {
+        let springs = self.table.all();
+        self.scratch
+            .parallel
+            .apply(springs, ctx.pos, ctx.vel, forces, Some((g, mass)));
+    }
+}
+
 impl Force for Springs {
     #[inline]
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
         let (pos, vel) = (ctx.pos, ctx.vel);
         let springs = self.table.all();
-        if springs.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1 {
-            self.scratch.parallel.apply(springs, pos, vel, forces);
+        if self.on_threads() {
+            self.scratch.parallel.apply(springs, pos, vel, forces, None);
         } else if springs.len() < kernel::MIN_BLOCKED {
             kernel::plain(springs, pos, vel, forces);
         } else {

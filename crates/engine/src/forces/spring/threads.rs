@@ -110,7 +110,17 @@ impl Parallel {
     }
 
     /// Adds every spring's force to its ends, on the current rayon pool.
-    pub fn apply(&mut self, springs: Slice, pos: &[DVec3], vel: &[DVec3], forces: &mut [DVec3]) {
+    /// With `start = Some((g, mass))`, each thread first sets its particles'
+    /// forces to `m g` (uniform gravity on all, in the same fork), which
+    /// `forces` need not hold yet.
+    pub fn apply(
+        &mut self,
+        springs: Slice,
+        pos: &[DVec3],
+        vel: &[DVec3],
+        forces: &mut [DVec3],
+        start: Option<(DVec3, &[f64])>,
+    ) {
         let threads = rayon::current_num_threads();
         self.index(springs, forces.len(), threads);
         let (per_range, per_piece) = (self.per_range, self.per_piece);
@@ -130,6 +140,11 @@ impl Parallel {
         }
         tasks.into_par_iter().for_each(|(t, code, kept, piece)| {
             // (With more threads than springs the last tasks have none.)
+            if let Some((g, mass)) = start {
+                for (f, &m) in piece.iter_mut().zip(&mass[t * per_piece..]) {
+                    *f = m * g;
+                }
+            }
             let first = (t * per_range).min(springs.len());
             let range = springs.range(first..first + kept.len());
             let mut sink = Owned {
