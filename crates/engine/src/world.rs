@@ -821,7 +821,7 @@ impl World {
     }
 
     /// True when nothing in the world can add mechanical energy (see
-    /// [`Force::is_passive`](crate::Force::is_passive)).
+    /// [`Force::is_passive`]).
     pub fn is_passive(&self) -> bool {
         let mut passive = self.events.iter().all(|e| e.is_passive());
         self.forces.for_each(|f| passive &= f.is_passive());
@@ -874,7 +874,10 @@ fn check_by_pieces(
                 };
                 flags |= code << (3 * k);
             }
-            (finite || all_finite(&ctx.pos[r.clone()], &ctx.vel[r]), flags)
+            (
+                finite || all_finite(&ctx.pos[r.clone()], &ctx.vel[r]),
+                flags,
+            )
         },
         |a, b| (a.0 & b.0, a.1 | b.1),
     );
