@@ -155,6 +155,9 @@ pub struct World {
     /// The last trial's events were checked piece by piece, and those
     /// occurring can be handled so (see [`DiscreteEvent::check_piece`]).
     handle_by_pieces: bool,
+    /// An event could not answer by pieces: this world's events are
+    /// checked on one thread (until another event is added).
+    unanswered: bool,
     integrator: IntegratorKind,
     solver: Solver,
     scratch: Scratch,
@@ -181,6 +184,7 @@ impl World {
             events: Vec::new(),
             event_states: Vec::new(),
             handle_by_pieces: false,
+            unanswered: false,
             integrator: IntegratorKind::default(),
             solver: Solver::default(),
             scratch: Scratch::default(),
@@ -478,6 +482,7 @@ impl World {
     pub fn add_event(&mut self, event: Box<dyn DiscreteEvent>) -> usize {
         self.events.push(event);
         self.event_states.push(EventState::None);
+        self.unanswered = false;
         self.events.len() - 1
     }
 
@@ -617,8 +622,9 @@ impl World {
             &mut self.next,
         );
         self.handle_by_pieces = false;
-        let large =
-            crate::parallel::piece_len(self.len()).is_some() && self.events.len() <= PIECE_EVENTS;
+        let large = crate::parallel::piece_len(self.len()).is_some()
+            && self.events.len() <= PIECE_EVENTS
+            && !self.unanswered;
         if self.events.is_empty() && !large {
             return (EventState::None, finite);
         }
@@ -634,11 +640,17 @@ impl World {
             particles: &self.particles,
         };
         if large {
-            let worst;
-            (finite, worst) = check_by_pieces(&self.events, &mut self.event_states, &ctx, finite);
-            if let Some(worst) = worst {
-                self.handle_by_pieces = true;
-                return (worst, finite);
+            let answer;
+            (finite, answer) = check_by_pieces(&self.events, &mut self.event_states, &ctx, finite);
+            match answer {
+                ByPieces::Checked(worst) => {
+                    self.handle_by_pieces = true;
+                    return (worst, finite);
+                }
+                ByPieces::Check => {}
+                // (Sphere contact, say: asking again would only cost a
+                // fork-join every step.)
+                ByPieces::Unanswered => self.unanswered = true,
             }
         }
         let mut worst = EventState::None;
@@ -851,16 +863,15 @@ impl World {
 /// reading every particle (as `check` and the serial finiteness scan do)
 /// would pull half the world across cores, and the other thread would then
 /// have to take those lines back to write the next step. Returns whether
-/// the trial is finite (`finite`: already known to be) and, if every event
-/// answered by pieces and those occurring can be handled so, the worst
-/// state (with `states` set); `None` leaves the events to `check`.
+/// the trial is finite (`finite`: already known to be) and what the events
+/// said.
 #[inline(never)]
 fn check_by_pieces(
     events: &[Box<dyn DiscreteEvent>],
     states: &mut [EventState],
     ctx: &EventContext,
     finite: bool,
-) -> (bool, Option<EventState>) {
+) -> (bool, ByPieces) {
     let (finite, flags) = crate::parallel::map_pieces(
         ctx.pos.len(),
         |r| {
@@ -882,7 +893,7 @@ fn check_by_pieces(
         |a, b| (a.0 & b.0, a.1 | b.1),
     );
     if (0..events.len()).any(|k| flags >> (3 * k) & UNANSWERED != 0) {
-        return (finite, None);
+        return (finite, ByPieces::Unanswered);
     }
     let (mut worst, mut by_pieces) = (EventState::None, true);
     for (k, (e, s)) in events.iter().zip(states.iter_mut()).enumerate() {
@@ -898,8 +909,23 @@ fn check_by_pieces(
         by_pieces &= *s == EventState::None || e.handles_pieces();
     }
     // An event handled on one thread needs the records of its `check`.
-    let handled = worst == EventState::None || by_pieces;
-    (finite, handled.then_some(worst))
+    if worst == EventState::None || by_pieces {
+        (finite, ByPieces::Checked(worst))
+    } else {
+        (finite, ByPieces::Check)
+    }
+}
+
+/// What [`check_by_pieces`] found.
+enum ByPieces {
+    /// Every event answered, and those occurring can be handled by pieces:
+    /// the worst state (each event's is set).
+    Checked(EventState),
+    /// Every event answered, but one occurring must be checked and handled
+    /// on one thread.
+    Check,
+    /// Some event cannot answer by pieces.
+    Unanswered,
 }
 
 /// Handles the events of a trial that [`check_by_pieces`] found occurring,

@@ -5,7 +5,8 @@
 
 use animats_engine::{
     DVec3, DiscreteEvent, EventContext, EventState, FloorCollision, FloorDef, IntegratorKind,
-    NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SpringDef, Targets, World,
+    NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SphereContactDef, SpringDef,
+    Targets, World,
 };
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -343,5 +344,57 @@ fn a_blow_up_is_named_alike_on_any_number_of_threads() {
             (k, e.to_string(), t),
             "{threads} threads"
         );
+    }
+}
+
+/// A large pile of spheres: sphere contact cannot answer by pieces, so the
+/// world checks its events on one thread from its first step on, and again
+/// by pieces once an event is added that can (with contact still there, the
+/// answer is again no). The same bits on 1, 2 and 3 threads either way.
+#[test]
+fn a_large_world_with_sphere_contact_is_the_same_bits_on_any_number_of_threads() {
+    let pile = |clamp: bool| {
+        move || {
+            let mut w = World::new();
+            w.set_integrator(IntegratorKind::Symplectic);
+            w.set_gravity(DVec3::new(0.0, -9.81, 0.0));
+            w.add_floor(FloorDef::default()).unwrap();
+            for i in 0..4096 {
+                let (x, y, z) = (i % 16, i / 256, (i / 16) % 16);
+                let at = DVec3::new(x as f64, y as f64 + 0.5, z as f64) * 0.021
+                    + DVec3::new(0.001 * (i % 3) as f64, 0.0, 0.001 * (i % 5) as f64);
+                w.add_particle(ParticleDef::new(0.01).at(at).with_radius(0.01))
+                    .unwrap();
+            }
+            w.add_sphere_contact(SphereContactDef::default()).unwrap();
+            if clamp {
+                w.add_event(Box::new(Clamp {
+                    height: 0.015,
+                    by_pieces: true,
+                    below: Vec::new(),
+                }));
+            }
+            w
+        }
+    };
+    // The spheres do touch: the second layer rests on the first, which
+    // without contact it would have fallen into (to about 0.014 m).
+    let mut w = pile(false)();
+    for _ in 0..60 {
+        w.step(1e-3).unwrap();
+    }
+    let second = (256..512)
+        .map(|i| w.state().pos[i].y)
+        .fold(f64::INFINITY, f64::min);
+    assert!(second > 0.025, "second layer down to {second} m");
+    for clamp in [false, true] {
+        let one = run_world(1, pile(clamp), 60);
+        for threads in [2, 3] {
+            assert_eq!(
+                run_world(threads, pile(clamp), 60),
+                one,
+                "{threads} threads, clamp {clamp}"
+            );
+        }
     }
 }
