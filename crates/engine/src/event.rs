@@ -88,7 +88,8 @@ pub trait DiscreteEvent: Send + Sync + CloneEvent {
     /// alone (`pos` and `vel` are theirs; `particles` is the whole world's),
     /// for events whose [`handles_pieces`](Self::handles_pieces) is true.
     /// Called for every piece of a trial in which some piece was
-    /// `Occurring`: a piece in which nothing occurs is left as it is.
+    /// `Occurring` (or `Missed`, once the step cannot be split further), so
+    /// it must leave a piece in which nothing happened as it is.
     fn handle_piece(
         &self,
         _t: f64,
