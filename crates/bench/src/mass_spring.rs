@@ -119,7 +119,7 @@ pub fn spring_world(spec: &Spec, k: f64, c: f64, kind: IntegratorKind) -> World 
 /// floor rule, applied after each full step).
 pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
     let mut w = spring_world(spec, STIFFNESS, DAMPING, kind);
-    w.add_event(Box::new(WorkloadFloor::default()));
+    w.add_event(Box::new(WorkloadFloor));
     w
 }
 
@@ -128,24 +128,16 @@ pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
 /// floor is more careful (it reflects the speed at the plane, so an impact
 /// never adds energy, and lets bounces end): a user event reproduces the
 /// published rule exactly, as any user can plug in their own.
+///
+/// The rule looks at each particle on its own, so the event keeps no records:
+/// `check` and `handle` are its piece-by-piece versions over every particle.
 #[derive(Clone, Debug, Default)]
-pub struct WorkloadFloor {
-    below: Vec<u32>,
-}
+pub struct WorkloadFloor;
 
 impl DiscreteEvent for WorkloadFloor {
     fn check(&mut self, ctx: &EventContext) -> EventState {
-        self.below.clear();
-        for (i, x) in ctx.pos.iter().enumerate() {
-            if x.y < 0.0 && ctx.particles.inv_mass[i] != 0.0 {
-                self.below.push(i as u32);
-            }
-        }
-        if self.below.is_empty() {
-            EventState::None
-        } else {
-            EventState::Occurring
-        }
+        self.check_piece(ctx, 0..ctx.pos.len())
+            .unwrap_or(EventState::None)
     }
 
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
@@ -172,7 +164,6 @@ impl DiscreteEvent for WorkloadFloor {
         vel: &mut [DVec3],
         p: &Properties,
     ) {
-        // As `check` and `handle` do it, particle by particle.
         for (i, (x, v)) in pos.iter_mut().zip(vel.iter_mut()).enumerate() {
             if x.y < 0.0 && p.inv_mass[first + i] != 0.0 {
                 if v.y < 0.0 {
@@ -183,14 +174,8 @@ impl DiscreteEvent for WorkloadFloor {
         }
     }
 
-    fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
-        for &i in &self.below {
-            let i = i as usize;
-            if vel[i].y < 0.0 {
-                vel[i].y *= -p.restitution[i];
-            }
-            pos[i].y = 0.0;
-        }
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        self.handle_piece(t, 0, pos, vel, p);
     }
 
     fn name(&self) -> &str {

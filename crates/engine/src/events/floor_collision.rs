@@ -107,6 +107,16 @@ impl FloorCollision {
         Ok(())
     }
 
+    /// What a trial's deepest moving sphere below the plane (its gap, if
+    /// there is one) makes of this event.
+    fn state(&self, deepest: Option<f64>) -> EventState {
+        match deepest {
+            None => EventState::None,
+            Some(d) if d < -self.envelope => EventState::Missed,
+            Some(_) => EventState::Occurring,
+        }
+    }
+
     /// The bounces of the last step.
     pub fn collisions(&self) -> &[Collision] {
         &self.collisions
@@ -148,13 +158,7 @@ impl DiscreteEvent for FloorCollision {
                 }
             }
         }
-        if self.hits.is_empty() {
-            EventState::None
-        } else if deepest < -self.envelope {
-            EventState::Missed
-        } else {
-            EventState::Occurring
-        }
+        self.state((!self.hits.is_empty()).then_some(deepest))
     }
 
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
@@ -173,11 +177,7 @@ impl DiscreteEvent for FloorCollision {
             .fold(None, |d: Option<f64>, gap| {
                 Some(d.map_or(gap, |d| d.min(gap)))
             });
-        Some(match deepest {
-            None => EventState::None,
-            Some(d) if d < -self.envelope => EventState::Missed,
-            Some(_) => EventState::Occurring,
-        })
+        Some(self.state(deepest))
     }
 
     fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
