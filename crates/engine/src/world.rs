@@ -16,7 +16,7 @@ use crate::forces::{
     spring::{SpringDef, SpringId},
     torque_joint::{TorqueJointDef, TorqueJointId},
 };
-use crate::integrators::{integrate, Dynamics, IntegratorKind, Scratch, Solver};
+use crate::integrators::{flat, integrate, widest, Dynamics, IntegratorKind, Scratch, Solver};
 use crate::particle::{ParticleDef, ParticleId, Properties, State};
 use glam::DVec3;
 
@@ -972,26 +972,71 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     let (pos, vel) = (&pos[..n], &vel[..n]);
     // A sum of finite numbers is finite (unless it overflows, which the
     // confirming scan at the end tells apart) and any inf or NaN makes it
-    // non-finite. Four independent lanes keep the pass short next to the
-    // force loops.
-    let sum = |p: &DVec3, v: &DVec3| ((p.x + p.y) + (p.z + v.x)) + (v.y + v.z);
-    let (mut a, mut b, mut c, mut d) = (0.0, 0.0, 0.0, 0.0);
-    let (pc, vc) = (pos.chunks_exact(4), vel.chunks_exact(4));
-    let (pr, vr) = (pc.remainder(), vc.remainder());
-    for (p, v) in pc.zip(vc) {
-        a += sum(&p[0], &v[0]);
-        b += sum(&p[1], &v[1]);
-        c += sum(&p[2], &v[2]);
-        d += sum(&p[3], &v[3]);
-    }
-    for (p, v) in pr.iter().zip(vr) {
-        a += sum(p, v);
-    }
-    if [a, b, c, d].iter().all(|l| l.is_finite()) {
+    // non-finite. Sixteen independent lanes over the flat coordinates, as
+    // wide as the CPU's vectors, keep the pass short next to the force
+    // loops.
+    let (p, v) = (flat(pos), flat(vel));
+    let sums_finite = widest(
+        #[inline(always)]
+        || {
+            const LANES: usize = 16;
+            let mut acc = [0.0f64; LANES];
+            let (pc, vc) = (p.chunks_exact(LANES), v.chunks_exact(LANES));
+            let (pr, vr) = (pc.remainder(), vc.remainder());
+            for (p, v) in pc.zip(vc) {
+                for k in 0..LANES {
+                    acc[k] += p[k] + v[k];
+                }
+            }
+            for (a, (p, v)) in acc.iter_mut().zip(pr.iter().zip(vr)) {
+                *a += p + v;
+            }
+            acc.iter().all(|a| a.is_finite())
+        },
+    );
+    if sums_finite {
         return true;
     }
     // A sum may overflow with every term finite: look at each.
     pos.iter()
         .zip(vel)
         .all(|(p, v)| p.is_finite() && v.is_finite())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{all_finite, first_non_finite};
+    use crate::particle::State;
+    use glam::DVec3;
+
+    /// The wide scan finds one bad coordinate wherever it is (inside the
+    /// vectors or in the remainder), and is not fooled by finite numbers
+    /// whose sum overflows.
+    #[test]
+    fn the_finiteness_scan_finds_every_bad_coordinate() {
+        for n in [1, 5, 16, 37] {
+            let pos: Vec<DVec3> = (0..n).map(|i| DVec3::splat(i as f64 - 3.5)).collect();
+            let vel: Vec<DVec3> = (0..n).map(|i| DVec3::splat(0.25 * i as f64)).collect();
+            assert!(all_finite(&pos, &vel));
+            let huge = vec![DVec3::splat(f64::MAX); n];
+            assert!(
+                all_finite(&huge, &huge),
+                "{n}: finite, though the sums overflow"
+            );
+            for i in 0..n {
+                for k in 0..3 {
+                    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                        for in_pos in [true, false] {
+                            let (mut p, mut v) = (pos.clone(), vel.clone());
+                            let x = if in_pos { &mut p[i] } else { &mut v[i] };
+                            x[k] = bad;
+                            assert!(!all_finite(&p, &v), "{n} particles, {i}.{k} = {bad}");
+                            let s = State { pos: p, vel: v };
+                            assert_eq!(first_non_finite(&s, &vec![false; n]), Some(i));
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

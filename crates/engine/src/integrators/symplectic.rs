@@ -2,7 +2,7 @@
 //! `x₁ = x₀ + h v₁`. First order, but symplectic: on a conservative system its
 //! energy error oscillates and stays bounded instead of drifting.
 
-use super::{flat, flat_mut, Coord, Dynamics, SMALL};
+use super::{flat, flat_mut, widest, Coord, Dynamics, SMALL};
 use crate::parallel::by_pieces;
 use crate::particle::State;
 
@@ -27,7 +27,10 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
             flat(&f[r]),
         );
         let w = &w3[3 * first..3 * first + x0.len()];
-        update(x0, v0, f, w, h, flat_mut(x1), flat_mut(v1));
+        widest(
+            #[inline(always)]
+            || update(x0, v0, f, w, h, flat_mut(x1), flat_mut(v1)),
+        );
     });
     false
 }
@@ -56,4 +59,32 @@ fn update<T: Coord>(
         finite &= v.finite() & x.finite();
     }
     finite
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{on, test_numbers, Width};
+    use super::update;
+
+    /// The flat update gives the same bits compiled for every instruction
+    /// set this CPU has (a length that is no multiple of any vector).
+    #[test]
+    fn every_width_updates_to_the_same_bits() {
+        let n = 3 * 37;
+        let (x0, v0, f) = (test_numbers(n, 1), test_numbers(n, 2), test_numbers(n, 3));
+        let w: Vec<f64> = test_numbers(n, 4).iter().map(|w| w.abs()).collect();
+        let run = |width| {
+            let (mut x1, mut v1) = (vec![0.0; n], vec![0.0; n]);
+            on(
+                width,
+                #[inline(always)]
+                || update(&x0, &v0, &f, &w, 1e-3, &mut x1, &mut v1),
+            );
+            [x1, v1].map(|a| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
+        };
+        let base = run(Width::Base);
+        for width in Width::available() {
+            assert_eq!(run(width), base, "{width:?}");
+        }
+    }
 }
