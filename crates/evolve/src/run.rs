@@ -311,7 +311,8 @@ impl State {
 
     /// Advances every lane by up to `generations` generations (not past the
     /// configured total); lanes and each generation's evaluations in
-    /// parallel on the current rayon pool.
+    /// parallel on the current rayon pool, each thread taking the free lane
+    /// that has done the fewest generations of the batch.
     pub fn advance(&mut self, generations: u64) -> Result<(), String> {
         let problem = self.config.problem.build()?;
         self.advance_with(problem.as_ref(), generations)
@@ -321,18 +322,12 @@ impl State {
     /// `self.config.problem` (a long run builds it once, not per batch).
     pub fn advance_with(&mut self, problem: &dyn Problem, generations: u64) -> Result<(), String> {
         let target = self.config.generations;
-        let results: Vec<Result<Vec<LogRow>, String>> = self
+        let todo: Vec<u64> = self
             .lanes
-            .par_iter_mut()
-            .map(|lane| {
-                let n = generations.min(target.saturating_sub(lane.generation));
-                advance_lane(lane, problem, n)
-            })
+            .iter()
+            .map(|l| generations.min(target.saturating_sub(l.generation)))
             .collect();
-        let mut rows = Vec::new();
-        for r in results {
-            rows.extend(r?);
-        }
+        let rows = advance_lanes(&mut self.lanes, &todo, problem)?;
         self.extend_log(rows);
         Ok(())
     }
@@ -503,6 +498,94 @@ impl State {
 }
 
 /// Generations of one lane; rows in generation order.
+/// Advances lane `k` by `todo[k]` generations, on every thread of the
+/// current rayon pool, one generation at a time: a thread that has finished
+/// a generation takes next the free lane that has done the fewest (the
+/// lowest-numbered among equals). A lane's generations still run one after
+/// another, each a pure function of the one before, so the results do not
+/// depend on which thread runs what; but no thread waits for another at the
+/// end of a lane's share, as it would with a lane per task (the thesis's six
+/// lanes on two threads, lanes of unequal cost: 4.66 s against 4.0 s for
+/// half the work of one thread). No thread ever blocks: one that finds every
+/// unfinished lane taken stops, since what is left is sequential.
+fn advance_lanes(
+    lanes: &mut [Lane],
+    todo: &[u64],
+    problem: &dyn Problem,
+) -> Result<Vec<LogRow>, String> {
+    use std::sync::Mutex;
+    struct Slot<'a> {
+        /// `None` while a thread advances it.
+        lane: Option<&'a mut Lane>,
+        done: u64,
+        todo: u64,
+    }
+    struct Board<'a> {
+        slots: Vec<Slot<'a>>,
+        rows: Vec<LogRow>,
+        /// The first error, by lane.
+        error: Option<(usize, String)>,
+    }
+    let board = Mutex::new(Board {
+        slots: lanes
+            .iter_mut()
+            .zip(todo)
+            .map(|(lane, &todo)| Slot {
+                lane: Some(lane),
+                done: 0,
+                todo,
+            })
+            .collect(),
+        rows: Vec::new(),
+        error: None,
+    });
+    let work = || loop {
+        let taken = {
+            let Ok(mut b) = board.lock() else { return };
+            if b.error.is_some() {
+                return;
+            }
+            let next = b
+                .slots
+                .iter()
+                .enumerate()
+                .filter(|(_, s)| s.lane.is_some() && s.done < s.todo)
+                .min_by_key(|(k, s)| (s.done, *k))
+                .map(|(k, _)| k);
+            let Some(k) = next else { return };
+            b.slots[k].lane.take().map(|lane| (k, lane))
+        };
+        let Some((k, lane)) = taken else { return };
+        let result = advance_lane(lane, problem, 1);
+        let Ok(mut b) = board.lock() else { return };
+        match result {
+            Ok(rows) => b.rows.extend(rows),
+            Err(e) => {
+                if b.error.as_ref().is_none_or(|(j, _)| k < *j) {
+                    b.error = Some((k, e));
+                }
+            }
+        }
+        let slot = &mut b.slots[k];
+        slot.done += 1;
+        slot.lane = Some(lane);
+    };
+    let threads = rayon::current_num_threads().min(lanes_len(todo)).max(1);
+    (0..threads).into_par_iter().for_each(|_| work());
+    let board = board
+        .into_inner()
+        .map_err(|_| "an evaluation panicked".to_string())?;
+    match board.error {
+        Some((_, e)) => Err(e),
+        None => Ok(board.rows),
+    }
+}
+
+/// How many lanes have generations to do.
+fn lanes_len(todo: &[u64]) -> usize {
+    todo.iter().filter(|&&n| n > 0).count()
+}
+
 fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {

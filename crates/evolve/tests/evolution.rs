@@ -278,3 +278,73 @@ fn a_run_evaluated_elsewhere_equals_one_advanced_here() {
     let g = s.ask();
     assert!(s.tell(g, &[]).is_err());
 }
+
+/// The roobot's problem, counting and recording its evaluations, failing
+/// from the `fail_after`-th on.
+struct Counted {
+    inner: Box<dyn animats_evolve::Problem>,
+    seen: std::sync::Mutex<Vec<Vec<f64>>>,
+    fail_after: usize,
+}
+
+impl animats_evolve::Problem for Counted {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn start(&self) -> Vec<f64> {
+        self.inner.start()
+    }
+    fn bounds(&self) -> Option<animats_evolve::optimiser::Bounds> {
+        self.inner.bounds()
+    }
+    fn relative_mutation(&self) -> bool {
+        self.inner.relative_mutation()
+    }
+    fn evaluate(&self, genome: &[f64]) -> Result<animats_evolve::Outcome, String> {
+        let n = {
+            let mut seen = self.seen.lock().unwrap();
+            seen.push(genome.to_vec());
+            seen.len()
+        };
+        if n > self.fail_after {
+            return Err(format!("evaluation {n}: budget spent"));
+        }
+        self.inner.evaluate(genome)
+    }
+}
+
+fn counted(config: &Config, fail_after: usize) -> Counted {
+    Counted {
+        inner: config.problem.build().unwrap(),
+        seen: std::sync::Mutex::new(Vec::new()),
+        fail_after,
+    }
+}
+
+#[test]
+fn lanes_advance_together_and_a_failure_stops_the_batch() {
+    // On one thread the lanes take turns, the least advanced first: the
+    // first generation of every lane (the starting parameters) before any
+    // lane's second.
+    let config = Config::thesis(3, 20, 5);
+    let problem = counted(&config, usize::MAX);
+    let mut s = State::new(config.clone()).unwrap();
+    pool(1).install(|| s.advance_with(&problem, 4)).unwrap();
+    let seen = problem.seen.into_inner().unwrap();
+    assert_eq!(seen.len(), 12);
+    let start = config.problem.build().unwrap().start();
+    assert!(seen[..3].iter().all(|g| *g == start), "{:?}", &seen[..4]);
+    assert!(seen[3..].iter().all(|g| *g != start));
+    // A failing evaluation ends the batch with its message, on any number
+    // of threads, and nothing waits for it forever.
+    for threads in [1, 2, 3] {
+        let problem = counted(&config, 5);
+        let mut s = State::new(config.clone()).unwrap();
+        let err = pool(threads)
+            .install(|| s.advance_with(&problem, 10))
+            .unwrap_err();
+        assert!(err.contains("budget spent"), "{threads} threads: {err}");
+        let evaluated = problem.seen.into_inner().unwrap().len();
+        assert!(evaluated <= 5 + threads, "{threads} threads: {evaluated}");
+    }
+}
