@@ -497,7 +497,6 @@ impl State {
     }
 }
 
-/// Generations of one lane; rows in generation order.
 /// Advances lane `k` by `todo[k]` generations, on every thread of the
 /// current rayon pool, one generation at a time: a thread that has finished
 /// a generation takes next the free lane that has done the fewest (the
@@ -586,6 +585,7 @@ fn lanes_len(todo: &[u64]) -> usize {
     todo.iter().filter(|&&n| n > 0).count()
 }
 
+/// Generations of one lane; rows in generation order.
 fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {

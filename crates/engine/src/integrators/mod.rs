@@ -253,8 +253,8 @@ pub(crate) fn widest<R>(body: impl FnOnce() -> R) -> R {
     on(Width::Base, body)
 }
 
-/// Calls `body` compiled for `width`, which must be one of
-/// [`Width::available`] (the baseline otherwise).
+/// Calls `body` compiled for `width` if this CPU has that instruction set,
+/// else for the baseline.
 #[inline(always)]
 pub(crate) fn on<R>(width: Width, body: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
