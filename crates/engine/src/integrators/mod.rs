@@ -206,8 +206,10 @@ impl Coord for DVec3 {
 pub(crate) enum Width {
     /// The x86-64 baseline (SSE2), or whatever the target has elsewhere.
     Base,
-    /// AVX2: four f64 a vector.
+    /// AVX2: four f64 a vector (named by the tests; [`on`] falls back to
+    /// it from AVX-512).
     #[cfg(target_arch = "x86_64")]
+    #[cfg_attr(not(test), allow(dead_code))]
     Avx2,
     /// AVX-512F: eight f64 a vector.
     #[cfg(target_arch = "x86_64")]
@@ -242,19 +244,13 @@ impl Width {
 #[inline(always)]
 pub(crate) fn widest<R>(body: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            return on(Width::Avx512, body);
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            return on(Width::Avx2, body);
-        }
-    }
+    return on(Width::Avx512, body);
+    #[cfg(not(target_arch = "x86_64"))]
     on(Width::Base, body)
 }
 
-/// Calls `body` compiled for `width` if this CPU has that instruction set,
-/// else for the baseline.
+/// Calls `body` compiled for `width`, or for the widest narrower
+/// instruction set this CPU has.
 #[inline(always)]
 pub(crate) fn on<R>(width: Width, body: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
@@ -267,20 +263,33 @@ pub(crate) fn on<R>(width: Width, body: impl FnOnce() -> R) -> R {
         unsafe fn avx2<R>(body: impl FnOnce() -> R) -> R {
             body()
         }
-        match width {
-            Width::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
-                // SAFETY: the CPU has AVX-512F (checked just above).
-                return unsafe { avx512(body) };
-            }
-            Width::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
-                // SAFETY: the CPU has AVX2 (checked just above).
-                return unsafe { avx2(body) };
-            }
-            _ => {}
+        if width == Width::Avx512 && std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F (checked just above).
+            return unsafe { avx512(body) };
+        }
+        if width != Width::Base && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            return unsafe { avx2(body) };
         }
     }
     let _ = width;
     body()
+}
+
+/// Asserts that `run` gives the same results compiled for every
+/// instruction set this CPU has as for the baseline.
+#[cfg(test)]
+pub(crate) fn assert_same_on_every_width<T: PartialEq + fmt::Debug>(run: impl Fn(Width) -> T) {
+    let base = run(Width::Base);
+    for width in Width::available() {
+        assert_eq!(run(width), base, "{width:?}");
+    }
+}
+
+/// The bits of each number of each array, to compare exactly.
+#[cfg(test)]
+pub(crate) fn bits<const K: usize>(arrays: [Vec<f64>; K]) -> [Vec<u64>; K] {
+    arrays.map(|a| a.iter().map(|x| x.to_bits()).collect())
 }
 
 /// A slice of vectors as one flat array, x, y, z of each in turn.

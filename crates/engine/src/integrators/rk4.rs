@@ -141,7 +141,7 @@ impl Start<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{on, test_numbers, Width};
+    use super::super::{assert_same_on_every_width, bits, on, test_numbers};
     use super::{stage, FIRST, LAST, MIDDLE};
 
     /// Every stage's flat update gives the same bits compiled for every
@@ -151,7 +151,7 @@ mod tests {
         let n = 3 * 37;
         let (x0, v0, f) = (test_numbers(n, 5), test_numbers(n, 6), test_numbers(n, 7));
         let w: Vec<f64> = test_numbers(n, 8).iter().map(|w| w.abs()).collect();
-        let run = |width| {
+        assert_same_on_every_width(|width| {
             let mut t = [9, 10, 11, 12].map(|seed| test_numbers(n, seed));
             let [x, v, dx, dv] = &mut t;
             on(
@@ -163,11 +163,7 @@ mod tests {
                     stage::<f64, LAST>(1e-3 / 6.0, [&x0, &v0, &f], &w, [x, v, dx, dv]);
                 },
             );
-            t.map(|a| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
-        };
-        let base = run(Width::Base);
-        for width in Width::available() {
-            assert_eq!(run(width), base, "{width:?}");
-        }
+            bits(t)
+        });
     }
 }

@@ -63,7 +63,7 @@ fn update<T: Coord>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::{on, test_numbers, Width};
+    use super::super::{assert_same_on_every_width, bits, on, test_numbers};
     use super::update;
 
     /// The flat update gives the same bits compiled for every instruction
@@ -73,18 +73,14 @@ mod tests {
         let n = 3 * 37;
         let (x0, v0, f) = (test_numbers(n, 1), test_numbers(n, 2), test_numbers(n, 3));
         let w: Vec<f64> = test_numbers(n, 4).iter().map(|w| w.abs()).collect();
-        let run = |width| {
+        assert_same_on_every_width(|width| {
             let (mut x1, mut v1) = (vec![0.0; n], vec![0.0; n]);
             on(
                 width,
                 #[inline(always)]
                 || update(&x0, &v0, &f, &w, 1e-3, &mut x1, &mut v1),
             );
-            [x1, v1].map(|a| a.iter().map(|x| x.to_bits()).collect::<Vec<_>>())
-        };
-        let base = run(Width::Base);
-        for width in Width::available() {
-            assert_eq!(run(width), base, "{width:?}");
-        }
+            bits([x1, v1])
+        });
     }
 }
