@@ -65,6 +65,13 @@ impl Forces {
         self.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g)
     }
 
+    /// Whether evaluating splits work over the current rayon pool's
+    /// threads, for a world of `n` particles (user forces aside: what they
+    /// do inside is theirs).
+    pub(crate) fn on_threads(&self, n: usize) -> bool {
+        self.springs.on_threads() || self.nbody.iter().any(|g| g.on_threads(n))
+    }
+
     pub(crate) fn add_user(&mut self, force: Box<dyn Force>) -> usize {
         match force.stage() {
             Stage::Body => self.user_body.push(force),

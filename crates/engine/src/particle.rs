@@ -217,12 +217,19 @@ impl State {
     pub fn is_empty(&self) -> bool {
         self.pos.is_empty()
     }
-    #[inline]
+    /// Makes room for `n` particles (a test inlined into the step; the
+    /// growing is out of line).
+    #[inline(always)]
     pub(crate) fn resize(&mut self, n: usize) {
         if self.pos.len() != n || self.vel.len() != n {
-            self.pos.resize(n, DVec3::ZERO);
-            self.vel.resize(n, DVec3::ZERO);
+            self.grow(n);
         }
+    }
+
+    #[cold]
+    fn grow(&mut self, n: usize) {
+        self.pos.resize(n, DVec3::ZERO);
+        self.vel.resize(n, DVec3::ZERO);
     }
 }
 

@@ -565,7 +565,36 @@ impl World {
     /// last good state (with its time: after a blow-up inside a backtracked
     /// step, the time of the last piece accepted) and an error names the
     /// particle.
+    ///
+    /// A world that splits its work over threads, stepped from outside a
+    /// rayon pool, runs the whole step on the global pool: each split would
+    /// otherwise send its pieces there and wait for them (17–60 µs a split
+    /// on a 2-core machine, several splits a step), where the pool's own
+    /// threads fork and join in about a microsecond while they are awake.
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        if self.on_threads() && rayon::current_thread_index().is_none() {
+            return self.step_in_pool(dt);
+        }
+        self.step_here(dt)
+    }
+
+    /// [`World::step`] on a thread of the global pool.
+    #[cold]
+    #[inline(never)]
+    fn step_in_pool(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        rayon::scope(|_| self.step_here(dt))
+    }
+
+    /// Whether a step splits some of its work over the current rayon
+    /// pool's threads (the per-particle loops of a large world, many
+    /// springs, a large n-body group).
+    fn on_threads(&self) -> bool {
+        crate::parallel::piece_len(self.len()).is_some() || self.forces.on_threads(self.len())
+    }
+
+    /// [`World::step`] on the calling thread.
+    #[inline(always)]
+    fn step_here(&mut self, dt: f64) -> Result<StepReport, SimError> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(SimError::BadStep(dt));
         }

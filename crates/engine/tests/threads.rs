@@ -398,3 +398,95 @@ fn a_large_world_with_sphere_contact_is_the_same_bits_on_any_number_of_threads()
         }
     }
 }
+
+/// A force that adds nothing and counts where it was evaluated: on a rayon
+/// pool's thread, or not.
+#[derive(Clone, Default)]
+struct WhereEvaluated {
+    on_pool: std::sync::Arc<AtomicUsize>,
+    elsewhere: std::sync::Arc<AtomicUsize>,
+}
+
+impl animats_engine::Force for WhereEvaluated {
+    fn apply(&mut self, _ctx: &animats_engine::ForceContext, _forces: &mut [DVec3]) {
+        let count = if rayon::current_thread_index().is_some() {
+            &self.on_pool
+        } else {
+            &self.elsewhere
+        };
+        count.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// A world to step: its name, how to make it, and whether its steps should
+/// run on the pool.
+type Case = (&'static str, fn() -> World, bool);
+
+/// A world that splits its work, stepped from outside any pool (as the CLI
+/// and the Python bindings step), runs each whole step on the global pool's
+/// threads (then its splits are fork-joins among them, not one round trip
+/// from this thread each) and ends in the same bits as on one thread; a
+/// small world never leaves the calling thread (waking the pool would cost
+/// more than its step).
+#[test]
+fn a_world_that_splits_steps_on_the_pool_and_a_small_one_where_it_is_called() {
+    assert!(
+        rayon::current_thread_index().is_none(),
+        "tests run outside the pool"
+    );
+    let splits = rayon::current_num_threads() > 1;
+    let cases: [Case; 3] = [
+        (
+            "the 64 × 64 cloth",
+            || bare_cloth(IntegratorKind::Rk4, true),
+            splits,
+        ),
+        (
+            "300 bodies' gravity",
+            || {
+                let mut w = world(0.01);
+                w.set_integrator(IntegratorKind::Rk4);
+                w
+            },
+            splits,
+        ),
+        ("a 10-particle chain", || chain(10), false),
+    ];
+    for (name, make, on_pool) in cases {
+        let counts = WhereEvaluated::default();
+        let mut w = make();
+        w.add_force(Box::new(counts.clone()));
+        for _ in 0..5 {
+            w.step(1e-3).unwrap();
+        }
+        // RK4: four evaluations a step.
+        let (pool, here) = (
+            counts.on_pool.load(Ordering::Relaxed),
+            counts.elsewhere.load(Ordering::Relaxed),
+        );
+        let expected = if on_pool { (20, 0) } else { (0, 20) };
+        assert_eq!((pool, here), expected, "{name}: (on the pool, elsewhere)");
+        let mut alone = make();
+        alone.add_force(Box::new(WhereEvaluated::default()));
+        let one = run_world(1, move || alone, 5);
+        assert_eq!(hash(&w), one, "{name}: the same bits as on one thread");
+    }
+}
+
+/// `n` particles in a row joined by springs, the first nailed.
+fn chain(n: usize) -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Rk4);
+    w.set_gravity(DVec3::new(0.0, -9.81, 0.0));
+    for i in 0..n {
+        let mut p = ParticleDef::new(0.1).at(DVec3::new(0.1 * i as f64, 1.0, 0.0));
+        p.fixed = i == 0;
+        w.add_particle(p).unwrap();
+    }
+    for i in 1..n {
+        let id = ParticleId::from_index;
+        w.add_spring(SpringDef::new(id(i - 1), id(i), 50.0, 0.1))
+            .unwrap();
+    }
+    w
+}

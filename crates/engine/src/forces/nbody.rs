@@ -63,6 +63,17 @@ impl NBodyGravity {
         Ok(())
     }
 
+    /// Whether its evaluation splits over the current rayon pool's threads
+    /// in a world of `n` particles.
+    pub(crate) fn on_threads(&self, n: usize) -> bool {
+        let bodies = if self.targets == Targets::All {
+            n
+        } else {
+            self.indices.len()
+        };
+        gather::splits(bodies) && rayon::current_num_threads() > 1
+    }
+
     fn resolve(&mut self, n: usize) {
         if self.targets == Targets::All && self.indices.len() != n {
             self.indices = (0..n as u32).collect();

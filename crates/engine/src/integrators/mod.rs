@@ -157,12 +157,19 @@ pub struct Scratch {
 }
 
 impl Scratch {
-    #[inline]
+    /// Makes room for `n` particles (the same `n` every step but the
+    /// first: a test inlined into the step).
+    #[inline(always)]
     pub(crate) fn resize(&mut self, n: usize) {
         if self.force.len() != n {
-            for v in [&mut self.force, &mut self.dx, &mut self.dv] {
-                v.resize(n, DVec3::ZERO);
-            }
+            self.grow(n);
+        }
+    }
+
+    #[cold]
+    fn grow(&mut self, n: usize) {
+        for v in [&mut self.force, &mut self.dx, &mut self.dv] {
+            v.resize(n, DVec3::ZERO);
         }
     }
 }

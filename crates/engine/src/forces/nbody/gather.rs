@@ -67,7 +67,7 @@ impl Gather {
             m: &self.m,
             eps2,
         };
-        if n >= 2 * ROWS_PER_TASK {
+        if splits(n) {
             self.ax
                 .par_chunks_mut(ROWS_PER_TASK)
                 .zip(self.ay.par_chunks_mut(ROWS_PER_TASK))
@@ -78,6 +78,11 @@ impl Gather {
             src.rows(0, &mut self.ax, &mut self.ay, &mut self.az);
         }
     }
+}
+
+/// Whether `n` bodies are gathered in parallel (more than one task's rows).
+pub(super) fn splits(n: usize) -> bool {
+    n >= 2 * ROWS_PER_TASK
 }
 
 /// The bodies, read-only, shared by the threads.
