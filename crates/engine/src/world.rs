@@ -568,9 +568,10 @@ impl World {
     ///
     /// A world that splits its work over threads, stepped from outside a
     /// rayon pool, runs the whole step on the global pool: each split would
-    /// otherwise send its pieces there and wait for them (17–60 µs a split
-    /// on a 2-core machine, several splits a step), where the pool's own
-    /// threads fork and join in about a microsecond while they are awake.
+    /// otherwise send its pieces there and wait for them (16–53 µs a split
+    /// on a 2-core machine, several splits a step), where a pool's own
+    /// thread splits in 0–8 µs (the `outside_pool` example of
+    /// `animats-bench` measures both).
     pub fn step(&mut self, dt: f64) -> Result<StepReport, SimError> {
         if self.on_threads() && rayon::current_thread_index().is_none() {
             return self.step_in_pool(dt);
