@@ -37,6 +37,9 @@ pub struct Forces {
     pub(crate) floor: Option<FloorContact>,
     pub(crate) user_body: Vec<Box<dyn Force>>,
     pub(crate) user_contact: Vec<Box<dyn Force>>,
+    /// Keep the per-particle loops in one piece even in a large world (set
+    /// by the world; see `World::one_piece`).
+    pub(crate) one_piece: bool,
 }
 
 impl Forces {
@@ -110,7 +113,7 @@ impl Forces {
             }
             Some(g) if g.targets == Targets::All => {
                 let (g, mass) = (g.g, &particles.mass);
-                crate::parallel::by_pieces([&mut *out], |first, [out]| {
+                crate::parallel::by_pieces(!self.one_piece, [&mut *out], |first, [out]| {
                     for (f, &m) in out.iter_mut().zip(&mass[first..]) {
                         *f = m * g;
                     }

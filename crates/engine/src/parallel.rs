@@ -28,13 +28,14 @@ pub fn piece_len(n: usize) -> Option<usize> {
 
 /// Calls `body(first, pieces)` for contiguous pieces `first..first + len` of
 /// the `slices` (all as long as each other): once with everything for small
-/// worlds, once per thread for large ones.
+/// worlds or without `split`, once per thread for large ones.
 #[inline]
 pub fn by_pieces<const K: usize>(
+    split: bool,
     slices: [&mut [DVec3]; K],
     body: impl Fn(usize, [&mut [DVec3]; K]) + Sync,
 ) {
-    all_by_pieces(slices, |first, piece| {
+    all_by_pieces(split, slices, |first, piece| {
         body(first, piece);
         true
     });
@@ -44,11 +45,12 @@ pub fn by_pieces<const K: usize>(
 /// piece's answer was true.
 #[inline]
 pub fn all_by_pieces<const K: usize>(
+    split: bool,
     slices: [&mut [DVec3]; K],
     body: impl Fn(usize, [&mut [DVec3]; K]) -> bool + Sync,
 ) -> bool {
     let n = slices.first().map_or(0, |s| s.len());
-    let Some(len) = piece_len(n) else {
+    let Some(len) = piece_len(n).filter(|_| split) else {
         return body(0, slices);
     };
     let mut rest = slices;

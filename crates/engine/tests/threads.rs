@@ -418,28 +418,35 @@ impl animats_engine::Force for WhereEvaluated {
     }
 }
 
-/// A world to step: its name, how to make it, and whether its steps should
-/// run on the pool.
-type Case = (&'static str, fn() -> World, bool);
+/// A world to step: its name, how to make it, and how many of its force
+/// evaluations in five RK4 steps should run on the pool and elsewhere.
+type Case = (&'static str, fn() -> World, (usize, usize));
 
 /// A world that splits its work, stepped from outside any pool (as the CLI
 /// and the Python bindings step), runs each whole step on the global pool's
 /// threads (then its splits are fork-joins among them, not one round trip
 /// from this thread each) and ends in the same bits as on one thread; a
 /// small world never leaves the calling thread (waking the pool would cost
-/// more than its step).
+/// more than its step), nor does a large pile of spheres once its contact
+/// has said it cannot answer by pieces (its per-particle loops then stay in
+/// one piece).
 #[test]
 fn a_world_that_splits_steps_on_the_pool_and_a_small_one_where_it_is_called() {
     assert!(
         rayon::current_thread_index().is_none(),
         "tests run outside the pool"
     );
-    let splits = rayon::current_num_threads() > 1;
-    let cases: [Case; 3] = [
+    // Five RK4 steps: twenty evaluations.
+    let (all_on_pool, none) = if rayon::current_num_threads() > 1 {
+        ((20, 0), (4, 16))
+    } else {
+        ((0, 20), (0, 20))
+    };
+    let cases: [Case; 4] = [
         (
             "the 64 × 64 cloth",
             || bare_cloth(IntegratorKind::Rk4, true),
-            splits,
+            all_on_pool,
         ),
         (
             "300 bodies' gravity",
@@ -448,29 +455,45 @@ fn a_world_that_splits_steps_on_the_pool_and_a_small_one_where_it_is_called() {
                 w.set_integrator(IntegratorKind::Rk4);
                 w
             },
-            splits,
+            all_on_pool,
         ),
-        ("a 10-particle chain", || chain(10), false),
+        ("4,096 spheres with contact", spheres, none),
+        ("a 10-particle chain", || chain(10), (0, 20)),
     ];
-    for (name, make, on_pool) in cases {
+    for (name, make, expected) in cases {
         let counts = WhereEvaluated::default();
         let mut w = make();
         w.add_force(Box::new(counts.clone()));
         for _ in 0..5 {
             w.step(1e-3).unwrap();
         }
-        // RK4: four evaluations a step.
         let (pool, here) = (
             counts.on_pool.load(Ordering::Relaxed),
             counts.elsewhere.load(Ordering::Relaxed),
         );
-        let expected = if on_pool { (20, 0) } else { (0, 20) };
         assert_eq!((pool, here), expected, "{name}: (on the pool, elsewhere)");
         let mut alone = make();
         alone.add_force(Box::new(WhereEvaluated::default()));
         let one = run_world(1, move || alone, 5);
         assert_eq!(hash(&w), one, "{name}: the same bits as on one thread");
     }
+}
+
+/// 4,096 spheres in a 16-wide cube of layers 1 mm apart, sphere contact and
+/// a floor, RK4.
+fn spheres() -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Rk4);
+    w.set_gravity(DVec3::new(0.0, -9.81, 0.0));
+    w.add_floor(FloorDef::default()).unwrap();
+    for i in 0..4096 {
+        let (x, y, z) = (i % 16, i / 256, (i / 16) % 16);
+        let at = DVec3::new(x as f64, y as f64 + 0.5, z as f64) * 0.021;
+        w.add_particle(ParticleDef::new(0.01).at(at).with_radius(0.01))
+            .unwrap();
+    }
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    w
 }
 
 /// `n` particles in a row joined by springs, the first nailed.

@@ -7,11 +7,12 @@ use crate::particle::State;
 
 /// One explicit Euler step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    let split = !d.scratch.one_piece;
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
     let (w, f) = (&d.particles.inv_mass, &*f);
-    by_pieces([&mut to.pos, &mut to.vel], |first, [x1, v1]| {
+    by_pieces(split, [&mut to.pos, &mut to.vel], |first, [x1, v1]| {
         for (k, (x1, v1)) in x1.iter_mut().zip(v1.iter_mut()).enumerate() {
             let i = first + k;
             *x1 = from.pos[i] + h * from.vel[i];

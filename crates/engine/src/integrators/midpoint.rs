@@ -8,6 +8,7 @@ use crate::particle::State;
 
 /// One midpoint step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    let split = !d.scratch.one_piece;
     let f = &mut d.scratch.force;
     let w = &d.particles.inv_mass;
     d.forces
@@ -15,7 +16,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     let half = 0.5 * h;
     // The trial (midpoint) state lives in `to` until the final update.
     let fr = &*f;
-    by_pieces([&mut to.pos, &mut to.vel], |first, [x, v]| {
+    by_pieces(split, [&mut to.pos, &mut to.vel], |first, [x, v]| {
         for (k, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
             let i = first + k;
             *x = from.pos[i] + half * from.vel[i];
@@ -25,7 +26,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     d.forces
         .evaluate(t + half, h, &to.pos, &to.vel, d.particles, f);
     let fr = &*f;
-    by_pieces([&mut to.pos, &mut to.vel], |first, [x, v]| {
+    by_pieces(split, [&mut to.pos, &mut to.vel], |first, [x, v]| {
         for (k, (x, v)) in x.iter_mut().zip(v.iter_mut()).enumerate() {
             let i = first + k;
             let vm = *v;

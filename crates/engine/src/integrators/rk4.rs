@@ -19,6 +19,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
         v0,
         w: &d.particles.inv_mass,
         w3: &d.particles.inv_mass3,
+        split: !s.one_piece,
     };
     // Stage 1 at (x0, v0). Trial states live in `to`; `dx`, `dv` accumulate
     // the weighted derivatives.
@@ -107,6 +108,8 @@ struct Start<'a> {
     v0: &'a [DVec3],
     w: &'a [f64],
     w3: &'a [f64],
+    /// Split a large world's loops over the pool's threads.
+    split: bool,
 }
 
 impl Start<'_> {
@@ -121,7 +124,7 @@ impl Start<'_> {
         if self.x0.len() < SMALL {
             return stage::<_, STAGE>(s, [self.x0, self.v0, f], self.w, [x, v, dx, dv]);
         }
-        by_pieces([x, v, dx, dv], |first, [x, v, dx, dv]| {
+        by_pieces(self.split, [x, v, dx, dv], |first, [x, v, dx, dv]| {
             let r = first..first + x.len();
             let start = [
                 flat(&self.x0[r.clone()]),

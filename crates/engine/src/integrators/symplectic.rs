@@ -9,6 +9,7 @@ use crate::particle::State;
 /// One symplectic Euler step of size `h` from time `t`; true if it knows
 /// every new coordinate to be finite (see [`super::integrate`]).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    let split = !d.scratch.one_piece;
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
@@ -19,7 +20,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     }
     // Each coordinate on its own, as one flat loop the compiler vectorises.
     let w3 = &d.particles.inv_mass3;
-    by_pieces([&mut to.pos, &mut to.vel], |first, [x1, v1]| {
+    by_pieces(split, [&mut to.pos, &mut to.vel], |first, [x1, v1]| {
         let r = first..first + x1.len();
         let (x0, v0, f) = (
             flat(&from.pos[r.clone()]),
