@@ -598,11 +598,11 @@ impl World {
     /// gravity) in one piece: when one of its events cannot answer by
     /// pieces (sphere contact), it checks and handles every particle on
     /// one thread every step, much more work than those loops, while the
-    /// pool's other threads fall asleep; waking them for the loops, and
-    /// moving the world between cores' caches, cost more than the loops
-    /// save (a pile of 10,000 spheres 3 % slower on two threads than on
-    /// one). Springs split over threads keep the loops split with them,
-    /// in the same pieces. The results are the same bits either way.
+    /// pool's other threads fall asleep, and waking them for the loops
+    /// cost more than the loops save (a pile of 10,000 spheres 3 % slower
+    /// on two threads than on one). Springs split over threads keep the
+    /// loops split with them, in the same pieces. The results are the same
+    /// bits either way.
     fn one_piece(&self) -> bool {
         self.unanswered && !self.forces.springs.on_threads()
     }
