@@ -2,7 +2,9 @@
 //! symplectic steps of the workload (`mass_spring::engine_world`), of the
 //! same without its floor rule (no event to check), and of 1,000 force
 //! evaluations alone at its starting state, on a pool of one thread and of
-//! two, for `--runs` runs each (default 7).
+//! two, for `--runs` runs each (default 7); then the force evaluations on
+//! one thread alone and with a second, independent copy running on the
+//! other core at the same time (what the hardware shares).
 //!
 //! `cargo run --release -p animats-bench --example cloth_threads`
 
@@ -79,6 +81,46 @@ fn main() {
             b * 1e3,
             e * 1e3,
             (s - e) * 1e3
+        );
+    }
+    // The machine's share: two copies of the whole evaluation, one per
+    // core, at once, each on its own world (nothing shared but the
+    // hardware), against one copy alone.
+    let evaluate_alone = || -> f64 {
+        let w = engine_world(&spec, IntegratorKind::Symplectic);
+        let (state, particles) = (w.state().clone(), w.particles().clone());
+        let mut forces = w.forces().clone();
+        let mut out = vec![DVec3::ZERO; state.pos.len()];
+        let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(1).build() else {
+            eprintln!("cloth_threads: cannot start a thread");
+            std::process::exit(1);
+        };
+        median(
+            (0..runs)
+                .map(|_| {
+                    pool.install(|| {
+                        let t = Instant::now();
+                        for _ in 0..1000 {
+                            forces
+                                .evaluate(0.0, 1e-3, &state.pos, &state.vel, &particles, &mut out);
+                        }
+                        t.elapsed().as_secs_f64()
+                    })
+                })
+                .collect(),
+        )
+    };
+    let alone = evaluate_alone();
+    let both: Vec<f64> = std::thread::scope(|s| {
+        let copies: Vec<_> = (0..2).map(|_| s.spawn(evaluate_alone)).collect();
+        copies.into_iter().filter_map(|c| c.join().ok()).collect()
+    });
+    if let [a, b] = both[..] {
+        println!(
+            "1,000 force evaluations on one thread: {:.1} ms alone, {:.1} / {:.1} ms with a second copy on the other core",
+            alone * 1e3,
+            a * 1e3,
+            b * 1e3
         );
     }
 }

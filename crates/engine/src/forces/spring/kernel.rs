@@ -179,55 +179,41 @@ fn run_any<S: Sink>(springs: Slice, block: &mut Block, pos: &[DVec3], vel: &[DVe
     sink.finish();
 }
 
-/// The one-thread sink: `+f` on `a`, `−f` on `b`, straight into the forces
-/// of particles `lo..lo + forces.len()`: the whole world (`PIECE` false, `lo`
-/// zero: no subtraction in the loop), or the piece of it one thread owns.
+/// The one-thread sink: `+f` on `a`, `−f` on `b`, straight into `forces`,
+/// indexed by the ends it is given (the world's particle indices, or a
+/// thread's piece's: `threads.rs` gives its blocks ends counted from the
+/// piece's first particle, so that no end needs a subtraction here).
 ///
 /// Consecutive springs sharing their first end (a mesh lists a particle's
 /// springs together) add to a register instead of to memory: the same
 /// additions in the same order, without waiting for each store to reach the
 /// next load. No spring of such a run has that particle as its second end (a
 /// spring's ends differ), so memory and register never disagree about it.
-pub(super) struct Scatter<'a, const PIECE: bool> {
+pub(super) struct Scatter<'a> {
     pub forces: &'a mut [DVec3],
-    pub lo: usize,
     run: Option<usize>,
     acc: DVec3,
 }
 
-impl<'a> Scatter<'a, false> {
-    /// A sink adding to every particle's force.
+impl<'a> Scatter<'a> {
+    /// A sink adding to `forces`.
     pub fn new(forces: &'a mut [DVec3]) -> Self {
         Scatter {
             forces,
-            lo: 0,
             run: None,
             acc: DVec3::ZERO,
         }
     }
 }
 
-impl<'a> Scatter<'a, true> {
-    /// A sink adding to `forces`, the forces of particles `lo..`.
-    pub fn piece(forces: &'a mut [DVec3], lo: usize) -> Self {
-        Scatter {
-            forces,
-            lo,
-            run: None,
-            acc: DVec3::ZERO,
-        }
-    }
-}
-
-impl<const PIECE: bool> Sink for Scatter<'_, PIECE> {
+impl Sink for Scatter<'_> {
     #[inline(always)]
     fn take(&mut self, _: usize, ends: &[[u32; 2]], block: &Block) {
         let (mut run, mut acc) = (self.run, self.acc);
-        let lo = if PIECE { self.lo } else { 0 };
         let forces = &mut *self.forces;
         for (i, &[a, b]) in ends.iter().enumerate() {
             let f = block.force(i);
-            let a = a as usize - lo;
+            let a = a as usize;
             if run != Some(a) {
                 if let Some(p) = run {
                     forces[p] = acc;
@@ -236,7 +222,7 @@ impl<const PIECE: bool> Sink for Scatter<'_, PIECE> {
                 acc = forces[a];
             }
             acc += f;
-            forces[b as usize - lo] -= f;
+            forces[b as usize] -= f;
         }
         (self.run, self.acc) = (run, acc);
     }

@@ -11,7 +11,7 @@
 //! (`+f` as a spring's first end, `−f` as its second): the same bits on any
 //! number of threads.
 
-use super::kernel::{run, Block, Scatter, Sink};
+use super::kernel::{run, Block, Scatter, Sink, BLOCK};
 use super::Slice;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -33,6 +33,14 @@ pub(super) struct Parallel {
     /// (bit 1) are particles of its task's piece whose springs all lie in
     /// its range, which its task adds to directly.
     code: Vec<u8>,
+    /// For each block of each range (`per_range.div_ceil(BLOCK)` a range),
+    /// whether every end of its springs is its task's own (code 3): such a
+    /// block goes straight to the one-thread scatter.
+    whole: Vec<bool>,
+    /// Each spring's ends counted from the first particle of its task's
+    /// piece (meaningful where they are its task's own): the whole blocks'
+    /// scatter then indexes the piece without a subtraction per end.
+    local: Vec<[u32; 2]>,
     /// The other particles with springs and, for the `k`-th, its springs
     /// in order in `ends[start[k]..start[k + 1]]`, each `index << 1 | 1`
     /// where the particle is the spring's second end.
@@ -81,11 +89,27 @@ impl Parallel {
         for k in 0..shared.len() {
             start[k + 1] += start[k];
         }
-        let code = springs
+        let code: Vec<u8> = springs
             .ends
             .iter()
             .map(|&[a, b]| u8::from(owned[a as usize]) | u8::from(owned[b as usize]) << 1)
             .collect();
+        let local = springs
+            .ends
+            .iter()
+            .enumerate()
+            .map(|(i, &[a, b])| {
+                let lo = (i / per_range * per_piece) as u32;
+                [a.wrapping_sub(lo), b.wrapping_sub(lo)]
+            })
+            .collect();
+        let per_block = per_range.div_ceil(BLOCK);
+        let mut whole = vec![false; threads * per_block];
+        for (t, range) in code.chunks(per_range).enumerate() {
+            for (k, block) in range.chunks(BLOCK).enumerate() {
+                whole[t * per_block + k] = block.iter().all(|&c| c == 3);
+            }
+        }
         let mut next = start.clone();
         let mut ends = vec![0u32; start[shared.len()] as usize];
         for (i, &[a, b]) in springs.ends.iter().enumerate() {
@@ -102,6 +126,8 @@ impl Parallel {
             per_range,
             per_piece,
             code,
+            whole,
+            local,
             shared,
             start,
             ends,
@@ -138,6 +164,8 @@ impl Parallel {
             piece = rest;
             tasks.push((t, c, k, p));
         }
+        let (whole, per_block, local) =
+            (&self.whole[..], per_range.div_ceil(BLOCK), &self.local[..]);
         tasks.into_par_iter().for_each(|(t, code, kept, piece)| {
             // (With more threads than springs the last tasks have none.)
             if let Some((g, mass)) = start {
@@ -148,8 +176,11 @@ impl Parallel {
             let first = (t * per_range).min(springs.len());
             let range = springs.range(first..first + kept.len());
             let mut sink = Owned {
-                scatter: Scatter::piece(piece, t * per_piece),
+                scatter: Scatter::new(piece),
+                lo: t * per_piece,
                 code,
+                whole: &whole[t * per_block..(t + 1) * per_block],
+                local: &local[first..first + kept.len()],
                 kept,
             };
             run(range, &mut Block::default(), pos, vel, &mut sink);
@@ -173,9 +204,15 @@ impl Parallel {
 struct Owned<'a> {
     /// Adds to the piece's particles (all of a block's springs' ends are
     /// owned, the usual case).
-    scatter: Scatter<'a, true>,
+    scatter: Scatter<'a>,
+    /// The first particle of the piece.
+    lo: usize,
+    /// This range's springs' ends counted from `lo` (see [`Parallel::local`]).
+    local: &'a [[u32; 2]],
     /// This range's springs' codes (see [`Parallel::code`]).
     code: &'a [u8],
+    /// This range's blocks' flags (see [`Parallel::whole`]).
+    whole: &'a [bool],
     /// This range's springs' kept forces.
     kept: &'a mut [DVec3],
 }
@@ -183,12 +220,13 @@ struct Owned<'a> {
 impl Sink for Owned<'_> {
     #[inline(always)]
     fn take(&mut self, first: usize, ends: &[[u32; 2]], block: &Block) {
-        let code = &self.code[first..first + ends.len()];
-        if code.iter().all(|&c| c == 3) {
-            return self.scatter.take(first, ends, block);
+        if self.whole[first / BLOCK] {
+            let local = &self.local[first..first + ends.len()];
+            return self.scatter.take(first, local, block);
         }
+        let code = &self.code[first..first + ends.len()];
         self.scatter.finish();
-        let lo = self.scatter.lo;
+        let lo = self.lo;
         let piece = &mut *self.scatter.forces;
         let kept = &mut self.kept[first..first + ends.len()];
         // As the one-thread sink: a run of springs with the same first end
