@@ -37,8 +37,9 @@ pub struct Forces {
     pub(crate) floor: Option<FloorContact>,
     pub(crate) user_body: Vec<Box<dyn Force>>,
     pub(crate) user_contact: Vec<Box<dyn Force>>,
-    /// Keep the per-particle loops in one piece even in a large world (set
-    /// by the world; see `World::one_piece`).
+    /// Keep the per-particle loops (gravity here, the integrators' updates)
+    /// in one piece even in a large world (set by the world; see
+    /// `World::one_piece`).
     pub(crate) one_piece: bool,
 }
 

@@ -651,9 +651,7 @@ impl World {
     #[inline(always)]
     fn trial(&mut self, t: f64, h: f64, step: f64) -> (EventState, bool) {
         self.scratch.implicit.iterations = 0;
-        let one_piece = self.one_piece();
-        self.scratch.one_piece = one_piece;
-        self.forces.one_piece = one_piece;
+        self.forces.one_piece = self.one_piece();
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,

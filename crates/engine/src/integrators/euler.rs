@@ -7,7 +7,7 @@ use crate::particle::State;
 
 /// One explicit Euler step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    let split = !d.scratch.one_piece;
+    let split = !d.forces.one_piece;
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);

@@ -8,7 +8,7 @@ use crate::particle::State;
 
 /// One midpoint step of size `h` from time `t`.
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    let split = !d.scratch.one_piece;
+    let split = !d.forces.one_piece;
     let f = &mut d.scratch.force;
     let w = &d.particles.inv_mass;
     d.forces

@@ -154,9 +154,6 @@ pub struct Scratch {
     pub dv: Vec<DVec3>,
     /// The implicit step's linear system.
     pub implicit: implicit::Buffers,
-    /// Keep the per-particle loops in one piece even in a large world (set
-    /// by the world; see `World::one_piece`).
-    pub(crate) one_piece: bool,
 }
 
 impl Scratch {

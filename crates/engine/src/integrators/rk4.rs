@@ -19,7 +19,7 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
         v0,
         w: &d.particles.inv_mass,
         w3: &d.particles.inv_mass3,
-        split: !s.one_piece,
+        split: !d.forces.one_piece,
     };
     // Stage 1 at (x0, v0). Trial states live in `to`; `dx`, `dv` accumulate
     // the weighted derivatives.
