@@ -46,14 +46,17 @@ pub(crate) fn room(at: &At, field: &str, count: usize, world: &World) -> Result<
 pub(crate) struct At<'s> {
     src: &'s Source<'s>,
     entry: String,
-    line: usize,
+    /// Where the entry starts in the file: its line is counted only for an
+    /// error (counting it for every entry made loading quadratic in the
+    /// file's size: 35 s for a 16,384-particle cloth).
+    offset: usize,
 }
 
 impl At<'_> {
     pub(crate) fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
         SceneError {
             file: self.src.file.to_string(),
-            line: Some(self.line),
+            line: Some(self.src.line_of(self.offset)),
             entry: Some(self.entry.clone()),
             field: (!field.is_empty()).then(|| field.to_string()),
             message: message.into(),
@@ -98,7 +101,7 @@ pub(crate) fn at<'s, T>(
     At {
         src,
         entry: entry.into(),
-        line: src.line_of(spanned.span().start),
+        offset: spanned.span().start,
     }
 }
 
@@ -162,7 +165,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         None => At {
             src,
             entry: "world".into(),
-            line: 1,
+            offset: 0,
         },
     };
     let gravity = wat.vec3("gravity", wd.gravity)?;
