@@ -261,18 +261,25 @@ pub fn run(args: Args) -> Result<(), Failure> {
     // Where things are at t = 0, which the framing is for (the first frame
     // drawn may be later: a PNG draws only the last).
     let at_start = snapshot(&stage, &describe);
-    let mut snapshots = Vec::with_capacity(times.len());
-    for &t in &times {
-        while stage.time() < t - 0.5 * dt {
-            stage.step(dt).map_err(|e| {
-                Failure::Blowup(format!(
-                    "{}: {e}; nothing was written",
-                    args.scene.display()
-                ))
-            })?;
+    // A world that splits its work over threads enters the pool once for
+    // all the frames' steps, not at every step (the same bits).
+    let pooled = stage.scene().world.steps_on_pool();
+    let run = || -> Result<Vec<Snapshot>, Failure> {
+        let mut snapshots = Vec::with_capacity(times.len());
+        for &t in &times {
+            while stage.time() < t - 0.5 * dt {
+                stage.step(dt).map_err(|e| {
+                    Failure::Blowup(format!(
+                        "{}: {e}; nothing was written",
+                        args.scene.display()
+                    ))
+                })?;
+            }
+            snapshots.push(snapshot(&stage, &describe));
         }
-        snapshots.push(snapshot(&stage, &describe));
-    }
+        Ok(snapshots)
+    };
+    let snapshots = animats_engine::on_pool_if(pooled, run)?;
 
     let base = Camera::framing(DVec3::from_array(describe.target), describe.distance);
     let followed = stage.followed().to_vec();

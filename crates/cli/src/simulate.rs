@@ -35,6 +35,36 @@ pub struct Args {
     fps: f64,
 }
 
+/// The error for a blow-up at `step`: when, and which particle by name;
+/// the trajectory so far is kept under a `.partial` name, never the
+/// requested one.
+fn blowup(
+    args: &Args,
+    scene: &animats_scene::Scene,
+    e: &SimError,
+    step: &str,
+    trajectory: Option<Trajectory>,
+) -> Failure {
+    let message = match e.blame() {
+        Some((particle, time)) => format!(
+            "{}: the simulation {} at t = {time} s ({step}): {}; try a smaller --dt",
+            args.scene.display(),
+            if matches!(e, SimError::NonFinite { .. }) {
+                "went non-finite"
+            } else {
+                "diverged"
+            },
+            e.what(scene.name(particle))
+        ),
+        None => format!("{}: {e}", args.scene.display()),
+    };
+    let kept = trajectory.and_then(|t| t.abandon());
+    let note = kept.map_or(String::new(), |p| {
+        format!("\n(the trajectory up to then is in {})", p.display())
+    });
+    Failure::Blowup(format!("{message}{note}"))
+}
+
 fn parse_integrator(s: &str) -> Result<IntegratorKind, String> {
     s.parse()
 }
@@ -83,36 +113,27 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if let Some(t) = trajectory.as_mut() {
         t.record_scene(&scene, 0).map_err(write_err)?;
     }
-    let mut iterations = 0u64;
-    for step in 1..=steps {
-        let stepped = scene.step(dt);
-        iterations += scene.world.last_step().solver_iterations as u64;
-        if let Err(e) = stepped {
-            let message = match e.blame() {
-                Some((particle, time)) => format!(
-                    "{}: the simulation {} at t = {time} s (step {step} of {steps}): {}; try a smaller --dt",
-                    args.scene.display(),
-                    if matches!(e, SimError::NonFinite { .. }) {
-                        "went non-finite"
-                    } else {
-                        "diverged"
-                    },
-                    e.what(scene.name(particle))
-                ),
-                None => format!("{}: {e}", args.scene.display()),
-            };
-            let kept = trajectory.and_then(|t| t.abandon());
-            let note = kept.map_or(String::new(), |p| {
-                format!("\n(the trajectory up to then is in {})", p.display())
-            });
-            return Err(Failure::Blowup(format!("{message}{note}")));
-        }
-        if let Some(t) = trajectory.as_mut() {
-            if step % args.every == 0 || step == steps {
-                t.record_scene(&scene, step).map_err(write_err)?;
+    // A world that splits its work over threads enters the pool once for
+    // the whole run instead of at every step (the same bits).
+    let pooled = scene.world.steps_on_pool();
+    let run = || -> Result<u64, Failure> {
+        let mut iterations = 0u64;
+        for step in 1..=steps {
+            let stepped = scene.step(dt);
+            iterations += scene.world.last_step().solver_iterations as u64;
+            if let Err(e) = stepped {
+                let step = format!("step {step} of {steps}");
+                return Err(blowup(&args, &scene, &e, &step, trajectory.take()));
+            }
+            if let Some(t) = trajectory.as_mut() {
+                if step % args.every == 0 || step == steps {
+                    t.record_scene(&scene, step).map_err(write_err)?;
+                }
             }
         }
-    }
+        Ok(iterations)
+    };
+    let iterations = animats_engine::on_pool_if(pooled, run)?;
     let wall = start.elapsed().as_secs_f64();
 
     let world = &scene.world;
@@ -217,55 +238,55 @@ fn realtime(args: Args) -> Result<(), Failure> {
         args.scene.display(),
         args.fps
     );
-    while scene.world.time() < duration - 1e-12 {
-        let work = Instant::now();
-        let frame = frame_dt.min(duration - scene.world.time());
-        let n = (frame / max_dt).ceil().max(1.0);
-        let h = frame / n;
-        for _ in 0..n as u64 {
-            if let Err(e) = scene.step(h) {
-                let kept = trajectory.and_then(|t| t.abandon());
-                let note = kept.map_or(String::new(), |p| {
-                    format!(" (trajectory so far in {})", p.display())
-                });
-                return Err(Failure::Blowup(format!(
-                    "{}: {e}{note}",
-                    args.scene.display()
-                )));
-            }
-            steps += 1;
-            if let Some(t) = trajectory.as_mut() {
-                if steps.is_multiple_of(args.every) {
-                    t.record(scene.world.time(), steps, scene.world.state())
-                        .map_err(Failure::Other)?;
+    // As in `run`: a world that splits its work enters the pool once.
+    let pooled = scene.world.steps_on_pool();
+    let run = || -> Result<(), Failure> {
+        while scene.world.time() < duration - 1e-12 {
+            let work = Instant::now();
+            let frame = frame_dt.min(duration - scene.world.time());
+            let n = (frame / max_dt).ceil().max(1.0);
+            let h = frame / n;
+            for _ in 0..n as u64 {
+                if let Err(e) = scene.step(h) {
+                    let step = format!("step {}", steps + 1);
+                    return Err(blowup(&args, &scene, &e, &step, trajectory.take()));
+                }
+                steps += 1;
+                if let Some(t) = trajectory.as_mut() {
+                    if steps.is_multiple_of(args.every) {
+                        t.record(scene.world.time(), steps, scene.world.state())
+                            .map_err(Failure::Other)?;
+                    }
                 }
             }
+            busy += work.elapsed();
+            frames += 1;
+            next_frame += frame_period;
+            let now = Instant::now();
+            if next_frame > now {
+                std::thread::sleep(next_frame - now);
+            } else {
+                next_frame = now; // behind: do not try to catch up in a burst
+            }
+            let interval = second_start.elapsed().as_secs_f64();
+            if interval >= 1.0 {
+                let sim = scene.world.time() - sim_at_second;
+                println!(
+                    "t = {:7.2} s  {:5.1} frames/s  simulated/real {:.3}  step {:.5} s  CPU {:.1}%",
+                    scene.world.time(),
+                    frames as f64 / interval,
+                    sim / interval,
+                    frame_dt / n,
+                    100.0 * busy.as_secs_f64() / interval
+                );
+                frame_dt = (3.0 * frame_dt + interval / frames as f64) / 4.0;
+                (second_start, frames, sim_at_second, busy) =
+                    (Instant::now(), 0, scene.world.time(), Duration::ZERO);
+            }
         }
-        busy += work.elapsed();
-        frames += 1;
-        next_frame += frame_period;
-        let now = Instant::now();
-        if next_frame > now {
-            std::thread::sleep(next_frame - now);
-        } else {
-            next_frame = now; // behind: do not try to catch up in a burst
-        }
-        let interval = second_start.elapsed().as_secs_f64();
-        if interval >= 1.0 {
-            let sim = scene.world.time() - sim_at_second;
-            println!(
-                "t = {:7.2} s  {:5.1} frames/s  simulated/real {:.3}  step {:.5} s  CPU {:.1}%",
-                scene.world.time(),
-                frames as f64 / interval,
-                sim / interval,
-                frame_dt / n,
-                100.0 * busy.as_secs_f64() / interval
-            );
-            frame_dt = (3.0 * frame_dt + interval / frames as f64) / 4.0;
-            (second_start, frames, sim_at_second, busy) =
-                (Instant::now(), 0, scene.world.time(), Duration::ZERO);
-        }
-    }
+        Ok(())
+    };
+    animats_engine::on_pool_if(pooled, run)?;
     if let Some(t) = trajectory {
         let written = t.frames();
         let path = t.finish().map_err(Failure::Other)?;

@@ -489,3 +489,55 @@ fn implicit_runs_a_step_past_the_explicit_limit_without_a_warning() {
         .unwrap_or(-1.0);
     assert!(per_step > 0.0, "{out}");
 }
+
+#[test]
+fn realtime_runs_to_the_duration_and_a_blow_up_there_names_the_particle_and_keeps_a_partial() {
+    let dir = scratch("realtime");
+    let out = dir.join("rt.csv");
+    let o = animats(&[
+        "simulate",
+        "scenes/oscillator.toml",
+        "--realtime",
+        "--duration",
+        "0.2",
+        "--fps",
+        "100",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(stdout.contains("to t = 0.200 s"), "{stdout}");
+    let csv = std::fs::read_to_string(&out).unwrap();
+    let last: f64 = csv
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap();
+    assert!((last - 0.2).abs() < 1e-9, "the last row is at t = {last}");
+
+    // The stiff spring blows up within a few hundred steps (the guard
+    // calls it diverged, or it goes non-finite), as without --realtime:
+    // exit 3, the particle by name, the step, and the trajectory so far
+    // kept as .partial only.
+    let scene = write(&dir, "stiff.toml", STIFF_SCENE);
+    let out = dir.join("stiff.csv");
+    let o = animats(&[
+        "simulate",
+        &scene,
+        "--realtime",
+        "--fps",
+        "240",
+        "--output",
+        out.to_str().unwrap(),
+    ]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains(" at t = ") && err.contains("`wobbly`") && err.contains("(step "),
+        "{err}"
+    );
+    assert!(!out.exists(), "no file under the requested name");
+    assert!(dir.join("stiff.csv.partial").exists(), "{err}");
+}

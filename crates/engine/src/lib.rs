@@ -64,6 +64,6 @@ pub use integrators::{IntegratorKind, Solver};
 pub use jacobian::Jacobian;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
 pub use snapshot::Snapshot;
-pub use world::{Energy, FloorDef, Stats, StepLimit, StepReport, World};
+pub use world::{on_pool, on_pool_if, Energy, FloorDef, Stats, StepLimit, StepReport, World};
 
 pub use glam::DVec3;

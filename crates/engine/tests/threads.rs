@@ -465,10 +465,38 @@ fn a_world_that_splits_steps_on_the_pool_and_a_small_one_where_it_is_called() {
             counts.elsewhere.load(Ordering::Relaxed),
         );
         assert_eq!((pool, here), expected, "{name}: (on the pool, elsewhere)");
+        // What `steps_on_pool` tells a caller with a loop of steps: true
+        // exactly for the worlds whose steps went to the pool.
+        let splits = expected == all_on_pool && rayon::current_num_threads() > 1;
+        assert_eq!(w.steps_on_pool(), splits, "{name}: steps_on_pool");
+        let moved = &mut w; // a World is Send, not Sync
+        assert!(
+            !animats_engine::on_pool(move || moved.steps_on_pool()),
+            "{name}: on a pool thread, a step stays where it is"
+        );
         let mut alone = make();
         alone.add_force(Box::new(WhereEvaluated::default()));
         let one = run_world(1, move || alone, 5);
         assert_eq!(hash(&w), one, "{name}: the same bits as on one thread");
+        // The same five steps as one loop inside `on_pool`: every
+        // evaluation on the pool, the same bits.
+        let counts = WhereEvaluated::default();
+        let mut looped = make();
+        looped.add_force(Box::new(counts.clone()));
+        animats_engine::on_pool(|| {
+            for _ in 0..5 {
+                looped.step(1e-3).unwrap();
+            }
+        });
+        assert_eq!(
+            (
+                counts.on_pool.load(Ordering::Relaxed),
+                counts.elsewhere.load(Ordering::Relaxed)
+            ),
+            (20, 0),
+            "{name}: a loop inside on_pool evaluates on the pool"
+        );
+        assert_eq!(hash(&looped), one, "{name}: the same bits inside on_pool");
     }
 }
 

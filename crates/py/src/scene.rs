@@ -229,10 +229,7 @@ impl World {
         let scene = &mut *s;
         py.detach(|| {
             let dt = scene.dt;
-            for _ in 0..n {
-                scene.step(dt).map_err(|e| e.to_string())?;
-            }
-            Ok::<(), String>(())
+            scene.steps(n, dt).map_err(|e| e.to_string())
         })
         .map_err(runtime_error)
     }

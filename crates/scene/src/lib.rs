@@ -105,6 +105,16 @@ impl Scene {
         self.advance(dt)
     }
 
+    /// `n` steps of `dt`, each a [`Scene::step`]; a world that splits its
+    /// work over threads enters the global rayon pool once for all of them
+    /// ([`animats_engine::on_pool_if`]) instead of at every step. Stops at the
+    /// first blow-up.
+    pub fn steps(&mut self, n: u64, dt: f64) -> Result<(), SimError> {
+        animats_engine::on_pool_if(self.world.steps_on_pool(), || {
+            (0..n).try_for_each(|_| self.step(dt).map(drop))
+        })
+    }
+
     /// Like [`Scene::step`], but a program is the brain: every actuator is
     /// driven towards `levels` (scene order, each at most its `rate`
     /// allows) and no controller runs. The other actors act as usual.

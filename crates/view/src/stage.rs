@@ -16,6 +16,12 @@ pub trait Stage: Send {
     fn time(&self) -> f64;
     /// Advances by `dt`.
     fn step(&mut self, dt: f64) -> Result<(), String>;
+    /// Whether a step from this thread goes to the thread pool (a large
+    /// world: see `World::steps_on_pool`), so that a loop of steps should
+    /// run inside `animats_engine::on_pool_if`.
+    fn steps_on_pool(&self) -> bool {
+        false
+    }
     /// Writes every particle's position, x y z in order.
     fn positions(&self, out: &mut Vec<f32>);
     /// Every creature's state.
@@ -224,6 +230,10 @@ impl Stage for SceneStage {
 
     fn time(&self) -> f64 {
         self.scene.world.time()
+    }
+
+    fn steps_on_pool(&self) -> bool {
+        self.scene.world.steps_on_pool()
     }
 
     fn step(&mut self, dt: f64) -> Result<(), String> {

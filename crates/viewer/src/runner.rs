@@ -120,6 +120,17 @@ impl Runner {
         self.out.scene.send_replace(json.into());
     }
 
+    /// Steps while `more` says so; a large world's loop runs on the thread
+    /// pool, entering it once instead of at every step (the same bits).
+    fn step_while(&mut self, more: impl Fn(&Runner) -> bool + Send) {
+        let pooled = self.stage.steps_on_pool();
+        animats_engine::on_pool_if(pooled, move || {
+            while more(self) {
+                self.step();
+            }
+        });
+    }
+
     /// Steps once, recording a failure (which pauses the run).
     fn step(&mut self) {
         let dt = self.stage.dt();
@@ -210,19 +221,14 @@ impl Runner {
             if self.paused {
                 target = self.stage.time();
             } else if self.speed == 0.0 {
-                while Instant::now() < next_frame && !self.paused {
-                    self.step();
-                }
+                self.step_while(move |r| Instant::now() < next_frame && !r.paused);
                 target = self.stage.time();
             } else {
                 target += self.speed * wall.min(MAX_LAG);
                 let half = 0.5 * self.stage.dt();
-                while self.stage.time() + half < target
-                    && Instant::now() < next_frame
-                    && !self.paused
-                {
-                    self.step();
-                }
+                self.step_while(move |r| {
+                    r.stage.time() + half < target && Instant::now() < next_frame && !r.paused
+                });
                 // Too slow for this speed: drop the debt, report the true rate.
                 target = target.min(self.stage.time() + self.speed * MAX_LAG);
             }

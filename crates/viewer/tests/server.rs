@@ -412,3 +412,69 @@ async fn the_view_waits_for_its_first_tab_and_follows_the_walker() {
     // The evolved gait travels about 2 m/s along +x.
     assert!(x1 - x0 > 1.0, "the focus moved from x = {x0} to {x1}");
 }
+
+/// A 64 × 64 net of 1 g beads on springs hanging from two corners: 4,096
+/// particles, a world that splits its work over threads, whose live loop
+/// runs on the thread pool (`Runner::step_while`).
+fn net_scene() -> PathBuf {
+    let side = 64;
+    let mut s = String::from(
+        "[world]\ngravity = [0, -9.8, 0]\nintegrator = \"symplectic\"\ndt = 0.0001\n\n",
+    );
+    let name = |i: usize, j: usize| format!("p{i}_{j}");
+    for i in 0..side {
+        for j in 0..side {
+            s += &format!(
+                "[[particle]]\nname = \"{}\"\nmass = 0.001\nradius = 0.002\nposition = [{}, {}, 0]\nfixed = {}\n\n",
+                name(i, j),
+                0.01 * i as f64,
+                1.0 + 0.01 * j as f64,
+                j == side - 1 && (i == 0 || i == side - 1)
+            );
+        }
+    }
+    for i in 0..side {
+        for j in 0..side {
+            for (k, l) in [(i + 1, j), (i, j + 1)] {
+                if k < side && l < side {
+                    s += &format!(
+                        "[[spring]]\na = \"{}\"\nb = \"{}\"\nstiffness = 10\ndamping = 0.001\n\n",
+                        name(i, j),
+                        name(k, l)
+                    );
+                }
+            }
+        }
+    }
+    let path = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("live_net.toml");
+    std::fs::write(&path, s).expect("write the scene");
+    path
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_large_world_plays_live_and_sags_under_gravity() {
+    let (live, _) = Live::scene("127.0.0.1", 4, net_scene());
+    let mut ws = connect(&live.url).await;
+    let scene = next(&mut ws).await.expect("scene");
+    assert_eq!(
+        scene["particles"].as_array().expect("particles").len(),
+        4096
+    );
+    let first = frame(&mut ws).await;
+    let lowest = |f: &Value| {
+        f["p"]
+            .as_array()
+            .expect("positions")
+            .chunks(3)
+            .map(|p| p[1].as_f64().expect("a finite y"))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let y0 = lowest(&first);
+    // Flat out, then wait until 20 ms have been simulated.
+    send(&mut ws, r#"{"cmd":"speed","value":0}"#).await;
+    let later = frame_where(&mut ws, |f| f["t"].as_f64().unwrap_or(0.0) > 0.02).await;
+    assert!(later["error"].is_null(), "{later}");
+    let y1 = lowest(&later);
+    // Free fall for 20 ms drops the loose bottom row by about g t²/2 ≈ 2 mm.
+    assert!(y1 < y0 - 1e-3, "the net sags: lowest y {y0} -> {y1}");
+}
