@@ -24,7 +24,8 @@ pub struct Args {
     json: bool,
 }
 
-/// The machine, for `--json`: CPU model (Linux's /proc/cpuinfo), cores, OS.
+/// The machine, for `--json`: CPU model (Linux's /proc/cpuinfo), cores, OS,
+/// and the vector instructions the engine chose on it.
 fn machine() -> serde_json::Value {
     let cpu = std::fs::read_to_string("/proc/cpuinfo")
         .ok()
@@ -36,7 +37,13 @@ fn machine() -> serde_json::Value {
         })
         .unwrap_or_else(|| "unknown".into());
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
-    serde_json::json!({ "cpu": cpu, "cores": cores, "os": std::env::consts::OS, "arch": std::env::consts::ARCH })
+    serde_json::json!({
+        "cpu": cpu,
+        "cores": cores,
+        "os": std::env::consts::OS,
+        "arch": std::env::consts::ARCH,
+        "simd": animats_engine::simd_summary(),
+    })
 }
 
 /// Today's UTC date, YYYY-MM-DD (civil from days since 1970, Hinnant's algorithm).
@@ -196,9 +203,10 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let (machine, date) = (machine(), today());
     if !args.json {
         println!(
-        "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}",
+        "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}; vectors: {}",
         opts.runs,
-        if opts.quick { " (quick)" } else { "" }
+        if opts.quick { " (quick)" } else { "" },
+        animats_engine::simd_summary()
     );
     }
     let mut failed = 0;

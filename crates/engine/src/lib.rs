@@ -37,6 +37,7 @@ pub mod integrators;
 pub mod jacobian;
 mod parallel;
 pub mod particle;
+mod simd;
 pub mod snapshot;
 pub mod world;
 
@@ -63,6 +64,7 @@ pub use guard::DivergenceGuard;
 pub use integrators::{IntegratorKind, Solver};
 pub use jacobian::Jacobian;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
+pub use simd::summary as simd_summary;
 pub use snapshot::Snapshot;
 pub use world::{on_pool, on_pool_if, Energy, FloorDef, Stats, StepLimit, StepReport, World};
 

@@ -16,8 +16,9 @@ use crate::forces::{
     spring::{SpringDef, SpringId},
     torque_joint::{TorqueJointDef, TorqueJointId},
 };
-use crate::integrators::{flat, integrate, widest, Dynamics, IntegratorKind, Scratch, Solver};
+use crate::integrators::{flat, integrate, Dynamics, IntegratorKind, Scratch, Solver};
 use crate::particle::{ParticleDef, ParticleId, Properties, State};
+use crate::simd::{chosen, Use};
 use glam::DVec3;
 
 /// How many times a step may be halved when an event is missed: pieces are
@@ -1048,7 +1049,8 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     // wide as the CPU's vectors, keep the pass short next to the force
     // loops.
     let (p, v) = (flat(pos), flat(vel));
-    let sums_finite = widest(
+    let sums_finite = chosen(
+        Use::Updates,
         #[inline(always)]
         || {
             const LANES: usize = 16;

@@ -19,6 +19,8 @@ use glam::DVec3;
 use std::fmt;
 use std::str::FromStr;
 
+#[cfg(test)]
+pub(crate) use crate::simd::{on, Width};
 pub use implicit::Solver;
 
 /// The integration methods.
@@ -206,81 +208,6 @@ impl Coord for DVec3 {
     fn finite(self) -> bool {
         self.is_finite()
     }
-}
-
-/// An instruction set the update loops can be compiled for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Width {
-    /// The x86-64 baseline (SSE2), or whatever the target has elsewhere.
-    Base,
-    /// AVX2: four f64 a vector (named by the tests; [`on`] falls back to
-    /// it from AVX-512).
-    #[cfg(target_arch = "x86_64")]
-    #[cfg_attr(not(test), allow(dead_code))]
-    Avx2,
-    /// AVX-512F: eight f64 a vector.
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
-}
-
-#[cfg(test)]
-impl Width {
-    /// Every width this CPU can run, narrowest first.
-    pub(crate) fn available() -> Vec<Width> {
-        let mut all = vec![Width::Base];
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                all.push(Width::Avx2);
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                all.push(Width::Avx512);
-            }
-        }
-        all
-    }
-}
-
-/// Calls `body` compiled for the widest vectors this CPU has: AVX-512,
-/// AVX2, or the baseline's SSE2. The update loops are flat arrays of
-/// coordinates that the compiler vectorises, as wide as it may in each
-/// copy (chain-64's step 5-8 % faster with AVX-512 than with SSE2). The
-/// same bits on every path: each element gets the same operations, and no
-/// FMA is ever formed from a separate multiply and add. `body` must be an
-/// `#[inline(always)]` closure, or it is compiled for the baseline alone.
-#[inline(always)]
-pub(crate) fn widest<R>(body: impl FnOnce() -> R) -> R {
-    #[cfg(target_arch = "x86_64")]
-    return on(Width::Avx512, body);
-    #[cfg(not(target_arch = "x86_64"))]
-    on(Width::Base, body)
-}
-
-/// Calls `body` compiled for `width`, or for the widest narrower
-/// instruction set this CPU has.
-#[inline(always)]
-pub(crate) fn on<R>(width: Width, body: impl FnOnce() -> R) -> R {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "avx512f")]
-        unsafe fn avx512<R>(body: impl FnOnce() -> R) -> R {
-            body()
-        }
-        #[target_feature(enable = "avx2")]
-        unsafe fn avx2<R>(body: impl FnOnce() -> R) -> R {
-            body()
-        }
-        if width == Width::Avx512 && std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
-            return unsafe { avx512(body) };
-        }
-        if width != Width::Base && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
-            return unsafe { avx2(body) };
-        }
-    }
-    let _ = width;
-    body()
 }
 
 /// Asserts that `run` gives the same results compiled for every

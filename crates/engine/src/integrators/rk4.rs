@@ -3,9 +3,10 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::{flat, flat_mut, widest, Coord, Dynamics, SMALL};
+use super::{flat, flat_mut, Coord, Dynamics, SMALL};
 use crate::parallel::by_pieces;
 use crate::particle::State;
+use crate::simd::{chosen, Use};
 use glam::DVec3;
 
 /// One RK4 step of size `h` from time `t`; true if it knows every new
@@ -133,7 +134,8 @@ impl Start<'_> {
             ];
             let w = &self.w3[3 * first..3 * first + 3 * x.len()];
             let trial = [flat_mut(x), flat_mut(v), flat_mut(dx), flat_mut(dv)];
-            widest(
+            chosen(
+                Use::Updates,
                 #[inline(always)]
                 || stage::<_, STAGE>(s, start, w, trial),
             );

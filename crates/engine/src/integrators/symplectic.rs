@@ -2,9 +2,10 @@
 //! `x₁ = x₀ + h v₁`. First order, but symplectic: on a conservative system its
 //! energy error oscillates and stays bounded instead of drifting.
 
-use super::{flat, flat_mut, widest, Coord, Dynamics, SMALL};
+use super::{flat, flat_mut, Coord, Dynamics, SMALL};
 use crate::parallel::by_pieces;
 use crate::particle::State;
+use crate::simd::{chosen, Use};
 
 /// One symplectic Euler step of size `h` from time `t`; true if it knows
 /// every new coordinate to be finite (see [`super::integrate`]).
@@ -28,7 +29,8 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
             flat(&f[r]),
         );
         let w = &w3[3 * first..3 * first + x0.len()];
-        widest(
+        chosen(
+            Use::Updates,
             #[inline(always)]
             || update(x0, v0, f, w, h, flat_mut(x1), flat_mut(v1)),
         );

@@ -95,16 +95,19 @@ struct Bodies<'a> {
 }
 
 impl Bodies<'_> {
-    /// Rows `first..first + ax.len()`, with the widest vectors this CPU has.
+    /// Rows `first..first + ax.len()`, with the vectors chosen for
+    /// arithmetic on this CPU (`crate::simd`).
     fn rows(&self, first: usize, ax: &mut [f64], ay: &mut [f64], az: &mut [f64]) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: the CPU has AVX-512F (checked just above).
+            use crate::simd::{width, Use, Width};
+            let width = width(Use::Arithmetic);
+            if width == Width::Avx512 {
+                // SAFETY: the CPU has AVX-512F (`width` chooses only what it has).
                 return unsafe { self.rows_avx512(first, ax, ay, az) };
             }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU has AVX2 (checked just above).
+            if width == Width::Avx2 {
+                // SAFETY: the CPU has AVX2 (`width` chooses only what it has).
                 return unsafe { self.rows_avx2(first, ax, ay, az) };
             }
         }

@@ -121,7 +121,8 @@ pub(super) trait Sink {
 }
 
 /// Computes every spring of `springs` in blocks and hands each force to
-/// `sink`, in order, with the widest vectors this CPU has.
+/// `sink`, in order, with the vectors chosen for arithmetic on this CPU
+/// (`crate::simd`).
 pub(super) fn run<S: Sink>(
     springs: Slice,
     block: &mut Block,
@@ -131,12 +132,14 @@ pub(super) fn run<S: Sink>(
 ) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F (checked just above).
+        use crate::simd::{width, Use, Width};
+        let width = width(Use::Arithmetic);
+        if width == Width::Avx512 {
+            // SAFETY: the CPU has AVX-512F (`width` chooses only what it has).
             return unsafe { run_avx512(springs, block, pos, vel, sink) };
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2 (checked just above).
+        if width == Width::Avx2 {
+            // SAFETY: the CPU has AVX2 (`width` chooses only what it has).
             return unsafe { run_avx2(springs, block, pos, vel, sink) };
         }
     }
