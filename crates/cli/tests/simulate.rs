@@ -541,3 +541,80 @@ fn realtime_runs_to_the_duration_and_a_blow_up_there_names_the_particle_and_keep
     assert!(!out.exists(), "no file under the requested name");
     assert!(dir.join("stiff.csv.partial").exists(), "{err}");
 }
+
+/// A 6 × 6 net of 36 particles (110 springs: the springs' blocks and the
+/// flat updates, both vectorised), under mutual gravitation as well (the
+/// all-pairs gather), dropped onto the floor with RK4: the bytes of its
+/// trajectory must not depend on the vector instructions the engine
+/// chose, whatever `ANIMATS_SIMD` caps them to (docs/DESIGN.md, "Which
+/// vectors, per CPU"). On an Intel CPU the caps reach only the
+/// arithmetic's choice (its updates stay SSE2); the loops' own unit tests
+/// compare every width this CPU has directly.
+#[test]
+fn every_vector_instruction_set_writes_the_same_trajectory() {
+    let dir = scratch("simd");
+    let mut scene = String::from(
+        "[world]\ndt = 0.001\nduration = 0.5\nintegrator = \"rk4\"\n\n[floor]\n\n[[nbody]]\nG = 0.01\n",
+    );
+    let name = |i: usize, j: usize| format!("p{i}_{j}");
+    for i in 0..6 {
+        for j in 0..6 {
+            let y = 0.3 + 0.01 * ((i * 7 + j * 3) % 5) as f64;
+            scene += &format!(
+                "\n[[particle]]\nname = \"{}\"\nmass = 0.01\nposition = [{}, {y}, {}]\nradius = 0.02\n",
+                name(i, j),
+                0.1 * i as f64,
+                0.1 * j as f64
+            );
+        }
+    }
+    let spring = |a: String, b: String| {
+        format!("\n[[spring]]\na = \"{a}\"\nb = \"{b}\"\nstiffness = 50.0\ndamping = 0.05\n")
+    };
+    for i in 0..6 {
+        for j in 0..6 {
+            if i + 1 < 6 {
+                scene += &spring(name(i, j), name(i + 1, j));
+            }
+            if j + 1 < 6 {
+                scene += &spring(name(i, j), name(i, j + 1));
+            }
+            if i + 1 < 6 && j + 1 < 6 {
+                scene += &spring(name(i, j), name(i + 1, j + 1));
+                scene += &spring(name(i + 1, j), name(i, j + 1));
+            }
+        }
+    }
+    let scene = write(&dir, "net.toml", &scene);
+    let run = |cap: Option<&str>| {
+        let out = dir.join(format!("{}.csv", cap.unwrap_or("chosen")));
+        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_animats"));
+        cmd.args(["simulate", &scene, "--output", out.to_str().unwrap()]);
+        match cap {
+            Some(c) => cmd.env("ANIMATS_SIMD", c),
+            None => cmd.env_remove("ANIMATS_SIMD"),
+        };
+        let o = cmd.output().expect("run animats");
+        let (_, err) = text(&o);
+        assert!(o.status.success(), "{cap:?}: {err}");
+        std::fs::read(&out).expect("trajectory written")
+    };
+    let chosen = run(None);
+    let rows = chosen.iter().filter(|&&b| b == b'\n').count();
+    assert!(rows > 36 * 400, "a row per particle per step: {rows}");
+    // It moved: p0_0 fell from 0.3 m towards the floor.
+    let last_y = String::from_utf8_lossy(&chosen)
+        .lines()
+        .rfind(|l| l.split(',').nth(1) == Some("p0_0"))
+        .and_then(|l| l.split(',').nth(3).and_then(|y| y.parse::<f64>().ok()))
+        .expect("p0_0's last row");
+    assert!(last_y < 0.25, "p0_0 ends at y = {last_y}");
+    // An unknown word caps nothing.
+    assert!(run(Some("fast")) == chosen);
+    for cap in ["base", "avx2", "avx512"] {
+        assert!(
+            run(Some(cap)) == chosen,
+            "ANIMATS_SIMD={cap} changed the trajectory"
+        );
+    }
+}
