@@ -17,6 +17,7 @@ pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
 pub mod pile;
+pub mod scene_load;
 pub mod seaworld;
 pub mod stability;
 pub mod stiff;
@@ -25,7 +26,7 @@ use animats_engine::{DVec3, IntegratorKind};
 use std::time::Instant;
 
 /// The workloads, in the order they are run by default.
-pub const WORKLOADS: [&str; 9] = [
+pub const WORKLOADS: [&str; 10] = [
     "chain-64",
     "cloth-32",
     "cloth-128",
@@ -35,6 +36,7 @@ pub const WORKLOADS: [&str; 9] = [
     "brains",
     "seaworld",
     "stability",
+    "scene-load",
 ];
 
 /// Workloads run only when named (they take minutes).
@@ -395,6 +397,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "seaworld" => seaworld::run(opts.quick, runs),
         "implicit" => Ok(run_implicit(opts.quick)),
         "contacts" => Ok(pile::run(opts.quick, runs)),
+        "scene-load" => Ok(scene_load::run(opts.quick, runs)),
         "stability" => Ok(stability::run(Some(std::path::Path::new(
             "scenes/seaworld.toml",
         )))),

@@ -122,7 +122,13 @@ fn ms(t: f64) -> String {
 }
 
 fn print_row(r: &Row) {
-    let rate = if r.springs > 0 {
+    let rate = if r.dt == 0.0 {
+        // Nothing simulated (scene-load): what was built, per second.
+        format!(
+            "{}/s particles built",
+            si(r.particles as f64 / r.engine.median)
+        )
+    } else if r.springs > 0 {
         format!(
             "{}/s pstep, {}/s spring-eval",
             si(r.particle_steps_per_s()),
@@ -142,15 +148,20 @@ fn print_row(r: &Row) {
         (Some((name, b)), Some(ratio)) => format!("{} ms {name}, ratio {ratio:.2}", ms(b.median)),
         _ => "-".into(),
     };
+    let sim = if r.dt == 0.0 {
+        String::new()
+    } else {
+        format!("  {} sim-s/s", si(r.sim_per_wall()))
+    };
     println!(
-        "{:<14} {:<34} {:>10} ms [{}–{}]  {}  {} sim-s/s  | baseline {}",
+        "{:<14} {:<34} {:>10} ms [{}–{}]  {}{}  | baseline {}",
         r.workload,
         r.variant,
         ms(r.engine.median),
         ms(r.engine.min),
         ms(r.engine.max),
         rate,
-        si(r.sim_per_wall()),
+        sim,
         base
     );
     for c in &r.checks {

@@ -34,7 +34,41 @@ fn json_has_every_run_the_checks_the_machine_and_the_date() {
             .iter()
             .any(|c| c["name"] == "com_y" && c["passed"] == true));
         assert!(r["machine"]["cores"].as_u64().unwrap() >= 1);
+        let simd = r["machine"]["simd"].as_str().unwrap();
+        assert!(
+            simd.starts_with("arithmetic ") && simd.contains(", updates "),
+            "{simd}"
+        );
         let date = r["date"].as_str().unwrap();
         assert!(date.len() == 10 && date.starts_with("20"), "{date}");
     }
+}
+
+/// `scene-load --quick`: the cloth scene files of side 16 and 32 load with
+/// every particle and spring, and the larger's row compares time per byte.
+#[test]
+fn scene_load_builds_every_particle_and_spring() {
+    let o = animats(&["bench", "scene-load", "--quick", "--json"]);
+    let (out, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let rows: Vec<serde_json::Value> = out
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    assert_eq!(rows.len(), 2);
+    for (r, side) in rows.iter().zip([16.0, 32.0]) {
+        let checks = r["checks"].as_array().unwrap();
+        let value = |name: &str| {
+            checks
+                .iter()
+                .find(|c| c["name"] == name)
+                .and_then(|c| c["value"].as_f64())
+        };
+        assert_eq!(value("particles"), Some(side * side));
+        assert_eq!(value("springs"), Some(2.0 * side * (side - 1.0)));
+    }
+    let last = rows[1]["checks"].as_array().unwrap();
+    assert!(last
+        .iter()
+        .any(|c| c["name"] == "time per byte against the 4x smaller file"));
 }
