@@ -19,7 +19,9 @@
 //!   run time.
 //!
 //! No I/O, no global state: a world is a plain value, so many can run side
-//! by side (one per evolving individual). A large world also splits its own
+//! by side (one per evolving individual). The one exception changes speed,
+//! never results: the vector instructions the hot loops use, chosen once
+//! per process from the CPU and `ANIMATS_SIMD` ([`simd_summary`]). A large world also splits its own
 //! heaviest loops (springs, n-body gravity, the integrators' updates) among
 //! the threads of the current rayon pool, with the same bits on any number
 //! of threads.

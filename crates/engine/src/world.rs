@@ -1045,9 +1045,9 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     let (pos, vel) = (&pos[..n], &vel[..n]);
     // A sum of finite numbers is finite (unless it overflows, which the
     // confirming scan at the end tells apart) and any inf or NaN makes it
-    // non-finite. Sixteen independent lanes over the flat coordinates, as
-    // wide as the CPU's vectors, keep the pass short next to the force
-    // loops.
+    // non-finite. Sixteen independent lanes over the flat coordinates, in
+    // the vectors chosen for updates (`simd.rs`), keep the pass short next
+    // to the force loops.
     let (p, v) = (flat(pos), flat(vel));
     let sums_finite = chosen(
         Use::Updates,
