@@ -11,7 +11,8 @@
 use crate::{measure, Check, Row};
 use std::fmt::Write;
 
-/// The cloth scene of `bench/scenes/cloth.py` for `side` (its exact text).
+/// The cloth scene that `bench/scenes/cloth.py` writes for `side` (its
+/// text, but for a final blank line).
 pub fn cloth_scene(side: usize) -> String {
     let h = 1.0 / (side - 1) as f64;
     let mut out = String::from(

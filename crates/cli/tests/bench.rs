@@ -3,15 +3,19 @@
 mod common;
 use common::{animats, text};
 
+/// `--json`'s output: one object per line.
+fn json_rows(out: &str) -> Vec<serde_json::Value> {
+    out.lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect()
+}
+
 #[test]
 fn json_has_every_run_the_checks_the_machine_and_the_date() {
     let o = animats(&["bench", "chain-64", "--json"]);
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{err}");
-    let rows: Vec<serde_json::Value> = out
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
-        .collect();
+    let rows = json_rows(&out);
     let variants: Vec<&str> = rows
         .iter()
         .map(|r| r["variant"].as_str().unwrap())
@@ -51,10 +55,7 @@ fn scene_load_builds_every_particle_and_spring() {
     let o = animats(&["bench", "scene-load", "--quick", "--json"]);
     let (out, err) = text(&o);
     assert_eq!(o.status.code(), Some(0), "{err}");
-    let rows: Vec<serde_json::Value> = out
-        .lines()
-        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
-        .collect();
+    let rows = json_rows(&out);
     assert_eq!(rows.len(), 2);
     for (r, side) in rows.iter().zip([16.0, 32.0]) {
         let checks = r["checks"].as_array().unwrap();

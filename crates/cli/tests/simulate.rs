@@ -588,7 +588,7 @@ fn every_vector_instruction_set_writes_the_same_trajectory() {
     let scene = write(&dir, "net.toml", &scene);
     let run = |cap: Option<&str>| {
         let out = dir.join(format!("{}.csv", cap.unwrap_or("chosen")));
-        let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_animats"));
+        let mut cmd = command();
         cmd.args(["simulate", &scene, "--output", out.to_str().unwrap()]);
         match cap {
             Some(c) => cmd.env("ANIMATS_SIMD", c),

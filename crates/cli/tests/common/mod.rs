@@ -12,13 +12,17 @@ pub fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// The `animats` binary, to be run in the repository root: for tests that
+/// set its environment too.
+pub fn command() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_animats"));
+    c.current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."));
+    c
+}
+
 /// Runs `animats` with `args` in the repository root.
 pub fn animats(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_animats"))
-        .args(args)
-        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
-        .output()
-        .expect("run animats")
+    command().args(args).output().expect("run animats")
 }
 
 /// Stdout and stderr as text.
