@@ -4,7 +4,7 @@
 
 use animats_engine::{
     DVec3, DiscreteEvent, EventContext, EventState, IntegratorKind, ParticleDef, ParticleId,
-    Properties, SpringDef, World,
+    Properties, SpringDef, TrialPiece, World,
 };
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -154,6 +154,26 @@ impl DiscreteEvent for WorkloadFloor {
 
     fn handles_pieces(&self) -> bool {
         true
+    }
+
+    fn settles_pieces(&self) -> bool {
+        true
+    }
+
+    fn settle_piece(&self, piece: &mut TrialPiece) -> EventState {
+        let p = piece.particles;
+        let (w, e) = (&p.inv_mass[piece.first..], &p.restitution[piece.first..]);
+        let mut found = EventState::None;
+        for (((x, v), &w), &e) in piece.pos.iter_mut().zip(piece.vel.iter_mut()).zip(w).zip(e) {
+            if x.y < 0.0 && w != 0.0 {
+                if v.y < 0.0 {
+                    v.y *= -e;
+                }
+                x.y = 0.0;
+                found = EventState::Occurring;
+            }
+        }
+        found
     }
 
     fn handle_piece(

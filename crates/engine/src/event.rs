@@ -53,6 +53,38 @@ pub struct EventContext<'a> {
     pub particles: &'a Properties,
 }
 
+/// A piece of a trial step, the particles `first..first + pos.len()`, as
+/// the thread that has just integrated it holds it: the end of the trial,
+/// to change in place, and the start of the step, to read (see
+/// [`DiscreteEvent::settle_piece`]). Every slice but `particles` holds this
+/// piece's particles alone: particle `first + k` is `pos[k]`, and
+/// `particles`' arrays are indexed by `first + k`.
+pub struct TrialPiece<'a> {
+    /// Simulated time at the end of the trial step, s.
+    pub t: f64,
+    /// Length of the trial, s (see [`EventContext::h`]).
+    pub h: f64,
+    /// The length of the whole step the trial belongs to, s.
+    pub step: f64,
+    /// The integrator's [`free_flight_shift`](crate::IntegratorKind::free_flight_shift).
+    pub flight_shift: f64,
+    /// True when the trial cannot be split further: a missed event is then
+    /// handled as if it were occurring.
+    pub finest: bool,
+    /// Index of the piece's first particle.
+    pub first: usize,
+    /// Positions at the end of the trial step.
+    pub pos: &'a mut [DVec3],
+    /// Velocities at the end of the trial step.
+    pub vel: &'a mut [DVec3],
+    /// Positions at the start of the trial step.
+    pub start_pos: &'a [DVec3],
+    /// Velocities at the start of the trial step.
+    pub start_vel: &'a [DVec3],
+    /// The whole world's particle properties.
+    pub particles: &'a Properties,
+}
+
 /// A discrete event: detected after a trial step, handled by changing the state.
 /// Events are `Clone` (derive it), so that a world can be cloned whole, and
 /// `Sync`, so that the threads of a large world can ask
@@ -98,6 +130,32 @@ pub trait DiscreteEvent: Send + Sync + CloneEvent {
         _vel: &mut [DVec3],
         _particles: &Properties,
     ) {
+    }
+
+    /// True if [`settle_piece`](Self::settle_piece) stands in for `check`
+    /// and `handle` altogether: then, with the integrators that write a
+    /// trial by pieces (symplectic Euler, RK4), the thread that has just
+    /// written a piece of the trial checks and handles it at once, while it
+    /// is in its cache, and a large world on many threads needs no pass of
+    /// its own for this event (cloth-128 on two threads: docs/PERFORMANCE.md).
+    /// A world uses it only when every one of its events settles pieces.
+    /// False, the default.
+    fn settles_pieces(&self) -> bool {
+        false
+    }
+
+    /// Checks one piece of a trial as [`check`](Self::check) would if these
+    /// were the only particles, handles it in place as
+    /// [`handle`](Self::handle) would if the piece is `Occurring` (or
+    /// `Missed` while `piece.finest`), and returns the state it found. A
+    /// piece in which nothing happens must be left as it is; a missed piece
+    /// of a trial that is not the finest may be left or handled (the world
+    /// throws that trial away). The events of a world settle each piece in
+    /// the order they were added, each seeing the piece as the ones before
+    /// left it. Called only when [`settles_pieces`](Self::settles_pieces)
+    /// is true, from many threads at once: keep no records here.
+    fn settle_piece(&self, _piece: &mut TrialPiece) -> EventState {
+        EventState::None
     }
 
     /// Handles the event found by the last `check` (called only after

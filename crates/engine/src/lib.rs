@@ -44,7 +44,7 @@ pub mod snapshot;
 pub mod world;
 
 pub use error::{ModelError, SimError};
-pub use event::{DiscreteEvent, EventContext, EventState};
+pub use event::{DiscreteEvent, EventContext, EventState, TrialPiece};
 pub use events::floor_collision::{Collision, FloorCollision};
 pub use events::plane_constraint::PlaneConstraint;
 pub use events::sphere_contact::{Impact, SphereContact, SphereContactDef};

@@ -49,6 +49,18 @@ pub fn all_by_pieces<const K: usize>(
     slices: [&mut [DVec3]; K],
     body: impl Fn(usize, [&mut [DVec3]; K]) -> bool + Sync,
 ) -> bool {
+    fold_by_pieces(split, slices, body, |a, b| a & b)
+}
+
+/// [`by_pieces`] with an answer from each piece, combined in piece order by
+/// `combine`, which must be associative.
+#[inline]
+pub fn fold_by_pieces<const K: usize, R: Send>(
+    split: bool,
+    slices: [&mut [DVec3]; K],
+    body: impl Fn(usize, [&mut [DVec3]; K]) -> R + Sync,
+    combine: impl Fn(R, R) -> R + Sync + Send,
+) -> R {
     let n = slices.first().map_or(0, |s| s.len());
     let Some(len) = piece_len(n).filter(|_| split) else {
         return body(0, slices);
@@ -69,7 +81,8 @@ pub fn all_by_pieces<const K: usize>(
     pieces
         .into_par_iter()
         .map(|(first, piece)| body(first, piece))
-        .reduce(|| true, |a, b| a & b)
+        .reduce_with(combine)
+        .unwrap_or_else(|| body(0, std::array::from_fn(|_| &mut [][..])))
 }
 
 /// `body` of each piece `first..first + len` of a world of `n` particles

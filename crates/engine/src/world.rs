@@ -2,7 +2,7 @@
 //! the step that advances them (thesis §3.1.4, `advance()`).
 
 use crate::error::{ModelError, SimError};
-use crate::event::{DiscreteEvent, EventContext, EventState};
+use crate::event::{DiscreteEvent, EventContext, EventState, TrialPiece};
 use crate::events::floor_collision::FloorCollision;
 use crate::force::{Force, ForceContext, Targets};
 use crate::force_set::Forces;
@@ -16,7 +16,10 @@ use crate::forces::{
     spring::{SpringDef, SpringId},
     torque_joint::{TorqueJointDef, TorqueJointId},
 };
-use crate::integrators::{flat, integrate, Dynamics, IntegratorKind, Scratch, Solver};
+use crate::integrators::{
+    flat, integrate, integrate_then, Dynamics, IntegratorKind, Scratch, Settled, Solver, Written,
+    SMALL,
+};
 use crate::particle::{ParticleDef, ParticleId, Properties, State};
 use crate::simd::{chosen, Use};
 use glam::DVec3;
@@ -159,6 +162,12 @@ pub struct World {
     /// An event could not answer by pieces: this world's events are
     /// checked on one thread (until another event is added).
     unanswered: bool,
+    /// Every event settles pieces ([`DiscreteEvent::settles_pieces`]; true
+    /// without events).
+    settles: bool,
+    /// The last trial was settled piece by piece as it was written: its
+    /// events are handled and its finiteness known.
+    settled: bool,
     integrator: IntegratorKind,
     solver: Solver,
     scratch: Scratch,
@@ -205,6 +214,8 @@ impl World {
             event_states: Vec::new(),
             handle_by_pieces: false,
             unanswered: false,
+            settles: true,
+            settled: false,
             integrator: IntegratorKind::default(),
             solver: Solver::default(),
             scratch: Scratch::default(),
@@ -503,6 +514,7 @@ impl World {
         self.events.push(event);
         self.event_states.push(EventState::None);
         self.unanswered = false;
+        self.settles = self.events.iter().all(|e| e.settles_pieces());
         self.events.len() - 1
     }
 
@@ -649,7 +661,7 @@ impl World {
         }
         let t0 = self.time;
         // The whole step first; pieces only after a missed event.
-        let (events, finite) = self.trial(t0, dt, dt);
+        let (events, finite) = self.trial(t0, dt, dt, false);
         let report = if events == EventState::Missed {
             let first = self.scratch.implicit.iterations;
             let mut r = self.backtrack(t0, dt)?;
@@ -675,26 +687,78 @@ impl World {
     /// Integrates from the current state over `[t, t + h]` (part of a step
     /// of `step`) into the trial buffer and asks every event about the
     /// result; returns the worst state, and whether the integrator knows
-    /// the trial to be finite.
+    /// the trial to be finite. `finest`: the trial cannot be split further.
+    ///
+    /// When every event settles pieces (and there is one, or the world is
+    /// not tiny), each piece of the trial is checked, handled and scanned
+    /// for finiteness by the thread that has just written it, inside the
+    /// integrator's last loop (those of symplectic Euler and RK4): no pass
+    /// of its own, and on many threads no fork and join of its own.
     #[inline(always)]
-    fn trial(&mut self, t: f64, h: f64, step: f64) -> (EventState, bool) {
+    fn trial(&mut self, t: f64, h: f64, step: f64, finest: bool) -> (EventState, bool) {
         self.scratch.implicit.iterations = 0;
         self.forces.one_piece = self.one_piece();
+        self.handle_by_pieces = false;
+        self.settled = false;
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,
             scratch: &mut self.scratch,
             solver: self.solver,
         };
-        let mut finite = integrate(
-            self.integrator,
-            &mut dynamics,
-            t,
-            h,
-            &self.state,
-            &mut self.next,
-        );
-        self.handle_by_pieces = false;
+        let mut finite;
+        if self.settles && (!self.events.is_empty() || self.state.pos.len() >= SMALL) {
+            let (events, particles, from) = (&self.events, &self.particles, &self.state);
+            let flight_shift = self.integrator.free_flight_shift();
+            let finish = |first: usize, pos: &mut [DVec3], vel: &mut [DVec3]| {
+                let r = first..first + pos.len();
+                let mut piece = TrialPiece {
+                    t: t + h,
+                    h,
+                    step,
+                    flight_shift,
+                    finest,
+                    first,
+                    pos,
+                    vel,
+                    start_pos: &from.pos[r.clone()],
+                    start_vel: &from.vel[r],
+                    particles,
+                };
+                let mut worst = EventState::None;
+                for e in events {
+                    worst = worst.max(e.settle_piece(&mut piece));
+                }
+                Settled {
+                    finite: all_finite(piece.pos, piece.vel),
+                    worst,
+                }
+            };
+            match integrate_then(
+                self.integrator,
+                &mut dynamics,
+                t,
+                h,
+                from,
+                &mut self.next,
+                &finish,
+            ) {
+                Written::Settled(s) => {
+                    self.settled = true;
+                    return (s.worst, s.finite);
+                }
+                Written::Known(f) => finite = f,
+            }
+        } else {
+            finite = integrate(
+                self.integrator,
+                &mut dynamics,
+                t,
+                h,
+                &self.state,
+                &mut self.next,
+            );
+        }
         let large = crate::parallel::piece_len(self.len()).is_some()
             && self.events.len() <= PIECE_EVENTS
             && !self.unanswered;
@@ -741,7 +805,9 @@ impl World {
     #[inline]
     fn accept(&mut self, worst: EventState, finite: bool, t: f64) -> Result<(), SimError> {
         let mut known = finite;
-        if worst != EventState::None && self.handle_by_pieces {
+        if self.settled {
+            // Handled, and scanned after handling, piece by piece.
+        } else if worst != EventState::None && self.handle_by_pieces {
             known = handle_by_pieces(
                 &self.events,
                 &self.event_states,
@@ -786,7 +852,7 @@ impl World {
         while done < total {
             let t = t0 + dt * (done as f64 / total as f64);
             let h = dt * (piece as f64 / total as f64);
-            let (mut worst, finite) = self.trial(t, h, dt);
+            let (mut worst, finite) = self.trial(t, h, dt, piece == 1);
             report.solver_iterations += self.scratch.implicit.iterations;
             if worst == EventState::Missed {
                 if piece > 1 {

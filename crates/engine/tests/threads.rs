@@ -6,7 +6,7 @@
 use animats_engine::{
     DVec3, DiscreteEvent, EventContext, EventState, FloorCollision, FloorDef, IntegratorKind,
     NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SphereContactDef, SpringDef,
-    Targets, World,
+    Targets, TrialPiece, World,
 };
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -170,20 +170,50 @@ const GOLDEN: u64 = 0x550e_2088_816d_8ecb;
 
 /// Pieces handled by every [`Clamp`] so far.
 static PIECES_HANDLED: AtomicUsize = AtomicUsize::new(0);
+/// Pieces settled by every [`Clamp`] so far.
+static PIECES_SETTLED: AtomicUsize = AtomicUsize::new(0);
 
 /// The peer kit's floor rule at a height (`if y < h { if v_y < 0 { v_y ←
 /// −e v_y }; y ← h }`), a user event written for one thread only, or also
-/// piece by piece.
+/// piece by piece, or settling pieces; a particle more than `envelope`
+/// below the height is missed.
 #[derive(Clone)]
 struct Clamp {
     height: f64,
-    by_pieces: bool,
+    envelope: f64,
+    mode: Mode,
     below: Vec<usize>,
 }
 
+/// How a [`Clamp`] answers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Mode {
+    Whole,
+    Pieces,
+    Settles,
+}
+
 impl Clamp {
+    fn new(height: f64, mode: Mode) -> Self {
+        Clamp {
+            height,
+            envelope: f64::INFINITY,
+            mode,
+            below: Vec::new(),
+        }
+    }
+
     fn below(&self, x: DVec3, w: f64) -> bool {
         x.y < self.height && w != 0.0
+    }
+
+    /// Occurring, or missed if any of the particles below is too deep.
+    fn state(&self, deepest: Option<f64>) -> EventState {
+        match deepest {
+            None => EventState::None,
+            Some(y) if y < self.height - self.envelope => EventState::Missed,
+            Some(_) => EventState::Occurring,
+        }
     }
 
     fn bounce(&self, x: &mut DVec3, v: &mut DVec3, e: f64) {
@@ -199,26 +229,43 @@ impl DiscreteEvent for Clamp {
         self.below = (0..ctx.pos.len())
             .filter(|&i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]))
             .collect();
-        if self.below.is_empty() {
-            EventState::None
-        } else {
-            EventState::Occurring
-        }
+        let deepest = self.below.iter().map(|&i| ctx.pos[i].y).reduce(f64::min);
+        self.state(deepest)
     }
 
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
-        let hit = range
-            .clone()
-            .any(|i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]));
-        self.by_pieces.then_some(if hit {
-            EventState::Occurring
-        } else {
-            EventState::None
-        })
+        let deepest = range
+            .filter(|&i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]))
+            .map(|i| ctx.pos[i].y)
+            .reduce(f64::min);
+        (self.mode == Mode::Pieces).then_some(self.state(deepest))
     }
 
     fn handles_pieces(&self) -> bool {
-        self.by_pieces
+        self.mode == Mode::Pieces
+    }
+
+    fn settles_pieces(&self) -> bool {
+        self.mode == Mode::Settles
+    }
+
+    fn settle_piece(&self, piece: &mut TrialPiece) -> EventState {
+        PIECES_SETTLED.fetch_add(1, Ordering::Relaxed);
+        let p = piece.particles;
+        let w = |i: usize| p.inv_mass[piece.first + i];
+        let deepest = (0..piece.pos.len())
+            .filter(|&i| self.below(piece.pos[i], w(i)))
+            .map(|i| piece.pos[i].y)
+            .reduce(f64::min);
+        let state = self.state(deepest);
+        if state == EventState::Occurring || piece.finest {
+            for (i, (x, v)) in piece.pos.iter_mut().zip(piece.vel.iter_mut()).enumerate() {
+                if self.below(*x, w(i)) {
+                    self.bounce(x, v, p.restitution[piece.first + i]);
+                }
+            }
+        }
+        state
     }
 
     fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
@@ -265,11 +312,8 @@ fn events_checked_and_handled_by_pieces_are_the_same_bits() {
                     } else {
                         bare_cloth(kind, true)
                     };
-                    w.add_event(Box::new(Clamp {
-                        height,
-                        by_pieces,
-                        below: Vec::new(),
-                    }));
+                    let mode = if by_pieces { Mode::Pieces } else { Mode::Whole };
+                    w.add_event(Box::new(Clamp::new(height, mode)));
                     w
                 }
             };
@@ -298,11 +342,7 @@ fn events_checked_and_handled_by_pieces_are_the_same_bits() {
     }
     // The clamp did act: particles rest on it, none below.
     let mut w = bare_cloth(IntegratorKind::Symplectic, true);
-    w.add_event(Box::new(Clamp {
-        height: 0.04,
-        by_pieces: true,
-        below: Vec::new(),
-    }));
+    w.add_event(Box::new(Clamp::new(0.04, Mode::Pieces)));
     for _ in 0..100 {
         w.step(1e-3).unwrap();
     }
@@ -312,6 +352,64 @@ fn events_checked_and_handled_by_pieces_are_the_same_bits() {
         on > 100 && under == 0,
         "{on} particles on the clamp, {under} below"
     );
+}
+
+/// An event that settles pieces (checks and handles each as it is
+/// written) gives the bits of the same event checked and handled whole, on
+/// any number of threads, with every integrator (those that do not write
+/// by pieces fall back to `check` and `handle`), also when it is missed and
+/// the steps are retaken in pieces down to the finest.
+#[test]
+fn events_settled_piece_by_piece_are_the_same_bits() {
+    for kind in [
+        IntegratorKind::Symplectic,
+        IntegratorKind::Rk4,
+        IntegratorKind::Euler,
+    ] {
+        // No envelope; then one so thin that the cloth's fall is missed and
+        // the step halved down to its finest pieces, where it is handled.
+        for envelope in [f64::INFINITY, 1e-5] {
+            let world = |mode: Mode| {
+                move || {
+                    let mut w = bare_cloth(kind, true);
+                    let mut clamp = Clamp::new(0.04, mode);
+                    clamp.envelope = envelope;
+                    w.add_event(Box::new(clamp));
+                    w
+                }
+            };
+            let why = format!("{kind}, envelope {envelope}");
+            let whole = run_world(1, world(Mode::Whole), 60);
+            let settled = PIECES_SETTLED.load(Ordering::Relaxed);
+            for threads in [1, 2, 3] {
+                assert_eq!(
+                    run_world(threads, world(Mode::Settles), 60),
+                    whole,
+                    "{why}, {threads} threads"
+                );
+            }
+            let used = PIECES_SETTLED.load(Ordering::Relaxed) > settled;
+            assert_eq!(used, kind != IntegratorKind::Euler, "{why}: pieces settled");
+            // The clamp acted; with the thin envelope, by backtracking.
+            let mut w = world(Mode::Settles)();
+            for _ in 0..60 {
+                w.step(1e-3).unwrap();
+            }
+            let on = w.state().pos.iter().filter(|x| x.y == 0.04).count();
+            let under = w.state().pos.iter().filter(|x| x.y < 0.04).count();
+            assert!(
+                on > 0 && under == 0,
+                "{why}: {on} particles on the clamp, {under} below"
+            );
+            let stats = w.stats();
+            assert_eq!(
+                stats.backtracks > 0,
+                envelope.is_finite(),
+                "{why}: {stats:?}"
+            );
+            assert_eq!(stats.unresolved > 0, envelope < 1e-6, "{why}: {stats:?}");
+        }
+    }
 }
 
 /// A large world that blows up names the same particle at the same time on
@@ -357,11 +455,7 @@ fn a_large_world_with_sphere_contact_is_the_same_bits_on_any_number_of_threads()
         move || {
             let mut w = spheres(IntegratorKind::Symplectic);
             if clamp {
-                w.add_event(Box::new(Clamp {
-                    height: 0.015,
-                    by_pieces: true,
-                    below: Vec::new(),
-                }));
+                w.add_event(Box::new(Clamp::new(0.015, Mode::Pieces)));
             }
             w
         }

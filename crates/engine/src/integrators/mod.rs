@@ -13,6 +13,7 @@ pub mod midpoint;
 pub mod rk4;
 pub mod symplectic;
 
+use crate::event::EventState;
 use crate::force_set::Forces;
 use crate::particle::{Properties, State};
 use glam::DVec3;
@@ -273,6 +274,61 @@ pub fn integrate(
         IntegratorKind::Rk4 => rk4::step(d, t, h, from, to),
         IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
         IntegratorKind::Implicit => implicit::step(d, t, h, from, to),
+    }
+}
+
+/// What the pieces of a trial said once settled ([`Finish`]), combined:
+/// whether every coordinate is finite, and the worst event state.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Settled {
+    pub finite: bool,
+    pub worst: EventState,
+}
+
+impl Settled {
+    /// Both pieces' answers.
+    #[inline]
+    pub fn and(self, other: Settled) -> Settled {
+        Settled {
+            finite: self.finite & other.finite,
+            worst: self.worst.max(other.worst),
+        }
+    }
+}
+
+/// Work the caller wants done on each piece of the trial state
+/// (`first`, its positions, its velocities) right after an integrator has
+/// written it, by the thread that wrote it, while the piece is in its
+/// cache: the world's events and the finiteness scan (`World::trial`).
+pub(crate) type Finish<'a> = &'a (dyn Fn(usize, &mut [DVec3], &mut [DVec3]) -> Settled + Sync);
+
+/// What an integrator did with a [`Finish`].
+pub(crate) enum Written {
+    /// Not run (the integrator writes its trial in one go); true if it
+    /// knows every coordinate to be finite, as [`integrate`] answers.
+    Known(bool),
+    /// Run on every piece: their answers.
+    Settled(Settled),
+}
+
+/// [`integrate`], then `finish` on every piece of `to` where the
+/// integrator writes its last loop by pieces (symplectic Euler, RK4).
+pub(crate) fn integrate_then(
+    kind: IntegratorKind,
+    d: &mut Dynamics,
+    t: f64,
+    h: f64,
+    from: &State,
+    to: &mut State,
+    finish: Finish,
+) -> Written {
+    if d.particles.inv_mass3.len() != 3 * d.particles.inv_mass.len() {
+        return Written::Known(integrate(kind, d, t, h, from, to));
+    }
+    match kind {
+        IntegratorKind::Rk4 => rk4::step_then(d, t, h, from, to, Some(finish)),
+        IntegratorKind::Symplectic => symplectic::step_then(d, t, h, from, to, Some(finish)),
+        _ => Written::Known(integrate(kind, d, t, h, from, to)),
     }
 }
 

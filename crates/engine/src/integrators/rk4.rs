@@ -3,8 +3,8 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::{flat, flat_mut, Coord, Dynamics, SMALL};
-use crate::parallel::by_pieces;
+use super::{flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
+use crate::parallel::{by_pieces, fold_by_pieces};
 use crate::particle::State;
 use crate::simd::{chosen, Use};
 use glam::DVec3;
@@ -12,6 +12,22 @@ use glam::DVec3;
 /// One RK4 step of size `h` from time `t`; true if it knows every new
 /// coordinate to be finite (see [`super::integrate`]).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    match step_then(d, t, h, from, to, None) {
+        Written::Known(finite) => finite,
+        Written::Settled(s) => s.finite,
+    }
+}
+
+/// [`step`], then `finish` on each piece of the last stage (see
+/// [`super::integrate_then`]).
+pub(crate) fn step_then(
+    d: &mut Dynamics,
+    t: f64,
+    h: f64,
+    from: &State,
+    to: &mut State,
+    finish: Option<Finish>,
+) -> Written {
     let s = &mut *d.scratch;
     let (x0, v0) = (&from.pos, &from.vel);
     let half = 0.5 * h;
@@ -26,18 +42,18 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     // the weighted derivatives.
     d.forces.evaluate(t, h, x0, v0, d.particles, &mut s.force);
     let mut trial = [&mut to.pos, &mut to.vel, &mut s.dx, &mut s.dv];
-    start.run::<FIRST>(half, &s.force, &mut trial);
+    start.run::<FIRST>(half, &s.force, &mut trial, None);
     // Stages 2 and 3 at the midpoint.
     for step_to in [half, h] {
         let [x, v, ..] = &trial;
         d.forces
             .evaluate(t + half, h, x, v, d.particles, &mut s.force);
-        start.run::<MIDDLE>(step_to, &s.force, &mut trial);
+        start.run::<MIDDLE>(step_to, &s.force, &mut trial, None);
     }
     // Stage 4 at the end of the step, then the weighted sum.
     let [x, v, ..] = &trial;
     d.forces.evaluate(t + h, h, x, v, d.particles, &mut s.force);
-    start.run::<LAST>(h / 6.0, &s.force, &mut trial)
+    start.run::<LAST>(h / 6.0, &s.force, &mut trial, finish)
 }
 
 /// The stages' updates (a constant parameter, so that each is compiled on
@@ -117,15 +133,25 @@ impl Start<'_> {
     /// Runs stage `STAGE` with its step `s` over the `trial` state (x, v,
     /// dx, dv) with the forces `f`: particle by particle in a small world,
     /// else as flat arrays of every coordinate of every particle in turn,
-    /// in pieces (one per thread for a large world). True if the last stage
-    /// of a small world wrote only finite numbers.
+    /// in pieces (one per thread for a large world), then `finish` on each
+    /// piece (the last stage only).
     #[inline(always)]
-    fn run<const STAGE: u8>(&self, s: f64, f: &[DVec3], trial: &mut [&mut Vec<DVec3>; 4]) -> bool {
+    fn run<const STAGE: u8>(
+        &self,
+        s: f64,
+        f: &[DVec3],
+        trial: &mut [&mut Vec<DVec3>; 4],
+        finish: Option<Finish>,
+    ) -> Written {
         let [x, v, dx, dv] = trial;
         if self.x0.len() < SMALL {
-            return stage::<_, STAGE>(s, [self.x0, self.v0, f], self.w, [x, v, dx, dv]);
+            let finite = stage::<_, STAGE>(s, [self.x0, self.v0, f], self.w, [x, v, dx, dv]);
+            return match finish {
+                Some(finish) => Written::Settled(finish(0, x, v)),
+                None => Written::Known(finite),
+            };
         }
-        by_pieces(self.split, [x, v, dx, dv], |first, [x, v, dx, dv]| {
+        let piece = |first: usize, [x, v, dx, dv]: [&mut [DVec3]; 4]| {
             let r = first..first + x.len();
             let start = [
                 flat(&self.x0[r.clone()]),
@@ -139,8 +165,23 @@ impl Start<'_> {
                 #[inline(always)]
                 || stage::<_, STAGE>(s, start, w, trial),
             );
-        });
-        false
+        };
+        let slices = [&mut x[..], &mut v[..], &mut dx[..], &mut dv[..]];
+        match finish {
+            Some(finish) => Written::Settled(fold_by_pieces(
+                self.split,
+                slices,
+                |first, [x, v, dx, dv]| {
+                    piece(first, [&mut *x, &mut *v, dx, dv]);
+                    finish(first, x, v)
+                },
+                Settled::and,
+            )),
+            None => {
+                by_pieces(self.split, slices, piece);
+                Written::Known(false)
+            }
+        }
     }
 }
 

@@ -2,14 +2,31 @@
 //! `x₁ = x₀ + h v₁`. First order, but symplectic: on a conservative system its
 //! energy error oscillates and stays bounded instead of drifting.
 
-use super::{flat, flat_mut, Coord, Dynamics, SMALL};
-use crate::parallel::by_pieces;
+use super::{flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
+use crate::parallel::{by_pieces, fold_by_pieces};
 use crate::particle::State;
 use crate::simd::{chosen, Use};
+use glam::DVec3;
 
 /// One symplectic Euler step of size `h` from time `t`; true if it knows
 /// every new coordinate to be finite (see [`super::integrate`]).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    match step_then(d, t, h, from, to, None) {
+        Written::Known(finite) => finite,
+        Written::Settled(s) => s.finite,
+    }
+}
+
+/// [`step`], then `finish` on each piece it wrote (see
+/// [`super::integrate_then`]).
+pub(crate) fn step_then(
+    d: &mut Dynamics,
+    t: f64,
+    h: f64,
+    from: &State,
+    to: &mut State,
+    finish: Option<Finish>,
+) -> Written {
     let split = !d.forces.one_piece;
     let f = &mut d.scratch.force;
     d.forces
@@ -17,11 +34,15 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
     let f = &*f;
     if from.pos.len() < SMALL {
         let w = &d.particles.inv_mass;
-        return update(&from.pos, &from.vel, f, w, h, &mut to.pos, &mut to.vel);
+        let finite = update(&from.pos, &from.vel, f, w, h, &mut to.pos, &mut to.vel);
+        return match finish {
+            Some(finish) => Written::Settled(finish(0, &mut to.pos, &mut to.vel)),
+            None => Written::Known(finite),
+        };
     }
     // Each coordinate on its own, as one flat loop the compiler vectorises.
     let w3 = &d.particles.inv_mass3;
-    by_pieces(split, [&mut to.pos, &mut to.vel], |first, [x1, v1]| {
+    let piece = |first: usize, [x1, v1]: [&mut [DVec3]; 2]| {
         let r = first..first + x1.len();
         let (x0, v0, f) = (
             flat(&from.pos[r.clone()]),
@@ -34,8 +55,23 @@ pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> b
             #[inline(always)]
             || update(x0, v0, f, w, h, flat_mut(x1), flat_mut(v1)),
         );
-    });
-    false
+    };
+    let slices = [&mut to.pos[..], &mut to.vel[..]];
+    match finish {
+        Some(finish) => Written::Settled(fold_by_pieces(
+            split,
+            slices,
+            |first, [x1, v1]| {
+                piece(first, [&mut *x1, &mut *v1]);
+                finish(first, x1, v1)
+            },
+            Settled::and,
+        )),
+        None => {
+            by_pieces(split, slices, piece);
+            Written::Known(false)
+        }
+    }
 }
 
 /// `v₁ = v₀ + f (h w)`, `x₁ = x₀ + v₁ h` for each element (`w` the inverse
