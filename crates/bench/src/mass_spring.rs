@@ -130,7 +130,10 @@ pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
 /// published rule exactly, as any user can plug in their own.
 ///
 /// The rule looks at each particle on its own, so the event keeps no records:
-/// `check` and `handle` are its piece-by-piece versions over every particle.
+/// it settles pieces (each thread checks and handles the piece it has just
+/// integrated, inside the integrator's loop), and `check` and `handle` are
+/// its piece-by-piece versions over every particle, for the integrators
+/// that do not write by pieces.
 #[derive(Clone, Debug, Default)]
 pub struct WorkloadFloor;
 
