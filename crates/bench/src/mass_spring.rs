@@ -165,6 +165,17 @@ impl DiscreteEvent for WorkloadFloor {
 
     fn settle_piece(&self, piece: &mut TrialPiece) -> EventState {
         let p = piece.particles;
+        // A read-only scan first: most steps of most pieces have nothing
+        // below the floor, and it is cheaper than the loop that writes.
+        let inv_mass = &p.inv_mass[piece.first..];
+        if !piece
+            .pos
+            .iter()
+            .zip(inv_mass)
+            .any(|(x, &w)| x.y < 0.0 && w != 0.0)
+        {
+            return EventState::None;
+        }
         let (w, e) = (&p.inv_mass[piece.first..], &p.restitution[piece.first..]);
         let mut found = EventState::None;
         for (((x, v), &w), &e) in piece.pos.iter_mut().zip(piece.vel.iter_mut()).zip(w).zip(e) {
