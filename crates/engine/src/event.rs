@@ -153,10 +153,19 @@ pub trait DiscreteEvent: Send + Sync + CloneEvent {
     /// throws that trial away). The events of a world settle each piece in
     /// the order they were added, each seeing the piece as the ones before
     /// left it. Called only when [`settles_pieces`](Self::settles_pieces)
-    /// is true, from many threads at once: keep no records here.
+    /// is true, from many threads at once: records of what it did must wait
+    /// behind a lock until [`settled`](Self::settled) says whether the
+    /// world keeps the trial.
     fn settle_piece(&self, _piece: &mut TrialPiece) -> EventState {
         EventState::None
     }
+
+    /// Called on one thread after every trial whose pieces were settled:
+    /// `kept` when the world keeps the trial, false when it throws it away
+    /// (an event missed in some piece, or a blow-up). An event that keeps
+    /// records of what it settled gathers them here, or drops them (the
+    /// floor's bounces). Nothing, the default.
+    fn settled(&mut self, _kept: bool) {}
 
     /// Handles the event found by the last `check` (called only after
     /// `Occurring`, or after `Missed` once the step cannot be split further).

@@ -147,8 +147,8 @@ impl Forces {
         for f in &mut self.user_body {
             f.apply(&ctx, out);
         }
-        if let Some(f) = &mut self.floor {
-            f.apply(&ctx, out);
+        if let Some(f) = &self.floor {
+            f.apply_split(&ctx, out, !self.one_piece);
         }
         for f in &mut self.user_contact {
             f.apply(&ctx, out);

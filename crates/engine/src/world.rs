@@ -663,6 +663,7 @@ impl World {
         // The whole step first; pieces only after a missed event.
         let (events, finite) = self.trial(t0, dt, dt, false);
         let report = if events == EventState::Missed {
+            self.end_settled(false);
             let first = self.scratch.implicit.iterations;
             let mut r = self.backtrack(t0, dt)?;
             r.solver_iterations += first;
@@ -828,6 +829,7 @@ impl World {
         } else {
             first_non_finite(&self.next, &self.particles.fixed)
         };
+        self.end_settled(bad.is_none());
         if let Some(i) = bad {
             // The world stays at its last finite state.
             return Err(SimError::NonFinite {
@@ -837,6 +839,18 @@ impl World {
         }
         std::mem::swap(&mut self.state, &mut self.next);
         Ok(())
+    }
+
+    /// Tells the events whether the world keeps the trial they have just
+    /// settled by pieces (see [`DiscreteEvent::settled`]); nothing for a
+    /// trial checked otherwise.
+    #[inline]
+    fn end_settled(&mut self, kept: bool) {
+        if self.settled {
+            for e in &mut self.events {
+                e.settled(kept);
+            }
+        }
     }
 
     /// Takes the step `[t0, t0 + dt]` in pieces: halve a piece whenever an
@@ -856,6 +870,7 @@ impl World {
             report.solver_iterations += self.scratch.implicit.iterations;
             if worst == EventState::Missed {
                 if piece > 1 {
+                    self.end_settled(false);
                     piece /= 2;
                     report.backtracks += 1;
                     continue;

@@ -412,6 +412,51 @@ fn events_settled_piece_by_piece_are_the_same_bits() {
     }
 }
 
+/// The engine's floor settles pieces: alone in a world it takes that path,
+/// and beside an event that does not settle (an inert clamp far below) the
+/// path before. The same states and the same bounces, recorded in the same
+/// order, every step, on 1, 2 and 3 threads, with an envelope thin enough
+/// that trials are thrown away (their bounces with them) and retaken.
+#[test]
+fn the_floor_settles_pieces_with_the_same_bits_and_bounces() {
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let world = |settle: bool| {
+            let mut w = bare_cloth(kind, true);
+            w.add_floor(FloorDef {
+                envelope: 2e-4,
+                ..FloorDef::default()
+            })
+            .unwrap();
+            if !settle {
+                w.add_event(Box::new(Clamp::new(-1.0, Mode::Whole)));
+            }
+            w
+        };
+        let run = |threads: usize, settle: bool| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut w = world(settle);
+                let mut bounces = Vec::new();
+                for _ in 0..150 {
+                    w.step(1e-3).unwrap();
+                    bounces.extend_from_slice(w.event::<FloorCollision>().unwrap().collisions());
+                }
+                (hash(&w), bounces, w.stats())
+            })
+        };
+        let before = run(1, false);
+        assert!(before.1.len() > 100, "{kind}: {} bounces", before.1.len());
+        assert!(before.2.backtracks > 0, "{kind}: {:?}", before.2);
+        for threads in [1, 2, 3] {
+            let settled = run(threads, true);
+            assert!(settled == before, "{kind}, {threads} threads");
+        }
+    }
+}
+
 /// A large world that blows up names the same particle at the same time on
 /// any number of threads (each thread looks at its own piece first).
 #[test]

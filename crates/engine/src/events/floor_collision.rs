@@ -33,11 +33,12 @@
 //! speed it would have at the plane.
 
 use crate::error::ModelError;
-use crate::event::{DiscreteEvent, EventContext, EventState};
+use crate::event::{DiscreteEvent, EventContext, EventState, TrialPiece};
 use crate::force::Targets;
 use crate::particle::{non_negative, ParticleId, Properties};
 use glam::DVec3;
 use std::ops::Range;
+use std::sync::{Mutex, MutexGuard};
 
 /// One bounce recorded during the last step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -65,6 +66,42 @@ pub struct FloorCollision {
     step: f64,
     shift: f64,
     collisions: Vec<Collision>,
+    /// The bounces of the pieces of a trial settled on many threads, until
+    /// the world says whether it keeps the trial.
+    pending: Pending,
+}
+
+/// Bounces behind a lock (the pieces of a trial settle at once); a copy of
+/// the event copies them, and events compare equal with equal ones.
+#[derive(Default)]
+struct Pending(Mutex<Vec<Collision>>);
+
+impl Pending {
+    /// The bounces (a thread that panicked holding the lock left whole
+    /// records: each is pushed whole).
+    fn lock(&self) -> MutexGuard<'_, Vec<Collision>> {
+        self.0
+            .lock()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+impl Clone for Pending {
+    fn clone(&self) -> Self {
+        Pending(Mutex::new(self.lock().clone()))
+    }
+}
+
+impl PartialEq for Pending {
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other) || *self.lock() == *other.lock()
+    }
+}
+
+impl std::fmt::Debug for Pending {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.lock().fmt(f)
+    }
 }
 
 /// A sphere found below the plane by the last check.
@@ -92,6 +129,7 @@ impl FloorCollision {
             step: 0.0,
             shift: 0.0,
             collisions: Vec::new(),
+            pending: Pending::default(),
         }
     }
 
@@ -115,6 +153,62 @@ impl FloorCollision {
             Some(d) if d < -self.envelope => EventState::Missed,
             Some(_) => EventState::Occurring,
         }
+    }
+
+    /// Moves the sphere of `hit` (at `x`, moving at `v`) up to the plane
+    /// and resolves its impact, for a trial of the step `step` ending at
+    /// `t`, `shift` the integrator's free-flight shift times the hit's
+    /// acceleration and the step; the bounce, if it moved into the plane.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn resolve(
+        &self,
+        hit: Hit,
+        step: f64,
+        shift: f64,
+        t: f64,
+        x: &mut DVec3,
+        v: &mut DVec3,
+        particles: &Properties,
+    ) -> Option<Collision> {
+        let i = hit.index as usize;
+        let depth = particles.radius[i] - x.y;
+        x.y = particles.radius[i];
+        let (vy, a) = (v.y, hit.accel);
+        // The normal speed at the plane under the trial's mean
+        // acceleration; below zero the sphere could not have got this
+        // deep this fast, and it is simply put on the plane.
+        let at_plane = (vy * vy + 2.0 * a * depth).max(0.0).sqrt();
+        if vy >= 0.0 {
+            v.y = at_plane;
+            return None;
+        }
+        // The rebound, in the plain velocity and in the one the
+        // integrator's free flight conserves (`w = v + s a h`); the
+        // smaller raises neither energy. For explicit Euler the second is
+        // smaller: it keeps the ½ a² h² that each step of flight gains
+        // out of the next bounce, without which a bounce never ends.
+        let e = particles.restitution[i];
+        let w = vy + shift;
+        let w_at_plane = (w * w + 2.0 * a * depth).max(0.0).sqrt();
+        let rebound = (e * at_plane).min(e * w_at_plane - shift);
+        // A rebound that cannot keep the sphere off the plane for a
+        // whole step is not resolvable at this step: it rests.
+        let flight = if a < 0.0 {
+            2.0 * rebound / -a
+        } else {
+            f64::INFINITY
+        };
+        v.y = if at_plane < self.rest_speed || flight <= step {
+            0.0
+        } else {
+            rebound
+        };
+        Some(Collision {
+            particle: ParticleId(i as u32),
+            t,
+            impact_speed: at_plane,
+        })
     }
 
     /// The bounces of the last step.
@@ -180,47 +274,78 @@ impl DiscreteEvent for FloorCollision {
         Some(self.state(deepest))
     }
 
-    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
-        for hit in &self.hits {
-            let i = hit.index as usize;
-            let depth = particles.radius[i] - pos[i].y;
-            pos[i].y = particles.radius[i];
-            let (vy, a) = (vel[i].y, hit.accel);
-            // The normal speed at the plane under the trial's mean
-            // acceleration; below zero the sphere could not have got this
-            // deep this fast, and it is simply put on the plane.
-            let at_plane = (vy * vy + 2.0 * a * depth).max(0.0).sqrt();
-            if vy >= 0.0 {
-                vel[i].y = at_plane;
+    fn settles_pieces(&self) -> bool {
+        self.targets == Targets::All
+    }
+
+    fn settle_piece(&self, piece: &mut TrialPiece) -> EventState {
+        let p = piece.particles;
+        let r = piece.first..piece.first + piece.pos.len();
+        let (radius, inv_mass) = (&p.radius[r.clone()], &p.inv_mass[r]);
+        // As `check`: the deepest moving sphere below the plane, read only
+        // (most pieces of most steps have none).
+        let mut deepest = 0.0f64;
+        for (k, (x, r)) in piece.pos.iter().zip(radius).enumerate() {
+            let gap = x.y - r;
+            if gap < 0.0 && inv_mass[k] != 0.0 {
+                deepest = deepest.min(gap);
+            }
+        }
+        let state = self.state((deepest < 0.0).then_some(deepest));
+        if state == EventState::None || (state == EventState::Missed && !piece.finest) {
+            return state;
+        }
+        // As `handle`, for the spheres `check` would have recorded.
+        let mut bounces = Vec::new();
+        for k in 0..piece.pos.len() {
+            if inv_mass[k] == 0.0 || piece.pos[k].y - radius[k] >= 0.0 {
                 continue;
             }
-            // The rebound, in the plain velocity and in the one the
-            // integrator's free flight conserves (`w = v + s a h`); the
-            // smaller raises neither energy. For explicit Euler the second is
-            // smaller: it keeps the ½ a² h² that each step of flight gains
-            // out of the next bounce, without which a bounce never ends.
-            let e = particles.restitution[i];
-            let shift = self.shift * a * self.step;
-            let w = vy + shift;
-            let w_at_plane = (w * w + 2.0 * a * depth).max(0.0).sqrt();
-            let rebound = (e * at_plane).min(e * w_at_plane - shift);
-            // A rebound that cannot keep the sphere off the plane for a
-            // whole step is not resolvable at this step: it rests.
-            let flight = if a < 0.0 {
-                2.0 * rebound / -a
-            } else {
-                f64::INFINITY
+            let accel = (piece.vel[k].y - piece.start_vel[k].y) / piece.h;
+            let hit = Hit {
+                index: (piece.first + k) as u32,
+                accel,
             };
-            vel[i].y = if at_plane < self.rest_speed || flight <= self.step {
-                0.0
-            } else {
-                rebound
-            };
-            self.collisions.push(Collision {
-                particle: ParticleId(i as u32),
+            let (x, v) = (&mut piece.pos[k], &mut piece.vel[k]);
+            let shift = piece.flight_shift * accel * piece.step;
+            if let Some(c) = self.resolve(hit, piece.step, shift, piece.t, x, v, p) {
+                bounces.push(c);
+            }
+        }
+        if !bounces.is_empty() {
+            self.pending.lock().extend(bounces);
+        }
+        state
+    }
+
+    fn settled(&mut self, kept: bool) {
+        let pending = &mut *self.pending.lock();
+        if kept {
+            // Pieces finish in any order: the bounces in particle order,
+            // as `handle` records them.
+            pending.sort_by_key(|c| c.particle.0);
+            self.collisions.append(pending);
+        } else {
+            pending.clear();
+        }
+    }
+
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
+        for k in 0..self.hits.len() {
+            let hit = self.hits[k];
+            let i = hit.index as usize;
+            let shift = self.shift * hit.accel * self.step;
+            if let Some(c) = self.resolve(
+                hit,
+                self.step,
+                shift,
                 t,
-                impact_speed: at_plane,
-            });
+                &mut pos[i],
+                &mut vel[i],
+                particles,
+            ) {
+                self.collisions.push(c);
+            }
         }
     }
 

@@ -102,8 +102,23 @@ impl FloorContact {
     }
 }
 
-impl Force for FloorContact {
-    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
+impl FloorContact {
+    /// [`Force::apply`], split like the world's per-particle loops when
+    /// `split` (a large world's particles on many threads): each particle's
+    /// contact is its own, so the pieces give the same bits, and each
+    /// thread reads the particles it has just summed forces for.
+    pub(crate) fn apply_split(&self, ctx: &ForceContext, forces: &mut [DVec3], split: bool) {
+        if self.targets != Targets::All || !split {
+            return self.apply_all(ctx, forces);
+        }
+        crate::parallel::by_pieces(true, [forces], |first, [piece]| {
+            for (k, f) in piece.iter_mut().enumerate() {
+                self.contact(ctx, first + k, f);
+            }
+        });
+    }
+
+    fn apply_all(&self, ctx: &ForceContext, forces: &mut [DVec3]) {
         match &self.targets {
             Targets::All => {
                 for (i, f) in forces.iter_mut().enumerate() {
@@ -116,6 +131,12 @@ impl Force for FloorContact {
                 }
             }
         }
+    }
+}
+
+impl Force for FloorContact {
+    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
+        self.apply_all(ctx, forces);
     }
 
     fn stage(&self) -> Stage {
