@@ -37,7 +37,7 @@ pub struct Forces {
     pub(crate) floor: Option<FloorContact>,
     pub(crate) user_body: Vec<Box<dyn Force>>,
     pub(crate) user_contact: Vec<Box<dyn Force>>,
-    /// Keep the per-particle loops (gravity here, the integrators' updates)
+    /// Keep the per-particle loops (gravity and the floor's contact here, the integrators' updates)
     /// in one piece even in a large world (set by the world; see
     /// `World::one_piece`).
     pub(crate) one_piece: bool,

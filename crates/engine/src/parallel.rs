@@ -1,5 +1,5 @@
 //! One large world on many threads: its per-particle loops (the integrators'
-//! updates, gravity) split into one contiguous piece
+//! updates, gravity, the floor's contact force) split into one contiguous piece
 //! of particles per thread of the current rayon pool. Each particle's
 //! arithmetic is the same wherever it runs, so the results are the same
 //! bits on any number of threads. The pieces line up with the ranges the
