@@ -137,6 +137,14 @@ pub fn engine_world(spec: &Spec, kind: IntegratorKind) -> World {
 #[derive(Clone, Debug, Default)]
 pub struct WorkloadFloor;
 
+/// Whether a moving particle of `pos` (inverse masses `inv_mass`) is below
+/// the floor.
+fn below(pos: &[DVec3], inv_mass: &[f64]) -> bool {
+    pos.iter()
+        .zip(inv_mass)
+        .any(|(x, &w)| x.y < 0.0 && w != 0.0)
+}
+
 impl DiscreteEvent for WorkloadFloor {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.check_piece(ctx, 0..ctx.pos.len())
@@ -144,15 +152,13 @@ impl DiscreteEvent for WorkloadFloor {
     }
 
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
-        let below = ctx.pos[range.clone()]
-            .iter()
-            .zip(&ctx.particles.inv_mass[range])
-            .any(|(x, &w)| x.y < 0.0 && w != 0.0);
-        Some(if below {
-            EventState::Occurring
-        } else {
-            EventState::None
-        })
+        Some(
+            if below(&ctx.pos[range.clone()], &ctx.particles.inv_mass[range]) {
+                EventState::Occurring
+            } else {
+                EventState::None
+            },
+        )
     }
 
     fn handles_pieces(&self) -> bool {
@@ -164,30 +170,14 @@ impl DiscreteEvent for WorkloadFloor {
     }
 
     fn settle_piece(&self, piece: &mut TrialPiece) -> EventState {
-        let p = piece.particles;
-        // A read-only scan first: most steps of most pieces have nothing
+        // The read-only scan first: most steps of most pieces have nothing
         // below the floor, and it is cheaper than the loop that writes.
-        let inv_mass = &p.inv_mass[piece.first..];
-        if !piece
-            .pos
-            .iter()
-            .zip(inv_mass)
-            .any(|(x, &w)| x.y < 0.0 && w != 0.0)
-        {
+        let p = piece.particles;
+        if !below(piece.pos, &p.inv_mass[piece.first..]) {
             return EventState::None;
         }
-        let (w, e) = (&p.inv_mass[piece.first..], &p.restitution[piece.first..]);
-        let mut found = EventState::None;
-        for (((x, v), &w), &e) in piece.pos.iter_mut().zip(piece.vel.iter_mut()).zip(w).zip(e) {
-            if x.y < 0.0 && w != 0.0 {
-                if v.y < 0.0 {
-                    v.y *= -e;
-                }
-                x.y = 0.0;
-                found = EventState::Occurring;
-            }
-        }
-        found
+        self.handle_piece(piece.t, piece.first, piece.pos, piece.vel, p);
+        EventState::Occurring
     }
 
     fn handle_piece(

@@ -17,8 +17,7 @@ use crate::forces::{
     torque_joint::{TorqueJointDef, TorqueJointId},
 };
 use crate::integrators::{
-    flat, integrate, integrate_then, Dynamics, IntegratorKind, Scratch, Settled, Solver, Written,
-    SMALL,
+    flat, integrate_then, Dynamics, IntegratorKind, Scratch, Settled, Solver, Written, SMALL,
 };
 use crate::particle::{ParticleDef, ParticleId, Properties, State};
 use crate::simd::{chosen, Use};
@@ -707,59 +706,49 @@ impl World {
             scratch: &mut self.scratch,
             solver: self.solver,
         };
-        let mut finite;
-        if self.settles && (!self.events.is_empty() || self.state.pos.len() >= SMALL) {
-            let (events, particles, from) = (&self.events, &self.particles, &self.state);
-            let flight_shift = self.integrator.free_flight_shift();
-            let finish = |first: usize, pos: &mut [DVec3], vel: &mut [DVec3]| {
-                let r = first..first + pos.len();
-                let mut piece = TrialPiece {
-                    t: t + h,
-                    h,
-                    step,
-                    flight_shift,
-                    finest,
-                    first,
-                    pos,
-                    vel,
-                    start_pos: &from.pos[r.clone()],
-                    start_vel: &from.vel[r],
-                    particles,
-                };
-                let mut worst = EventState::None;
-                for e in events {
-                    worst = worst.max(e.settle_piece(&mut piece));
-                }
-                Settled {
-                    finite: all_finite(piece.pos, piece.vel),
-                    worst,
-                }
+        let settle = self.settles && (!self.events.is_empty() || self.state.pos.len() >= SMALL);
+        let (events, particles, from) = (&self.events, &self.particles, &self.state);
+        let flight_shift = self.integrator.free_flight_shift();
+        let finish = |first: usize, pos: &mut [DVec3], vel: &mut [DVec3]| {
+            let r = first..first + pos.len();
+            let mut piece = TrialPiece {
+                t: t + h,
+                h,
+                step,
+                flight_shift,
+                finest,
+                first,
+                pos,
+                vel,
+                start_pos: &from.pos[r.clone()],
+                start_vel: &from.vel[r],
+                particles,
             };
-            match integrate_then(
-                self.integrator,
-                &mut dynamics,
-                t,
-                h,
-                from,
-                &mut self.next,
-                &finish,
-            ) {
-                Written::Settled(s) => {
-                    self.settled = true;
-                    return (s.worst, s.finite);
-                }
-                Written::Known(f) => finite = f,
+            let mut worst = EventState::None;
+            for e in events {
+                worst = worst.max(e.settle_piece(&mut piece));
             }
-        } else {
-            finite = integrate(
-                self.integrator,
-                &mut dynamics,
-                t,
-                h,
-                &self.state,
-                &mut self.next,
-            );
-        }
+            Settled {
+                finite: all_finite(piece.pos, piece.vel),
+                worst,
+            }
+        };
+        let written = integrate_then(
+            self.integrator,
+            &mut dynamics,
+            t,
+            h,
+            from,
+            &mut self.next,
+            settle.then_some(&finish),
+        );
+        let mut finite = match written {
+            Written::Settled(s) => {
+                self.settled = true;
+                return (s.worst, s.finite);
+            }
+            Written::Known(finite) => finite,
+        };
         let large = crate::parallel::piece_len(self.len()).is_some()
             && self.events.len() <= PIECE_EVENTS
             && !self.unanswered;

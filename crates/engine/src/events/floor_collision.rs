@@ -217,6 +217,19 @@ impl FloorCollision {
     }
 }
 
+/// As `check` finds it: the gap of the deepest moving sphere below the
+/// plane (radii `radius`, inverse masses `inv_mass`), if any is.
+fn deepest(pos: &[DVec3], radius: &[f64], inv_mass: &[f64]) -> Option<f64> {
+    let mut deepest = 0.0f64;
+    for ((x, r), &w) in pos.iter().zip(radius).zip(inv_mass) {
+        let gap = x.y - r;
+        if gap < 0.0 && w != 0.0 {
+            deepest = deepest.min(gap);
+        }
+    }
+    (deepest < 0.0).then_some(deepest)
+}
+
 impl DiscreteEvent for FloorCollision {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.hits.clear();
@@ -259,19 +272,9 @@ impl DiscreteEvent for FloorCollision {
         if self.targets != Targets::All {
             return None;
         }
-        // As `check`: the deepest moving sphere below the plane.
         let p = ctx.particles;
-        let deepest = ctx.pos[range.clone()]
-            .iter()
-            .zip(&p.radius[range.clone()])
-            .zip(&p.inv_mass[range])
-            .filter(|&(_, &w)| w != 0.0)
-            .map(|((x, r), _)| x.y - r)
-            .filter(|&gap| gap < 0.0)
-            .fold(None, |d: Option<f64>, gap| {
-                Some(d.map_or(gap, |d| d.min(gap)))
-            });
-        Some(self.state(deepest))
+        let (r, w) = (&p.radius[range.clone()], &p.inv_mass[range.clone()]);
+        Some(self.state(deepest(&ctx.pos[range], r, w)))
     }
 
     fn settles_pieces(&self) -> bool {
@@ -282,16 +285,8 @@ impl DiscreteEvent for FloorCollision {
         let p = piece.particles;
         let r = piece.first..piece.first + piece.pos.len();
         let (radius, inv_mass) = (&p.radius[r.clone()], &p.inv_mass[r]);
-        // As `check`: the deepest moving sphere below the plane, read only
-        // (most pieces of most steps have none).
-        let mut deepest = 0.0f64;
-        for (k, (x, r)) in piece.pos.iter().zip(radius).enumerate() {
-            let gap = x.y - r;
-            if gap < 0.0 && inv_mass[k] != 0.0 {
-                deepest = deepest.min(gap);
-            }
-        }
-        let state = self.state((deepest < 0.0).then_some(deepest));
+        // Read only first: most pieces of most steps have nothing below.
+        let state = self.state(deepest(piece.pos, radius, inv_mass));
         if state == EventState::None || (state == EventState::Missed && !piece.finest) {
             return state;
         }

@@ -255,26 +255,7 @@ pub fn integrate(
     from: &State,
     to: &mut State,
 ) -> bool {
-    if d.particles.inv_mass3.len() != 3 * d.particles.inv_mass.len() {
-        // Properties filled in by hand rather than by a World: make the
-        // per-coordinate copies of the inverse masses for this step.
-        let mut particles = d.particles.clone();
-        particles.inv_mass3 = particles.inv_mass.iter().flat_map(|&w| [w; 3]).collect();
-        let mut own = Dynamics {
-            forces: &mut *d.forces,
-            particles: &particles,
-            scratch: &mut *d.scratch,
-            solver: d.solver,
-        };
-        return integrate(kind, &mut own, t, h, from, to);
-    }
-    match kind {
-        IntegratorKind::Euler => euler::step(d, t, h, from, to),
-        IntegratorKind::Midpoint => midpoint::step(d, t, h, from, to),
-        IntegratorKind::Rk4 => rk4::step(d, t, h, from, to),
-        IntegratorKind::Symplectic => symplectic::step(d, t, h, from, to),
-        IntegratorKind::Implicit => implicit::step(d, t, h, from, to),
-    }
+    integrate_then(kind, d, t, h, from, to, None).finite()
 }
 
 /// What the pieces of a trial said once settled ([`Finish`]), combined:
@@ -311,6 +292,16 @@ pub(crate) enum Written {
     Settled(Settled),
 }
 
+impl Written {
+    /// Whether the new state is known to be finite.
+    pub fn finite(self) -> bool {
+        match self {
+            Written::Known(finite) => finite,
+            Written::Settled(s) => s.finite,
+        }
+    }
+}
+
 /// [`integrate`], then `finish` on every piece of `to` where the
 /// integrator writes its last loop by pieces (symplectic Euler, RK4).
 pub(crate) fn integrate_then(
@@ -320,15 +311,27 @@ pub(crate) fn integrate_then(
     h: f64,
     from: &State,
     to: &mut State,
-    finish: Finish,
+    finish: Option<Finish>,
 ) -> Written {
     if d.particles.inv_mass3.len() != 3 * d.particles.inv_mass.len() {
-        return Written::Known(integrate(kind, d, t, h, from, to));
+        // Properties filled in by hand rather than by a World: make the
+        // per-coordinate copies of the inverse masses for this step.
+        let mut particles = d.particles.clone();
+        particles.inv_mass3 = particles.inv_mass.iter().flat_map(|&w| [w; 3]).collect();
+        let mut own = Dynamics {
+            forces: &mut *d.forces,
+            particles: &particles,
+            scratch: &mut *d.scratch,
+            solver: d.solver,
+        };
+        return integrate_then(kind, &mut own, t, h, from, to, finish);
     }
     match kind {
-        IntegratorKind::Rk4 => rk4::step_then(d, t, h, from, to, Some(finish)),
-        IntegratorKind::Symplectic => symplectic::step_then(d, t, h, from, to, Some(finish)),
-        _ => Written::Known(integrate(kind, d, t, h, from, to)),
+        IntegratorKind::Euler => Written::Known(euler::step(d, t, h, from, to)),
+        IntegratorKind::Midpoint => Written::Known(midpoint::step(d, t, h, from, to)),
+        IntegratorKind::Rk4 => rk4::step_then(d, t, h, from, to, finish),
+        IntegratorKind::Symplectic => symplectic::step_then(d, t, h, from, to, finish),
+        IntegratorKind::Implicit => Written::Known(implicit::step(d, t, h, from, to)),
     }
 }
 

@@ -12,10 +12,7 @@ use glam::DVec3;
 /// One RK4 step of size `h` from time `t`; true if it knows every new
 /// coordinate to be finite (see [`super::integrate`]).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    match step_then(d, t, h, from, to, None) {
-        Written::Known(finite) => finite,
-        Written::Settled(s) => s.finite,
-    }
+    step_then(d, t, h, from, to, None).finite()
 }
 
 /// [`step`], then `finish` on each piece of the last stage (see
