@@ -293,7 +293,9 @@ impl DiscreteEvent for FloorCollision {
         // As `handle`, for the spheres `check` would have recorded.
         let mut bounces = Vec::new();
         for k in 0..piece.pos.len() {
-            if inv_mass[k] == 0.0 || piece.pos[k].y - radius[k] >= 0.0 {
+            // A hit as in `check` (a NaN gap is none).
+            let below = inv_mass[k] != 0.0 && piece.pos[k].y - radius[k] < 0.0;
+            if !below {
                 continue;
             }
             let accel = (piece.vel[k].y - piece.start_vel[k].y) / piece.h;
