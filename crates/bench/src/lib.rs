@@ -679,7 +679,7 @@ fn allpairs_checks(x: &[DVec3], v: &[DVec3], steps: usize) -> Vec<Check> {
 }
 
 /// A rayon pool of `n` threads: what "1 thread" and "2 threads" mean for a
-/// world whose forces use threads (the n-body gather does).
+/// world whose forces use threads (the n-body pairs do).
 fn threads(n: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(n)

@@ -12,6 +12,9 @@
 use glam::DVec3;
 use rayon::prelude::*;
 use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
 
 /// Worlds with fewer particles stay on one thread.
 pub const MIN_PARTICLES: usize = 4096;
@@ -78,11 +81,13 @@ pub fn fold_by_pieces<const K: usize, R: Send>(
         pieces.push((first, head));
         first += take;
     }
-    pieces
-        .into_par_iter()
-        .map(|(first, piece)| body(first, piece))
-        .reduce_with(combine)
-        .unwrap_or_else(|| body(0, std::array::from_fn(|_| &mut [][..])))
+    fork(|| {
+        pieces
+            .into_par_iter()
+            .map(|(first, piece)| body(first, piece))
+            .reduce_with(combine)
+    })
+    .unwrap_or_else(|| body(0, std::array::from_fn(|_| &mut [][..])))
 }
 
 /// `body` of each piece `first..first + len` of a world of `n` particles
@@ -98,9 +103,58 @@ pub fn map_pieces<R: Send>(
     let Some(len) = piece_len(n) else {
         return body(0..n);
     };
-    (0..n.div_ceil(len))
-        .into_par_iter()
-        .map(|k| body(k * len..n.min((k + 1) * len)))
-        .reduce_with(combine)
-        .unwrap_or_else(|| body(0..0))
+    fork(|| {
+        (0..n.div_ceil(len))
+            .into_par_iter()
+            .map(|k| body(k * len..n.min((k + 1) * len)))
+            .reduce_with(combine)
+    })
+    .unwrap_or_else(|| body(0..0))
+}
+
+/// Counts the forks of every world's work: the threads [`fork`] leaves
+/// spinning watch it to know when to go back to the pool.
+static FORKS: AtomicU64 = AtomicU64::new(0);
+
+/// How long a thread spins for the next fork before it lets the pool put
+/// it to sleep.
+const LINGER: Duration = Duration::from_micros(300);
+
+/// Runs `work`, a fork-join of one world's work over the current pool's
+/// threads, then leaves the pool's other threads (as many as the machine
+/// has other cores) spinning until the next fork, or for [`LINGER`],
+/// instead of asleep.
+///
+/// Why: a rayon thread that finds nothing to do yields 33 times (a few
+/// microseconds here) and then sleeps, and waking it for the next fork
+/// costs 100–300 µs on a virtual machine, longer than the gap between a
+/// world's forks and often longer than the fork's whole work: the other
+/// thread then arrives too late to take its half (allpairs-1000 on two
+/// threads ran little faster than on one). Each fork bumps [`FORKS`];
+/// after the join one job per other thread waits for the count to move,
+/// yielding the core to anything else runnable. A job still queued when
+/// the next fork comes sees the count moved and returns at once, so no
+/// fork waits for one. Results are untouched.
+pub fn fork<R>(work: impl FnOnce() -> R) -> R {
+    FORKS.fetch_add(1, Ordering::Relaxed);
+    let r = work();
+    let others = rayon::current_num_threads().min(cores()) - 1;
+    if others > 0 && rayon::current_thread_index().is_some() {
+        let at = FORKS.load(Ordering::Relaxed);
+        for _ in 0..others {
+            rayon::spawn(move || {
+                let t = Instant::now();
+                while FORKS.load(Ordering::Relaxed) == at && t.elapsed() < LINGER {
+                    std::thread::yield_now();
+                }
+            });
+        }
+    }
+    r
+}
+
+/// The cores this process may run on (at least 1), asked once.
+fn cores() -> usize {
+    static CORES: OnceLock<usize> = OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }

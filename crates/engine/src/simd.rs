@@ -3,7 +3,7 @@
 //! build machine's CPU).
 //!
 //! Two kinds of loop choose separately:
-//! - [`Use::Arithmetic`]: the springs' blocks and the all-pairs gather,
+//! - [`Use::Arithmetic`]: the springs' blocks and the n-body pairs,
 //!   long runs of square roots, divisions and products on separate arrays;
 //! - [`Use::Updates`]: the integrators' flat updates and the finiteness
 //!   scan, a few additions per coordinate, short and memory-bound.

@@ -2,12 +2,11 @@
 //! §4.1.2), with optional Plummer softening: every pair attracts with
 //! `F = G mᵢ mⱼ d / (|d|² + ε²)^{3/2}`, equal and opposite.
 //!
-//! Evaluated as a gather (`gather.rs`): each body sums the pull of every
-//! other in a fixed order, vectorised over the others and, for large sets,
-//! bodies split among threads. Each body's sum is the same bits on any
-//! thread and any CPU (see `gather.rs`); Newton's third law then holds to
-//! rounding rather than exactly (a pairs-once loop made it exact but could
-//! neither vectorise nor split across threads). The tutorial
+//! Evaluated pair by pair once (`nbody/pairs.rs`): each body adds the pull of
+//! every body after it and gives that body the reaction, vectorised over
+//! the others and, for large sets, in ranges of rows split among threads.
+//! Each body's sum is the same bits on any thread and any CPU (see
+//! `nbody/pairs.rs`); Newton's third law holds to rounding. The tutorial
 //! version written outside the engine is `examples/nbody/gravity.rs`; this one is what
 //! scene files get as `[[nbody]]`.
 
@@ -16,8 +15,8 @@ use crate::force::{Force, ForceContext, Targets};
 use crate::particle::non_negative;
 use glam::DVec3;
 
-mod gather;
-use gather::Gather;
+mod pairs;
+use pairs::Pairs;
 
 /// Newtonian gravity between every pair of its bodies.
 #[derive(Clone, Debug)]
@@ -29,7 +28,7 @@ pub struct NBodyGravity {
     targets: Targets,
     /// The bodies' indices, resolved once (and again if `All` grows).
     indices: Vec<u32>,
-    scratch: Gather,
+    scratch: Pairs,
 }
 
 impl NBodyGravity {
@@ -47,7 +46,7 @@ impl NBodyGravity {
             softening,
             targets,
             indices,
-            scratch: Gather::default(),
+            scratch: Pairs::default(),
         }
     }
 
@@ -71,7 +70,7 @@ impl NBodyGravity {
         } else {
             self.indices.len()
         };
-        gather::splits(bodies) && rayon::current_num_threads() > 1
+        pairs::splits(bodies) && rayon::current_num_threads() > 1
     }
 
     fn resolve(&mut self, n: usize) {
@@ -88,7 +87,7 @@ impl Force for NBodyGravity {
         let (pos, mass) = (ctx.pos, &ctx.particles.mass);
         let s = &mut self.scratch;
         s.load(&self.indices, pos, mass);
-        s.gather(eps2);
+        s.sum(eps2);
         for (k, &i) in self.indices.iter().enumerate() {
             let i = i as usize;
             let a = DVec3::new(s.ax[k], s.ay[k], s.az[k]);

@@ -166,24 +166,26 @@ impl Parallel {
         }
         let (whole, per_block, local) =
             (&self.whole[..], per_range.div_ceil(BLOCK), &self.local[..]);
-        tasks.into_par_iter().for_each(|(t, code, kept, piece)| {
-            // (With more threads than springs the last tasks have none.)
-            if let Some((g, mass)) = start {
-                for (f, &m) in piece.iter_mut().zip(&mass[t * per_piece..]) {
-                    *f = m * g;
+        crate::parallel::fork(|| {
+            tasks.into_par_iter().for_each(|(t, code, kept, piece)| {
+                // (With more threads than springs the last tasks have none.)
+                if let Some((g, mass)) = start {
+                    for (f, &m) in piece.iter_mut().zip(&mass[t * per_piece..]) {
+                        *f = m * g;
+                    }
                 }
-            }
-            let first = (t * per_range).min(springs.len());
-            let range = springs.range(first..first + kept.len());
-            let mut sink = Owned {
-                scatter: Scatter::new(piece),
-                lo: t * per_piece,
-                code,
-                whole: &whole[t * per_block..(t + 1) * per_block],
-                local: &local[first..first + kept.len()],
-                kept,
-            };
-            run(range, &mut Block::default(), pos, vel, &mut sink);
+                let first = (t * per_range).min(springs.len());
+                let range = springs.range(first..first + kept.len());
+                let mut sink = Owned {
+                    scatter: Scatter::new(piece),
+                    lo: t * per_piece,
+                    code,
+                    whole: &whole[t * per_block..(t + 1) * per_block],
+                    local: &local[first..first + kept.len()],
+                    kept,
+                };
+                run(range, &mut Block::default(), pos, vel, &mut sink);
+            });
         });
         for (k, &p) in self.shared.iter().enumerate() {
             let (from, to) = (self.start[k] as usize, self.start[k + 1] as usize);
