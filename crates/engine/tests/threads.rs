@@ -164,9 +164,10 @@ fn an_n_body_world_is_the_same_bits_on_any_number_of_threads() {
     assert_eq!(run(2, 0.01), GOLDEN, "{:#018x}", run(2, 0.01));
 }
 
-/// `hash` after 50 steps on 2 threads, softening 0.01, since the gather
-/// visits each pair once (measured on an Intel Xeon, where the gather runs
-/// AVX2; the kernel's test shows AVX-512, AVX2 and SSE2 give the same bits).
+/// `hash` after 50 steps on 2 threads, softening 0.01, since the n-body
+/// force visits each pair once (measured on an Intel Xeon, where its kernel
+/// runs AVX2; the kernel's test shows AVX-512, AVX2 and SSE2 give the same
+/// bits).
 const GOLDEN: u64 = 0x15e1_de14_aec2_b678;
 
 /// Pieces handled by every [`Clamp`] so far.
