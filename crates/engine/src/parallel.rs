@@ -29,6 +29,14 @@ pub fn piece_len(n: usize) -> Option<usize> {
     (threads > 1).then(|| n.div_ceil(threads))
 }
 
+/// Takes the first `len` elements off the front of `s` (`len <= s.len()`).
+#[inline]
+pub fn take_front<'a, T>(s: &mut &'a mut [T], len: usize) -> &'a mut [T] {
+    let (head, rest) = std::mem::take(s).split_at_mut(len);
+    *s = rest;
+    head
+}
+
 /// Calls `body(first, pieces)` for contiguous pieces `first..first + len` of
 /// the `slices` (all as long as each other): once with everything for small
 /// worlds or without `split`, once per thread for large ones.
@@ -73,11 +81,7 @@ pub fn fold_by_pieces<const K: usize, R: Send>(
     let mut first = 0;
     while first < n {
         let take = len.min(n - first);
-        let head: [&mut [DVec3]; K] = std::array::from_fn(|k| {
-            let (head, tail) = std::mem::take(&mut rest[k]).split_at_mut(take);
-            rest[k] = tail;
-            head
-        });
+        let head: [&mut [DVec3]; K] = rest.each_mut().map(|r| take_front(r, take));
         pieces.push((first, head));
         first += take;
     }

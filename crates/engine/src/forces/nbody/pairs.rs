@@ -19,6 +19,7 @@
 //!   whatever the vector width, so AVX-512, AVX2 and plain SSE2 give the
 //!   same bits; the ranges may run on any thread.
 
+use crate::parallel::take_front;
 use crate::simd::{width, Use, Width};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -103,18 +104,13 @@ impl Pairs {
         };
         // Each range's rows and buffer.
         let mut tasks = Vec::with_capacity(self.bounds.len() - 1);
-        let (mut ax, mut ay, mut az) = (&mut self.ax[..], &mut self.ay[..], &mut self.az[..]);
-        let (mut rx, mut ry, mut rz) = (&mut self.rx[..], &mut self.ry[..], &mut self.rz[..]);
+        let mut own: Out = [&mut self.ax, &mut self.ay, &mut self.az];
+        let mut react: Out = [&mut self.rx, &mut self.ry, &mut self.rz];
         for w in self.bounds.windows(2) {
             let rows = w[1] - w[0];
-            let (oax, tax) = std::mem::take(&mut ax).split_at_mut(rows);
-            let (oay, tay) = std::mem::take(&mut ay).split_at_mut(rows);
-            let (oaz, taz) = std::mem::take(&mut az).split_at_mut(rows);
-            let (orx, trx) = std::mem::take(&mut rx).split_at_mut(padded);
-            let (ory, try_) = std::mem::take(&mut ry).split_at_mut(padded);
-            let (orz, trz) = std::mem::take(&mut rz).split_at_mut(padded);
-            (ax, ay, az, rx, ry, rz) = (tax, tay, taz, trx, try_, trz);
-            tasks.push((w[0], [oax, oay, oaz], [orx, ory, orz]));
+            let own = own.each_mut().map(|a| take_front(a, rows));
+            let react = react.each_mut().map(|r| take_front(r, padded));
+            tasks.push((w[0], own, react));
         }
         if splits(n) {
             crate::parallel::fork(|| {

@@ -13,6 +13,7 @@
 
 use super::kernel::{run, Block, Scatter, Sink, BLOCK};
 use super::Slice;
+use crate::parallel::take_front;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -158,11 +159,7 @@ impl Parallel {
             let (c, rest) = code.split_at(per_range.min(code.len()));
             code = rest;
             let (nk, np) = (per_range.min(kept.len()), per_piece.min(piece.len()));
-            let (k, rest) = std::mem::take(&mut kept).split_at_mut(nk);
-            kept = rest;
-            let (p, rest) = std::mem::take(&mut piece).split_at_mut(np);
-            piece = rest;
-            tasks.push((t, c, k, p));
+            tasks.push((t, c, take_front(&mut kept, nk), take_front(&mut piece, np)));
         }
         let (whole, per_block, local) =
             (&self.whole[..], per_range.div_ceil(BLOCK), &self.local[..]);
