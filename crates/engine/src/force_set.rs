@@ -155,6 +155,62 @@ impl Forces {
         }
     }
 
+    /// Whether [`Self::evaluate_then`] may be used: gravity on every
+    /// particle or none, springs in blocks on the calling thread, and no
+    /// other force (so the springs are the last to add to a particle).
+    pub(crate) fn can_evaluate_then(&self) -> bool {
+        self.gravity
+            .as_ref()
+            .is_none_or(|g| g.targets == Targets::All)
+            && self.springs.can_apply_then()
+            && self.angle_joints.is_empty()
+            && self.torque_joints.is_empty()
+            && self.constant_forces.is_empty()
+            && self.fluids.is_empty()
+            && self.nbody.is_empty()
+            && self.user_body.is_empty()
+            && self.floor.is_none()
+            && self.user_contact.is_empty()
+    }
+
+    /// [`Self::evaluate`] on the calling thread
+    /// ([`Self::can_evaluate_then`]), handing on the particles whose net
+    /// force is complete as soon as it is, while it is still in the cache
+    /// (see `Springs::apply_then`): `then(range, forces)` for consecutive
+    /// ranges from the first particle to the last. The same forces, to the
+    /// bit, as [`Self::evaluate`].
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn evaluate_then(
+        &mut self,
+        t: f64,
+        dt: f64,
+        pos: &[DVec3],
+        vel: &[DVec3],
+        particles: &Properties,
+        out: &mut [DVec3],
+        then: impl FnMut(std::ops::Range<usize>, &[DVec3]),
+    ) {
+        let ctx = ForceContext {
+            t,
+            dt,
+            pos,
+            vel,
+            particles,
+            gravity: self.g(),
+        };
+        let g = self.gravity.as_ref().map(|g| g.g);
+        let mass = &particles.mass;
+        let start = |r: std::ops::Range<usize>, out: &mut [DVec3]| match g {
+            Some(g) => {
+                for (f, &m) in out.iter_mut().zip(&mass[r]) {
+                    *f = m * g;
+                }
+            }
+            None => out.fill(DVec3::ZERO),
+        };
+        self.springs.apply_then(&ctx, out, start, then);
+    }
+
     /// Adds the derivatives of every force that gives them at `ctx` to
     /// `jac` (see [`Force::jacobian`]); the others are left to be taken
     /// explicitly.

@@ -60,11 +60,21 @@ impl Block {
     #[inline(always)]
     fn compute(&mut self, springs: Slice) {
         let n = springs.len().min(BLOCK);
-        let (k, c, r) = (
-            &springs.stiffness[..n],
-            &springs.damping[..n],
-            &springs.rest_length[..n],
-        );
+        let r = &springs.rest_length[..n];
+        match springs.shared {
+            Some((k, c)) => self.compute_with(r, |_| k, |_| c),
+            None => {
+                let (k, c) = (&springs.stiffness[..n], &springs.damping[..n]);
+                self.compute_with(r, |i| k[i], |i| c[i])
+            }
+        }
+    }
+
+    /// [`Self::compute`] for the springs of rest lengths `r`, spring `i`
+    /// of stiffness `k(i)` and damping `c(i)`.
+    #[inline(always)]
+    fn compute_with(&mut self, r: &[f64], k: impl Fn(usize) -> f64, c: impl Fn(usize) -> f64) {
+        let n = r.len().min(BLOCK);
         let [dx, dy, dz] = &self.d;
         let [wx, wy, wz] = &self.w;
         let [fx, fy, fz] = &mut self.f;
@@ -72,7 +82,7 @@ impl Block {
             let len = ((dx[i] * dx[i] + dy[i] * dy[i]) + dz[i] * dz[i]).sqrt();
             let inv = if len > 0.0 { 1.0 / len } else { 0.0 };
             let (nx, ny, nz) = (dx[i] * inv, dy[i] * inv, dz[i] * inv);
-            let s = k[i] * (len - r[i]) + c[i] * ((wx[i] * nx + wy[i] * ny) + wz[i] * nz);
+            let s = k(i) * (len - r[i]) + c(i) * ((wx[i] * nx + wy[i] * ny) + wz[i] * nz);
             fx[i] = nx * s;
             fy[i] = ny * s;
             fz[i] = nz * s;
@@ -238,10 +248,144 @@ impl Sink for Scatter<'_> {
     }
 }
 
+/// Particles handed on at a time by [`Staged`] (fewer wait for the next
+/// block): a few pages of each array, still in the cache the springs
+/// warmed.
+const STAGE: usize = 256;
+
+/// Where a world's particles stand as its springs are added in blocks, for
+/// [`Staged`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(super) struct Stages {
+    /// Before block `b`, every particle before `first_touch[b]` must have
+    /// its force started (no spring up to block `b` touches a later one).
+    first_touch: Vec<u32>,
+    /// After block `b`, every particle before `complete[b]` has its force
+    /// (no later spring touches it).
+    complete: Vec<u32>,
+}
+
+impl Stages {
+    /// The stages of the springs with `ends` among `particles` particles.
+    pub fn new(ends: &[[u32; 2]], particles: usize) -> Self {
+        // The block of each particle's last spring, plus one (0: none).
+        let mut last = vec![0usize; particles];
+        let mut reach = 0;
+        let mut first_touch = Vec::with_capacity(ends.len().div_ceil(BLOCK));
+        for (k, block) in ends.chunks(BLOCK).enumerate() {
+            for &[a, b] in block {
+                last[a as usize] = k + 1;
+                last[b as usize] = k + 1;
+                reach = reach.max(a.max(b) + 1);
+            }
+            first_touch.push(reach);
+        }
+        let mut p = 0;
+        let complete = (0..first_touch.len())
+            .map(|k| {
+                while p < particles && last[p] <= k + 1 {
+                    p += 1;
+                }
+                p as u32
+            })
+            .collect();
+        Stages {
+            first_touch,
+            complete,
+        }
+    }
+}
+
+/// The one-thread sink that starts each particle's force just before the
+/// first spring adds to it (`start(range, forces)`, in order, each particle
+/// once), and hands it on as soon as it is complete (`then(range,
+/// forces)`, in order, each particle once, the last of them after the last
+/// block). A mesh lists its springs particle by particle, so its particles
+/// are started and handed on while they are in the cache, and no pass over
+/// all of them comes before or after the springs.
+pub(super) struct Staged<'a, S, F> {
+    scatter: Scatter<'a>,
+    stages: &'a Stages,
+    /// The particles started so far: `0..started`.
+    started: usize,
+    /// The particles handed on so far: `0..done`.
+    done: usize,
+    start: S,
+    then: F,
+}
+
+impl<'a, S, F> Staged<'a, S, F>
+where
+    S: FnMut(std::ops::Range<usize>, &mut [DVec3]),
+    F: FnMut(std::ops::Range<usize>, &[DVec3]),
+{
+    /// A sink adding to `forces`, staged by `stages`.
+    pub fn new(forces: &'a mut [DVec3], stages: &'a Stages, start: S, then: F) -> Self {
+        Staged {
+            scatter: Scatter::new(forces),
+            stages,
+            started: 0,
+            done: 0,
+            start,
+            then,
+        }
+    }
+
+    /// Starts the particles up to `to`.
+    fn start_to(&mut self, to: usize) {
+        if to > self.started {
+            let range = self.started..to;
+            (self.start)(range.clone(), &mut self.scatter.forces[range]);
+            self.started = to;
+        }
+    }
+
+    /// Hands on the particles up to `to`.
+    fn hand_on(&mut self, to: usize) {
+        // A particle no spring touches may come before the springs reach it.
+        self.start_to(to);
+        let range = self.done..to;
+        (self.then)(range.clone(), &self.scatter.forces[range]);
+        self.done = to;
+    }
+}
+
+impl<S, F> Sink for Staged<'_, S, F>
+where
+    S: FnMut(std::ops::Range<usize>, &mut [DVec3]),
+    F: FnMut(std::ops::Range<usize>, &[DVec3]),
+{
+    #[inline(always)]
+    fn take(&mut self, first: usize, ends: &[[u32; 2]], block: &Block) {
+        let k = first / BLOCK;
+        self.start_to(self.stages.first_touch[k] as usize);
+        self.scatter.take(first, ends, block);
+        let complete = self.stages.complete[k] as usize;
+        if complete >= self.done + STAGE {
+            // The particle of the open run may be among them: its sum so
+            // far is its force if no later spring touches it, and is
+            // stored again if one does.
+            if let Some(p) = self.scatter.run {
+                self.scatter.forces[p] = self.scatter.acc;
+            }
+            self.hand_on(complete);
+        }
+    }
+
+    fn finish(&mut self) {
+        self.scatter.finish();
+        let n = self.scatter.forces.len();
+        if self.done < n {
+            self.hand_on(n);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::Table;
     use super::*;
+    use std::ops::Range;
 
     /// 300 springs among 120 particles, in no particular order: runs of a
     /// shared first end, chains, repeated pairs, a spring squashed to a point,
@@ -284,6 +428,106 @@ mod tests {
             .iter()
             .flat_map(|f| f.to_array().map(f64::to_bits))
             .collect()
+    }
+
+    /// What a staged run gives: the forces, the ranges started, and the
+    /// ranges handed on with their forces then.
+    type StagedRun = (
+        Vec<DVec3>,
+        Vec<Range<usize>>,
+        Vec<(Range<usize>, Vec<DVec3>)>,
+    );
+
+    /// Runs the staged sink over `t`, the forces started at `start`.
+    fn staged(t: &Table, pos: &[DVec3], vel: &[DVec3], start: &[DVec3]) -> StagedRun {
+        let stages = Stages::new(&t.ends, pos.len());
+        let mut forces = vec![DVec3::NAN; pos.len()];
+        let (mut started, mut handed) = (Vec::new(), Vec::new());
+        let mut sink = Staged::new(
+            &mut forces,
+            &stages,
+            |r: Range<usize>, f: &mut [DVec3]| {
+                f.copy_from_slice(&start[r.clone()]);
+                started.push(r);
+            },
+            |r: Range<usize>, f: &[DVec3]| handed.push((r, f.to_vec())),
+        );
+        run(t.all(), &mut Block::default(), pos, vel, &mut sink);
+        (forces, started, handed)
+    }
+
+    /// The ranges cover `0..n` in order, each particle once.
+    fn consecutive<'a>(ranges: impl Iterator<Item = &'a Range<usize>>, n: usize) {
+        let mut next = 0;
+        for r in ranges {
+            assert_eq!(r.start, next, "ranges in order, none left out");
+            assert!(r.end > r.start, "no empty range");
+            next = r.end;
+        }
+        assert_eq!(next, n, "every particle");
+    }
+
+    /// Staged, the springs add the same bits as the plain loop: every
+    /// particle is started before a spring adds to it (else the spring's
+    /// part would be lost), once, and handed on with its final force (no
+    /// spring added to it afterwards), once, in order; springs in no
+    /// particular order, and a few particles no spring touches.
+    #[test]
+    fn staged_springs_start_and_hand_on_each_particle_once_with_its_final_force() {
+        let (t, mut pos, mut vel) = springs();
+        // Particles 120..130 have no springs.
+        pos.extend((0..10).map(|i| DVec3::splat(i as f64)));
+        vel.extend((0..10).map(|i| DVec3::splat(-(i as f64))));
+        let start: Vec<DVec3> = (0..pos.len()).map(|i| DVec3::splat(i as f64)).collect();
+        let mut want = start.clone();
+        plain(t.all(), &pos, &vel, &mut want);
+        let (forces, started, handed) = staged(&t, &pos, &vel, &start);
+        assert_eq!(bits(&forces), bits(&want));
+        consecutive(started.iter(), pos.len());
+        consecutive(handed.iter().map(|(r, _)| r), pos.len());
+        for (r, f) in &handed {
+            assert_eq!(bits(f), bits(&want[r.clone()]), "{r:?} handed on complete");
+        }
+    }
+
+    /// Springs listed particle by particle (a chain of 2,000) come out in
+    /// stages of at least `STAGE` particles while the springs are added,
+    /// not all at the end.
+    #[test]
+    fn staged_a_chain_in_order_is_handed_on_while_its_springs_are_added() {
+        let n = 2000;
+        let mut t = Table::default();
+        for i in 0..n as u32 - 1 {
+            t.ends.push([i, i + 1]);
+            t.stiffness.push(10.0);
+            t.damping.push(0.1);
+            t.rest_length.push(0.5);
+        }
+        let pos: Vec<DVec3> = (0..n)
+            .map(|i| DVec3::new(i as f64, 0.01 * i as f64, 0.0))
+            .collect();
+        let vel = vec![DVec3::ZERO; n];
+        let start = vec![DVec3::ZERO; n];
+        let mut want = start.clone();
+        plain(t.all(), &pos, &vel, &mut want);
+        let (forces, started, handed) = staged(&t, &pos, &vel, &start);
+        assert_eq!(bits(&forces), bits(&want));
+        assert!(started.len() > n / BLOCK / 2, "{} starts", started.len());
+        assert!(
+            handed.len() >= n / (STAGE + BLOCK),
+            "{} hand-ons",
+            handed.len()
+        );
+        for (r, f) in &handed {
+            assert_eq!(bits(f), bits(&want[r.clone()]), "{r:?} handed on complete");
+        }
+        let (last, rest) = handed.split_last().unwrap();
+        assert!(rest.iter().all(|(r, _)| r.len() >= STAGE));
+        assert!(
+            last.0.len() <= STAGE + BLOCK,
+            "{:?} left to the end",
+            last.0
+        );
     }
 
     #[test]
