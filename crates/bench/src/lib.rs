@@ -679,12 +679,11 @@ fn allpairs_checks(x: &[DVec3], v: &[DVec3], steps: usize) -> Vec<Check> {
 }
 
 /// A rayon pool of `n` threads: what "1 thread" and "2 threads" mean for a
-/// world whose forces use threads (the n-body pairs do).
+/// world whose forces use threads (the n-body pairs do). Its threads keep
+/// to their own processors (`animats_engine::pin`; the steps run inside
+/// the pool, where that pays).
 fn threads(n: usize) -> rayon::ThreadPool {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(n)
-        .build()
-        .expect("a thread pool")
+    animats_engine::pin::pinned_pool(n).expect("a thread pool")
 }
 
 fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {

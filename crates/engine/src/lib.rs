@@ -39,6 +39,7 @@ pub mod integrators;
 pub mod jacobian;
 mod parallel;
 pub mod particle;
+pub mod pin;
 mod simd;
 pub mod snapshot;
 pub mod world;
