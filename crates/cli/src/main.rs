@@ -62,7 +62,7 @@ fn main() -> ExitCode {
     // On request, the global pool's threads keep to their own processors
     // (`animats_engine::pin`). Not by default: where this loop steps a
     // world from outside the pool, a pinned pool measured slower on a
-    // cloth on the floor (docs/PERFORMANCE.md, 2026-11-25 11:40 UTC).
+    // cloth on the floor (docs/PERFORMANCE.md, 2026-11-25 11:38 UTC).
     // Nothing has built the pool yet; if something had, it stays as it is.
     if std::env::var_os("ANIMATS_PIN_THREADS").is_some_and(|v| v == "1") {
         let _ = animats_engine::pin::pin_global_pool();

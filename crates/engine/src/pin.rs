@@ -4,7 +4,7 @@
 //! at a time (a thread woken by the other is placed beside it), and the
 //! second thread then gains nothing (allpairs-1000 on two threads: 1.63–
 //! 1.65× one thread unpinned, 1.89–1.91× pinned; docs/PERFORMANCE.md,
-//! 2026-11-25 11:40 UTC). Pinning changes speed only, never results.
+//! 2026-11-25 11:38 UTC). Pinning changes speed only, never results.
 //!
 //! Thread `i` of a pool of `n` is pinned to the `i`-th processor the
 //! process may use, and only when it may use at least `n` (a pool larger
