@@ -1,8 +1,9 @@
 //! Pools whose threads keep to their own processors. A world split over
 //! threads forks and joins a few times a step; left to itself, the system
 //! often runs both threads of a pool on one processor for a hundred steps
-//! at a time (a thread woken by the other is placed beside it), and the
-//! second thread then gains nothing (allpairs-1000 on two threads: 1.63–
+//! at a time (we suppose because a woken thread is placed beside the one
+//! that woke it; the probe saw only where they ran), and the second
+//! thread then gains less than it could (allpairs-1000 on two threads: 1.63–
 //! 1.65× one thread unpinned, 1.89–1.91× pinned; docs/PERFORMANCE.md,
 //! 2026-11-25 11:38 UTC). Pinning changes speed only, never results.
 //!
