@@ -23,12 +23,16 @@
 /// A rayon pool of `threads` threads, each pinned to its own processor
 /// (see the module's documentation).
 pub fn pinned_pool(threads: usize) -> Result<rayon::ThreadPool, rayon::ThreadPoolBuildError> {
+    pinned(threads).build()
+}
+
+/// A builder of a pool of `threads` threads, each pinned as it starts.
+fn pinned(threads: usize) -> rayon::ThreadPoolBuilder {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .start_handler(move |i| {
             pin_thread(i, threads);
         })
-        .build()
 }
 
 /// Makes rayon's global pool a pinned one, of `RAYON_NUM_THREADS` threads
@@ -40,12 +44,7 @@ pub fn pin_global_pool() -> Result<(), rayon::ThreadPoolBuildError> {
         .and_then(|s| s.parse::<usize>().ok())
         .filter(|&n| n > 0)
         .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .start_handler(move |i| {
-            pin_thread(i, threads);
-        })
-        .build_global()
+    pinned(threads).build_global()
 }
 
 /// Whether pinning is turned off (`ANIMATS_PIN_THREADS=0`).

@@ -40,13 +40,7 @@ pub(crate) fn step_then(
         d.forces
             .evaluate_then(t, h, &from.pos, &from.vel, d.particles, f, |r, f| {
                 let (x1, v1) = (take_front(&mut x1, r.len()), take_front(&mut v1, r.len()));
-                let (x0, v0) = (flat(&from.pos[r.clone()]), flat(&from.vel[r.clone()]));
-                let w = &w3[3 * r.start..3 * r.end];
-                chosen(
-                    Use::Updates,
-                    #[inline(always)]
-                    || update(x0, v0, flat(f), w, h, flat_mut(x1), flat_mut(v1)),
-                );
+                update_piece(r.start, from, f, w3, h, [&mut *x1, &mut *v1]);
                 if let Some(finish) = finish {
                     settled = settled.and(finish(r.start, x1, v1));
                 }
@@ -67,21 +61,10 @@ pub(crate) fn step_then(
             None => Written::Known(finite),
         };
     }
-    // Each coordinate on its own, as one flat loop the compiler vectorises.
     let w3 = &d.particles.inv_mass3;
-    let piece = |first: usize, [x1, v1]: [&mut [DVec3]; 2]| {
-        let r = first..first + x1.len();
-        let (x0, v0, f) = (
-            flat(&from.pos[r.clone()]),
-            flat(&from.vel[r.clone()]),
-            flat(&f[r]),
-        );
-        let w = &w3[3 * first..3 * first + x0.len()];
-        chosen(
-            Use::Updates,
-            #[inline(always)]
-            || update(x0, v0, f, w, h, flat_mut(x1), flat_mut(v1)),
-        );
+    let piece = |first: usize, out: [&mut [DVec3]; 2]| {
+        let r = first..first + out[0].len();
+        update_piece(first, from, &f[r], w3, h, out);
     };
     let slices = [&mut to.pos[..], &mut to.vel[..]];
     match finish {
@@ -99,6 +82,29 @@ pub(crate) fn step_then(
             Written::Known(false)
         }
     }
+}
+
+/// [`update`] of the particles `first..first + x1.len()` from `from`, with
+/// their forces `f` and the per-coordinate inverse masses `w3` of every
+/// particle, into `x1`, `v1`: each coordinate on its own, as one flat loop
+/// the compiler vectorises.
+#[inline(always)]
+fn update_piece(
+    first: usize,
+    from: &State,
+    f: &[DVec3],
+    w3: &[f64],
+    h: f64,
+    [x1, v1]: [&mut [DVec3]; 2],
+) {
+    let r = first..first + x1.len();
+    let (x0, v0) = (flat(&from.pos[r.clone()]), flat(&from.vel[r]));
+    let w = &w3[3 * first..3 * first + x0.len()];
+    chosen(
+        Use::Updates,
+        #[inline(always)]
+        || update(x0, v0, flat(f), w, h, flat_mut(x1), flat_mut(v1)),
+    );
 }
 
 /// `v₁ = v₀ + f (h w)`, `x₁ = x₀ + v₁ h` for each element (`w` the inverse
