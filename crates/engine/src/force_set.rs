@@ -155,10 +155,12 @@ impl Forces {
         }
     }
 
-    /// Whether [`Self::evaluate_then`] may be used: gravity on every
-    /// particle or none, springs in blocks on the calling thread, and no
-    /// other force (so the springs are the last to add to a particle).
-    pub(crate) fn can_evaluate_then(&self) -> bool {
+    /// Whether [`Self::evaluate_then`] may be used for a world of `n`
+    /// particles: gravity on every particle or none, springs in blocks, and
+    /// no other force (so the springs are the last to add to a particle);
+    /// and the springs split over threads, or the per-particle loops not
+    /// (so the springs' pieces are the loops' pieces).
+    pub(crate) fn can_evaluate_then(&self, n: usize) -> bool {
         self.gravity
             .as_ref()
             .is_none_or(|g| g.targets == Targets::All)
@@ -171,16 +173,19 @@ impl Forces {
             && self.user_body.is_empty()
             && self.floor.is_none()
             && self.user_contact.is_empty()
+            && (self.springs.on_threads()
+                || self.one_piece
+                || crate::parallel::piece_len(n).is_none())
     }
 
-    /// [`Self::evaluate`] on the calling thread
-    /// ([`Self::can_evaluate_then`]), handing on the particles whose net
-    /// force is complete as soon as it is, while it is still in the cache
-    /// (see `Springs::apply_then`): `then(range, forces)` for consecutive
-    /// ranges from the first particle to the last. The same forces, to the
-    /// bit, as [`Self::evaluate`].
+    /// [`Self::evaluate`] ([`Self::can_evaluate_then`]), handing on each
+    /// run of particles whose net force is complete as soon as it is,
+    /// while it is still in the cache (see `Springs::apply_then`):
+    /// `then(first, forces, [x, v])` with the same run of `outs`, each
+    /// particle once; the answers combined by `combine` (associative and
+    /// commutative). The same forces, to the bit, as [`Self::evaluate`].
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn evaluate_then(
+    pub(crate) fn evaluate_then<R: Send>(
         &mut self,
         t: f64,
         dt: f64,
@@ -188,8 +193,10 @@ impl Forces {
         vel: &[DVec3],
         particles: &Properties,
         out: &mut [DVec3],
-        then: impl FnMut(std::ops::Range<usize>, &[DVec3]),
-    ) {
+        outs: [&mut [DVec3]; 2],
+        then: impl Fn(usize, &[DVec3], [&mut [DVec3]; 2]) -> R + Sync,
+        combine: impl Fn(R, R) -> R + Sync + Send,
+    ) -> Option<R> {
         let ctx = ForceContext {
             t,
             dt,
@@ -208,7 +215,8 @@ impl Forces {
             }
             None => out.fill(DVec3::ZERO),
         };
-        self.springs.apply_then(&ctx, out, start, then);
+        self.springs
+            .apply_then(&ctx, out, start, outs, then, combine)
     }
 
     /// Adds the derivatives of every force that gives them at `ctx` to

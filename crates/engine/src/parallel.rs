@@ -12,7 +12,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
@@ -85,13 +85,8 @@ pub fn fold_by_pieces<const K: usize, R: Send>(
         pieces.push((first, head));
         first += take;
     }
-    fork(|| {
-        pieces
-            .into_par_iter()
-            .map(|(first, piece)| body(first, piece))
-            .reduce_with(combine)
-    })
-    .unwrap_or_else(|| body(0, std::array::from_fn(|_| &mut [][..])))
+    fork_tasks(pieces, |(first, piece)| body(first, piece), combine)
+        .unwrap_or_else(|| body(0, std::array::from_fn(|_| &mut [][..])))
 }
 
 /// `body` of each piece `first..first + len` of a world of `n` particles
@@ -107,13 +102,39 @@ pub fn map_pieces<R: Send>(
     let Some(len) = piece_len(n) else {
         return body(0..n);
     };
-    fork(|| {
-        (0..n.div_ceil(len))
-            .into_par_iter()
-            .map(|k| body(k * len..n.min((k + 1) * len)))
-            .reduce_with(combine)
-    })
-    .unwrap_or_else(|| body(0..0))
+    let pieces: Vec<usize> = (0..n.div_ceil(len)).collect();
+    fork_tasks(pieces, |k| body(k * len..n.min((k + 1) * len)), combine)
+        .unwrap_or_else(|| body(0..0))
+}
+
+/// [`fork`] of `tasks`, at most one per thread of the current pool, each
+/// run by `body` (`None` without tasks); their answers combined in task
+/// order by `combine`, which must be associative.
+///
+/// A task that is done waits, yielding, while another of the fork's tasks
+/// is still running (for at most [`LINGER`]), instead of returning to
+/// rayon's wait for the stolen half: there a thread sleeps after a few
+/// dozen idle rounds, and the futex that wakes it when the other half is
+/// done cost cloth-128 on two threads about 5 % of its time. (With more
+/// tasks than threads the waiting would keep a thread from the tasks still
+/// queued; none of the callers makes more.)
+pub fn fork_tasks<T: Send, R: Send>(
+    tasks: Vec<T>,
+    body: impl Fn(T) -> R + Sync + Send,
+    combine: impl Fn(R, R) -> R + Sync + Send,
+) -> Option<R> {
+    let running = AtomicUsize::new(0);
+    let together = |task: T| {
+        running.fetch_add(1, Ordering::AcqRel);
+        let r = body(task);
+        running.fetch_sub(1, Ordering::AcqRel);
+        let t = Instant::now();
+        while running.load(Ordering::Acquire) > 0 && t.elapsed() < LINGER {
+            std::thread::yield_now();
+        }
+        r
+    };
+    fork(|| tasks.into_par_iter().map(together).reduce_with(combine))
 }
 
 /// Counts the forks of every world's work: the threads [`fork`] leaves

@@ -4,6 +4,7 @@
 
 use crate::error::ModelError;
 use crate::force::{Force, ForceContext};
+use crate::parallel::take_front;
 use crate::particle::{non_negative, ParticleId};
 use glam::DVec3;
 
@@ -288,28 +289,39 @@ impl Springs {
         self.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1
     }
 
-    /// Whether [`Self::apply_then`] may be used: the springs in blocks, on
-    /// the calling thread.
+    /// Whether [`Self::apply_then`] may be used: the springs in blocks.
     #[inline]
     pub(crate) fn can_apply_then(&self) -> bool {
-        self.len() >= kernel::MIN_BLOCKED && !self.on_threads()
+        self.len() >= kernel::MIN_BLOCKED
     }
 
-    /// [`Force::apply`] on the calling thread ([`Self::can_apply_then`]),
-    /// with no pass of its own over the particles before or after the
-    /// springs: `start(range, forces)` sets the forces of each range of
-    /// particles just before the first spring adds to them, and
-    /// `then(range, forces)` has them as soon as no later spring does; both
-    /// take consecutive ranges from the first particle to the last, each
-    /// particle once.
-    pub(crate) fn apply_then(
+    /// [`Force::apply`] with no pass of its own over the particles before
+    /// or after the springs: `start(range, forces)` sets the forces of each
+    /// run of particles just before the first spring adds to them, and
+    /// `then(first, forces, [x, v])` has a run's forces as soon as no
+    /// later spring adds to them, with the same run of `outs` (`first` its
+    /// first particle); each particle is started once and handed on once.
+    /// On one thread the runs go in order from the first particle to the
+    /// last; on many ([`Self::on_threads`]) each thread stages its own
+    /// particles, and the few that several threads' springs share are
+    /// handed on after the join. The answers of the runs are combined by
+    /// `combine`, which must be associative and commutative (`None`: no
+    /// particles).
+    pub(crate) fn apply_then<R: Send>(
         &mut self,
         ctx: &ForceContext,
         forces: &mut [DVec3],
-        start: impl FnMut(std::ops::Range<usize>, &mut [DVec3]),
-        then: impl FnMut(std::ops::Range<usize>, &[DVec3]),
-    ) {
+        start: impl Fn(std::ops::Range<usize>, &mut [DVec3]) + Sync,
+        outs: [&mut [DVec3]; 2],
+        then: impl Fn(usize, &[DVec3], [&mut [DVec3]; 2]) -> R + Sync,
+        combine: impl Fn(R, R) -> R + Sync + Send,
+    ) -> Option<R> {
         let springs = self.table.all();
+        if self.on_threads() {
+            let (pos, vel) = (ctx.pos, ctx.vel);
+            let parallel = &mut self.scratch.parallel;
+            return parallel.apply_then(springs, pos, vel, forces, start, outs, then, combine);
+        }
         let key = (springs.len(), forces.len());
         let Scratch { block, stages, .. } = &mut self.scratch;
         if stages.0 != key {
@@ -318,8 +330,23 @@ impl Springs {
             *stages = (key, kernel::Stages::new(springs.ends, forces.len()));
         }
         let block = block.get_or_insert_with(Box::default);
-        let mut sink = kernel::Staged::new(forces, &stages.1, start, then);
+        let [mut x, mut v] = outs;
+        let mut answer = None;
+        let mut sink = kernel::Staged::new(
+            kernel::Scatter::new(forces),
+            &stages.1,
+            |r, f| start(r, f),
+            |r: std::ops::Range<usize>, f: &[DVec3]| {
+                let out = [take_front(&mut x, r.len()), take_front(&mut v, r.len())];
+                let a = then(r.start, f, out);
+                answer = Some(match answer.take() {
+                    Some(b) => combine(b, a),
+                    None => a,
+                });
+            },
+        );
         kernel::run(springs, block, ctx.pos, ctx.vel, &mut sink);
+        answer
     }
 
     /// [`Force::apply`] for springs on threads ([`Self::on_threads`]), each

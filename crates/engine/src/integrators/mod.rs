@@ -267,6 +267,12 @@ pub(crate) struct Settled {
 }
 
 impl Settled {
+    /// Finite, no event: what nothing to settle answers.
+    pub const FINE: Settled = Settled {
+        finite: true,
+        worst: EventState::None,
+    };
+
     /// Both pieces' answers.
     #[inline]
     pub fn and(self, other: Settled) -> Settled {

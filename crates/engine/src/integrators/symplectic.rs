@@ -3,7 +3,7 @@
 //! energy error oscillates and stays bounded instead of drifting.
 
 use super::{flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
-use crate::parallel::{by_pieces, fold_by_pieces, piece_len, take_front};
+use crate::parallel::{by_pieces, fold_by_pieces};
 use crate::particle::State;
 use crate::simd::{chosen, Use};
 use glam::DVec3;
@@ -27,26 +27,27 @@ pub(crate) fn step_then(
     let split = !d.forces.one_piece;
     let f = &mut d.scratch.force;
     let n = from.pos.len();
-    if n >= SMALL && (!split || piece_len(n).is_none()) && d.forces.can_evaluate_then() {
-        // All on this thread: each run of particles is updated (and
-        // finished) as soon as its forces are complete, while they are in
-        // the cache, in no pass of its own.
+    if n >= SMALL && d.forces.can_evaluate_then(n) {
+        // Each run of particles is updated (and finished) as soon as its
+        // forces are complete, while they are in the cache, in no pass of
+        // its own (on each thread, its own particles).
         let w3 = &d.particles.inv_mass3;
-        let (mut x1, mut v1) = (&mut to.pos[..], &mut to.vel[..]);
-        let mut settled = Settled {
-            finite: true,
-            worst: crate::event::EventState::None,
-        };
-        d.forces
-            .evaluate_then(t, h, &from.pos, &from.vel, d.particles, f, |r, f| {
-                let (x1, v1) = (take_front(&mut x1, r.len()), take_front(&mut v1, r.len()));
-                update_piece(r.start, from, f, w3, h, [&mut *x1, &mut *v1]);
-                if let Some(finish) = finish {
-                    settled = settled.and(finish(r.start, x1, v1));
-                }
-            });
+        let settled = d.forces.evaluate_then(
+            t,
+            h,
+            &from.pos,
+            &from.vel,
+            d.particles,
+            f,
+            [&mut to.pos[..], &mut to.vel[..]],
+            |first, f, [x1, v1]| {
+                update_piece(first, from, f, w3, h, [&mut *x1, &mut *v1]);
+                finish.map_or(Settled::FINE, |finish| finish(first, x1, v1))
+            },
+            Settled::and,
+        );
         return match finish {
-            Some(_) => Written::Settled(settled),
+            Some(_) => Written::Settled(settled.unwrap_or(Settled::FINE)),
             None => Written::Known(false),
         };
     }

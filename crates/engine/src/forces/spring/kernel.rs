@@ -268,15 +268,28 @@ pub(super) struct Stages {
 impl Stages {
     /// The stages of the springs with `ends` among `particles` particles.
     pub fn new(ends: &[[u32; 2]], particles: usize) -> Self {
+        Self::of_blocks(
+            ends.chunks(BLOCK)
+                .map(|b| b.iter().flat_map(|&[a, b]| [a, b])),
+            particles,
+        )
+    }
+
+    /// The stages of `particles` particles of which each block of springs
+    /// adds to the particles it yields (a thread's springs add to its own
+    /// particles only: `threads.rs`).
+    pub fn of_blocks<B: IntoIterator<Item = u32>>(
+        blocks: impl Iterator<Item = B>,
+        particles: usize,
+    ) -> Self {
         // The block of each particle's last spring, plus one (0: none).
         let mut last = vec![0usize; particles];
         let mut reach = 0;
-        let mut first_touch = Vec::with_capacity(ends.len().div_ceil(BLOCK));
-        for (k, block) in ends.chunks(BLOCK).enumerate() {
-            for &[a, b] in block {
-                last[a as usize] = k + 1;
-                last[b as usize] = k + 1;
-                reach = reach.max(a.max(b) + 1);
+        let mut first_touch = Vec::with_capacity(blocks.size_hint().0);
+        for (k, block) in blocks.enumerate() {
+            for p in block {
+                last[p as usize] = k + 1;
+                reach = reach.max(p + 1);
             }
             first_touch.push(reach);
         }
@@ -296,15 +309,38 @@ impl Stages {
     }
 }
 
-/// The one-thread sink that starts each particle's force just before the
+/// A sink that adds to one array of forces, keeping the sum of a run of
+/// springs with the same first end in a register: what [`Staged`] wraps.
+pub(super) trait Adds: Sink {
+    /// The forces it adds to.
+    fn forces(&mut self) -> &mut [DVec3];
+    /// Stores the open run's sum so far, leaving the run open.
+    fn store_run(&mut self);
+}
+
+impl Adds for Scatter<'_> {
+    #[inline(always)]
+    fn forces(&mut self) -> &mut [DVec3] {
+        self.forces
+    }
+
+    #[inline(always)]
+    fn store_run(&mut self) {
+        if let Some(p) = self.run {
+            self.forces[p] = self.acc;
+        }
+    }
+}
+
+/// The sink that starts each particle's force just before the
 /// first spring adds to it (`start(range, forces)`, in order, each particle
 /// once), and hands it on as soon as it is complete (`then(range,
 /// forces)`, in order, each particle once, the last of them after the last
 /// block). A mesh lists its springs particle by particle, so its particles
 /// are started and handed on while they are in the cache, and no pass over
 /// all of them comes before or after the springs.
-pub(super) struct Staged<'a, S, F> {
-    scatter: Scatter<'a>,
+pub(super) struct Staged<'a, K, S, F> {
+    inner: K,
     stages: &'a Stages,
     /// The particles started so far: `0..started`.
     started: usize,
@@ -314,15 +350,17 @@ pub(super) struct Staged<'a, S, F> {
     then: F,
 }
 
-impl<'a, S, F> Staged<'a, S, F>
+impl<'a, K, S, F> Staged<'a, K, S, F>
 where
+    K: Adds,
     S: FnMut(std::ops::Range<usize>, &mut [DVec3]),
     F: FnMut(std::ops::Range<usize>, &[DVec3]),
 {
-    /// A sink adding to `forces`, staged by `stages`.
-    pub fn new(forces: &'a mut [DVec3], stages: &'a Stages, start: S, then: F) -> Self {
+    /// The sink `inner` (adding to the particles `stages` counts), staged
+    /// by `stages`.
+    pub fn new(inner: K, stages: &'a Stages, start: S, then: F) -> Self {
         Staged {
-            scatter: Scatter::new(forces),
+            inner,
             stages,
             started: 0,
             done: 0,
@@ -335,7 +373,7 @@ where
     fn start_to(&mut self, to: usize) {
         if to > self.started {
             let range = self.started..to;
-            (self.start)(range.clone(), &mut self.scatter.forces[range]);
+            (self.start)(range.clone(), &mut self.inner.forces()[range]);
             self.started = to;
         }
     }
@@ -345,13 +383,14 @@ where
         // A particle no spring touches may come before the springs reach it.
         self.start_to(to);
         let range = self.done..to;
-        (self.then)(range.clone(), &self.scatter.forces[range]);
+        (self.then)(range.clone(), &self.inner.forces()[range]);
         self.done = to;
     }
 }
 
-impl<S, F> Sink for Staged<'_, S, F>
+impl<K, S, F> Sink for Staged<'_, K, S, F>
 where
+    K: Adds,
     S: FnMut(std::ops::Range<usize>, &mut [DVec3]),
     F: FnMut(std::ops::Range<usize>, &[DVec3]),
 {
@@ -359,22 +398,20 @@ where
     fn take(&mut self, first: usize, ends: &[[u32; 2]], block: &Block) {
         let k = first / BLOCK;
         self.start_to(self.stages.first_touch[k] as usize);
-        self.scatter.take(first, ends, block);
+        self.inner.take(first, ends, block);
         let complete = self.stages.complete[k] as usize;
         if complete >= self.done + STAGE {
             // The particle of the open run may be among them: its sum so
             // far is its force if no later spring touches it, and is
             // stored again if one does.
-            if let Some(p) = self.scatter.run {
-                self.scatter.forces[p] = self.scatter.acc;
-            }
+            self.inner.store_run();
             self.hand_on(complete);
         }
     }
 
     fn finish(&mut self) {
-        self.scatter.finish();
-        let n = self.scatter.forces.len();
+        self.inner.finish();
+        let n = self.inner.forces().len();
         if self.done < n {
             self.hand_on(n);
         }
@@ -444,7 +481,7 @@ mod tests {
         let mut forces = vec![DVec3::NAN; pos.len()];
         let (mut started, mut handed) = (Vec::new(), Vec::new());
         let mut sink = Staged::new(
-            &mut forces,
+            Scatter::new(&mut forces),
             &stages,
             |r: Range<usize>, f: &mut [DVec3]| {
                 f.copy_from_slice(&start[r.clone()]);

@@ -11,11 +11,11 @@
 //! (`+f` as a spring's first end, `−f` as its second): the same bits on any
 //! number of threads.
 
-use super::kernel::{run, Block, Scatter, Sink, BLOCK};
+use super::kernel::{run, Adds, Block, Scatter, Sink, Staged, Stages, BLOCK};
 use super::Slice;
 use crate::parallel::take_front;
 use glam::DVec3;
-use rayon::prelude::*;
+use std::ops::Range;
 
 /// Below this many springs a world's springs stay on one thread: the
 /// fork-join would cost more than it saves.
@@ -50,6 +50,14 @@ pub(super) struct Parallel {
     ends: Vec<u32>,
     /// The force of every spring with a shared end.
     f: Vec<DVec3>,
+    /// For each task, the stages of its own particles (counted from its
+    /// piece's first) as its springs add to them, for [`Self::apply_then`].
+    stages: Vec<Stages>,
+    /// For each task, the runs of consecutive shared particles in its
+    /// piece (counted from its first), which it does not hand on.
+    holes: Vec<Vec<Range<usize>>>,
+    /// The runs of consecutive shared particles, handed on after the join.
+    runs: Vec<Range<usize>>,
 }
 
 impl Parallel {
@@ -95,7 +103,7 @@ impl Parallel {
             .iter()
             .map(|&[a, b]| u8::from(owned[a as usize]) | u8::from(owned[b as usize]) << 1)
             .collect();
-        let local = springs
+        let local: Vec<[u32; 2]> = springs
             .ends
             .iter()
             .enumerate()
@@ -122,7 +130,33 @@ impl Parallel {
                 }
             }
         }
+        let stages = (0..threads)
+            .map(|t| {
+                let r = (t * per_range).min(code.len())..((t + 1) * per_range).min(code.len());
+                let blocks = local[r.clone()].chunks(BLOCK).zip(code[r].chunks(BLOCK));
+                // Only the ends its task adds to directly.
+                let own = blocks.map(|(ends, code)| {
+                    ends.iter().zip(code).flat_map(|(&[a, b], &c)| {
+                        let a = (c & 1 != 0).then_some(a);
+                        a.into_iter().chain((c & 2 != 0).then_some(b))
+                    })
+                });
+                let piece = per_piece.min(particles.saturating_sub(t * per_piece));
+                Stages::of_blocks(own, piece)
+            })
+            .collect();
+        let runs = runs_of(shared.iter().map(|&p| p as usize));
+        let holes = (0..threads)
+            .map(|t| {
+                let lo = t * per_piece;
+                let mine = shared.iter().map(|&p| p as usize);
+                runs_of(mine.filter(|p| p / per_piece == t).map(|p| p - lo))
+            })
+            .collect();
         *self = Parallel {
+            stages,
+            holes,
+            runs,
             built: (springs.len(), particles, threads),
             per_range,
             per_piece,
@@ -148,42 +182,147 @@ impl Parallel {
         forces: &mut [DVec3],
         start: Option<(DVec3, &[f64])>,
     ) {
-        let threads = rayon::current_num_threads();
-        self.index(springs, forces.len(), threads);
-        let (per_range, per_piece) = (self.per_range, self.per_piece);
-        // One task per thread: its springs' kept forces, its particles.
-        let mut tasks = Vec::with_capacity(threads);
-        let (mut kept, mut piece) = (&mut self.f[..], &mut *forces);
-        let mut code = &self.code[..];
-        for t in 0..threads {
-            let (c, rest) = code.split_at(per_range.min(code.len()));
-            code = rest;
-            let (nk, np) = (per_range.min(kept.len()), per_piece.min(piece.len()));
-            tasks.push((t, c, take_front(&mut kept, nk), take_front(&mut piece, np)));
-        }
-        let (whole, per_block, local) =
-            (&self.whole[..], per_range.div_ceil(BLOCK), &self.local[..]);
-        crate::parallel::fork(|| {
-            tasks.into_par_iter().for_each(|(t, code, kept, piece)| {
-                // (With more threads than springs the last tasks have none.)
+        let per_piece = self.per_piece_for(springs, forces.len());
+        let tasks = self.tasks(springs, forces, []);
+        crate::parallel::fork_tasks(
+            tasks,
+            |mut task| {
                 if let Some((g, mass)) = start {
-                    for (f, &m) in piece.iter_mut().zip(&mass[t * per_piece..]) {
+                    let piece = &mut *task.sink.scatter.forces;
+                    for (f, &m) in piece.iter_mut().zip(&mass[task.t * per_piece..]) {
                         *f = m * g;
                     }
                 }
+                run(
+                    task.springs,
+                    &mut Block::default(),
+                    pos,
+                    vel,
+                    &mut task.sink,
+                );
+            },
+            |(), ()| (),
+        );
+        self.sum_shared(forces);
+    }
+}
+
+impl Parallel {
+    /// [`Self::apply`] staged (see `Springs::apply_then`): each thread
+    /// starts its own particles' forces with `start` as its springs reach
+    /// them and hands them on to `then(first, forces, [x, v])` with the same
+    /// run of `outs` as soon as they are complete; the shared particles,
+    /// summed after the join, are handed on last, run by run. The answers
+    /// are combined by `combine` (associative and commutative).
+    #[allow(clippy::too_many_arguments)]
+    pub fn apply_then<R: Send>(
+        &mut self,
+        springs: Slice,
+        pos: &[DVec3],
+        vel: &[DVec3],
+        forces: &mut [DVec3],
+        start: impl Fn(Range<usize>, &mut [DVec3]) + Sync,
+        outs: [&mut [DVec3]; 2],
+        then: impl Fn(usize, &[DVec3], [&mut [DVec3]; 2]) -> R + Sync,
+        combine: impl Fn(R, R) -> R + Sync + Send,
+    ) -> Option<R> {
+        let per_piece = self.per_piece_for(springs, forces.len());
+        let [x, v] = outs;
+        let tasks = self.tasks(springs, forces, [&mut *x, &mut *v]);
+        let (then, combine) = (&then, &combine);
+        let either = |a: Option<R>, b: Option<R>| match (a, b) {
+            (Some(a), Some(b)) => Some(combine(a, b)),
+            (a, b) => a.or(b),
+        };
+        let answer = crate::parallel::fork_tasks(
+            tasks,
+            |task| {
+                let Task {
+                    t,
+                    springs,
+                    sink,
+                    stages,
+                    holes,
+                    outs: [x, v],
+                } = task;
+                let lo = t * per_piece;
+                let (mut answer, mut hole) = (None, 0);
+                let mut sink = Staged::new(
+                    sink,
+                    stages,
+                    |r: Range<usize>, f: &mut [DVec3]| start(lo + r.start..lo + r.end, f),
+                    |r: Range<usize>, f: &[DVec3]| {
+                        outside(r.clone(), holes, &mut hole, |s| {
+                            let f = &f[s.start - r.start..s.end - r.start];
+                            let out = [&mut x[s.clone()], &mut v[s.clone()]];
+                            let a = then(lo + s.start, f, out);
+                            answer = either(answer.take(), Some(a));
+                        })
+                    },
+                );
+                run(springs, &mut Block::default(), pos, vel, &mut sink);
+                answer
+            },
+            either,
+        );
+        let mut answer = answer.flatten();
+        self.sum_shared(forces);
+        for r in &self.runs {
+            let out = [&mut x[r.clone()], &mut v[r.clone()]];
+            answer = either(answer, Some(then(r.start, &forces[r.clone()], out)));
+        }
+        answer
+    }
+
+    /// Cuts the springs and particles for the current pool: the particles
+    /// per piece.
+    fn per_piece_for(&mut self, springs: Slice, particles: usize) -> usize {
+        self.index(springs, particles, rayon::current_num_threads());
+        self.per_piece
+    }
+
+    /// One task per thread (as [`Self::per_piece_for`] cut them): its
+    /// springs, its sink adding to its piece of `forces` and keeping its
+    /// springs' forces for the shared particles, its stages and holes, its
+    /// piece of each of `outs`.
+    fn tasks<'a, const K: usize>(
+        &'a mut self,
+        springs: Slice<'a>,
+        forces: &'a mut [DVec3],
+        outs: [&'a mut [DVec3]; K],
+    ) -> Vec<Task<'a, K>> {
+        let (per_range, per_piece) = (self.per_range, self.per_piece);
+        let per_block = per_range.div_ceil(BLOCK);
+        let threads = self.stages.len();
+        let (mut kept, mut piece, mut outs) = (&mut self.f[..], forces, outs);
+        (0..threads)
+            .map(|t| {
+                // (With more threads than springs the last tasks have none.)
                 let first = (t * per_range).min(springs.len());
-                let range = springs.range(first..first + kept.len());
-                let mut sink = Owned {
-                    scatter: Scatter::new(piece),
-                    lo: t * per_piece,
-                    code,
-                    whole: &whole[t * per_block..(t + 1) * per_block],
-                    local: &local[first..first + kept.len()],
-                    kept,
-                };
-                run(range, &mut Block::default(), pos, vel, &mut sink);
-            });
-        });
+                let last = (first + per_range).min(springs.len());
+                let np = per_piece.min(piece.len());
+                Task {
+                    t,
+                    springs: springs.range(first..last),
+                    sink: Owned {
+                        scatter: Scatter::new(take_front(&mut piece, np)),
+                        lo: t * per_piece,
+                        code: &self.code[first..last],
+                        whole: &self.whole[t * per_block..(t + 1) * per_block],
+                        local: &self.local[first..last],
+                        kept: take_front(&mut kept, last - first),
+                    },
+                    stages: &self.stages[t],
+                    holes: &self.holes[t],
+                    outs: outs.each_mut().map(|o| take_front(o, np)),
+                }
+            })
+            .collect()
+    }
+
+    /// Adds the kept forces of their springs to the shared particles, each
+    /// in spring order.
+    fn sum_shared(&self, forces: &mut [DVec3]) {
         for (k, &p) in self.shared.iter().enumerate() {
             let (from, to) = (self.start[k] as usize, self.start[k + 1] as usize);
             let mut acc = forces[p as usize];
@@ -196,6 +335,53 @@ impl Parallel {
             forces[p as usize] = acc;
         }
     }
+}
+
+/// The runs of consecutive numbers of the increasing `items`.
+fn runs_of(items: impl Iterator<Item = usize>) -> Vec<Range<usize>> {
+    let mut runs: Vec<Range<usize>> = Vec::new();
+    for p in items {
+        match runs.last_mut() {
+            Some(r) if r.end == p => r.end += 1,
+            _ => runs.push(p..p + 1),
+        }
+    }
+    runs
+}
+
+/// Calls `each` with the runs of `r` outside the `holes` (increasing and
+/// apart), in order; `next` is the first hole not yet passed, kept between
+/// calls with increasing ranges.
+fn outside(
+    r: Range<usize>,
+    holes: &[Range<usize>],
+    next: &mut usize,
+    mut each: impl FnMut(Range<usize>),
+) {
+    let mut at = r.start;
+    while at < r.end {
+        while holes.get(*next).is_some_and(|h| h.end <= at) {
+            *next += 1;
+        }
+        match holes.get(*next) {
+            Some(h) if h.start <= at => at = h.end.min(r.end),
+            h => {
+                let end = h.map_or(r.end, |h| h.start.min(r.end));
+                each(at..end);
+                at = end;
+            }
+        }
+    }
+}
+
+/// One thread's part of the springs (see [`Parallel::tasks`]).
+struct Task<'a, const K: usize> {
+    t: usize,
+    springs: Slice<'a>,
+    sink: Owned<'a>,
+    stages: &'a Stages,
+    holes: &'a [Range<usize>],
+    outs: [&'a mut [DVec3]; K],
 }
 
 /// One task's sink: forces on its own particles go straight to them, the
@@ -265,5 +451,51 @@ impl Sink for Owned<'_> {
     #[inline(always)]
     fn finish(&mut self) {
         self.scatter.finish();
+    }
+}
+
+impl Adds for Owned<'_> {
+    #[inline(always)]
+    fn forces(&mut self) -> &mut [DVec3] {
+        self.scatter.forces()
+    }
+
+    #[inline(always)]
+    fn store_run(&mut self) {
+        self.scatter.store_run();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{outside, runs_of};
+    use std::ops::Range;
+
+    /// The runs a thread hands on leave out exactly its shared particles,
+    /// whatever ranges the stages cut (a hole across two of them, at the
+    /// start, at the end, a range all hole).
+    #[test]
+    fn the_runs_handed_on_are_every_particle_but_the_shared() {
+        let n = 40;
+        let shared = [0, 1, 7, 8, 9, 10, 15, 30, 31, 39];
+        let holes = runs_of(shared.iter().copied());
+        assert_eq!(holes, vec![0..2, 7..11, 15..16, 30..32, 39..40]);
+        for cuts in [
+            vec![0, 40],
+            vec![0, 8, 9, 12, 31, 40],
+            vec![0, 1, 2, 3, 16, 39, 40],
+        ] {
+            let mut next = 0;
+            let mut got: Vec<Range<usize>> = Vec::new();
+            for w in cuts.windows(2) {
+                outside(w[0]..w[1], &holes, &mut next, |r| {
+                    assert!(!r.is_empty() && r.start >= w[0] && r.end <= w[1]);
+                    got.push(r);
+                });
+            }
+            let covered: Vec<usize> = got.iter().flat_map(|r| r.clone()).collect();
+            let want: Vec<usize> = (0..n).filter(|p| !shared.contains(p)).collect();
+            assert_eq!(covered, want, "cut at {cuts:?}");
+        }
     }
 }
