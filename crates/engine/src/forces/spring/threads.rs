@@ -10,6 +10,11 @@
 //! particle adds the same forces in the same order as the one-thread loop
 //! (`+f` as a spring's first end, `−f` as its second): the same bits on any
 //! number of threads.
+//!
+//! Staged (`Parallel::apply_then`, symplectic Euler), each thread also
+//! starts and hands on its own particles as its springs reach them and
+//! finish with them (`kernel::Staged`), and the shared particles are
+//! handed on after the join.
 
 use super::kernel::{run, Adds, Block, Scatter, Sink, Staged, Stages, BLOCK};
 use super::Slice;
