@@ -3,8 +3,13 @@
 
 use crate::force::{Force, ForceContext, Stage, Targets};
 use crate::forces::{
-    angle_joint::AngleJoints, constant_force::ConstantForces, floor_contact::FloorContact,
-    fluid::FluidMedium, gravity::Gravity, nbody::NBodyGravity, spring::Springs,
+    angle_joint::AngleJoints,
+    constant_force::ConstantForces,
+    floor_contact::FloorContact,
+    fluid::FluidMedium,
+    gravity::{start_with_weights, Gravity},
+    nbody::NBodyGravity,
+    spring::Springs,
     torque_joint::TorqueJoints,
 };
 use crate::particle::Properties;
@@ -84,6 +89,25 @@ impl Forces {
         self.user_body.len() + self.user_contact.len() - 1
     }
 
+    /// The forces' view of a trial state.
+    fn context<'a>(
+        &self,
+        t: f64,
+        dt: f64,
+        pos: &'a [DVec3],
+        vel: &'a [DVec3],
+        particles: &'a Properties,
+    ) -> ForceContext<'a> {
+        ForceContext {
+            t,
+            dt,
+            pos,
+            vel,
+            particles,
+            gravity: self.g(),
+        }
+    }
+
     /// Overwrites `out` with the net force on every particle at the given
     /// trial state.
     #[inline]
@@ -96,14 +120,7 @@ impl Forces {
         particles: &Properties,
         out: &mut [DVec3],
     ) {
-        let ctx = ForceContext {
-            t,
-            dt,
-            pos,
-            vel,
-            particles,
-            gravity: self.g(),
-        };
+        let ctx = self.context(t, dt, pos, vel, particles);
         // Gravity on every particle starts the accumulator (m g) instead of
         // adding to zeros: one pass over the particles instead of two.
         let mut springs_done = false;
@@ -115,9 +132,7 @@ impl Forces {
             Some(g) if g.targets == Targets::All => {
                 let (g, mass) = (g.g, &particles.mass);
                 crate::parallel::by_pieces(!self.one_piece, [&mut *out], |first, [out]| {
-                    for (f, &m) in out.iter_mut().zip(&mass[first..]) {
-                        *f = m * g;
-                    }
+                    start_with_weights(g, &mass[first..], out)
                 });
             }
             Some(g) => {
@@ -197,22 +212,11 @@ impl Forces {
         then: impl Fn(usize, &[DVec3], [&mut [DVec3]; 2]) -> R + Sync,
         combine: impl Fn(R, R) -> R + Sync + Send,
     ) -> Option<R> {
-        let ctx = ForceContext {
-            t,
-            dt,
-            pos,
-            vel,
-            particles,
-            gravity: self.g(),
-        };
+        let ctx = self.context(t, dt, pos, vel, particles);
         let g = self.gravity.as_ref().map(|g| g.g);
         let mass = &particles.mass;
         let start = |r: std::ops::Range<usize>, out: &mut [DVec3]| match g {
-            Some(g) => {
-                for (f, &m) in out.iter_mut().zip(&mass[r]) {
-                    *f = m * g;
-                }
-            }
+            Some(g) => start_with_weights(g, &mass[r], out),
             None => out.fill(DVec3::ZERO),
         };
         self.springs

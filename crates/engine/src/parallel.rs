@@ -102,7 +102,7 @@ pub fn map_pieces<R: Send>(
     let Some(len) = piece_len(n) else {
         return body(0..n);
     };
-    let pieces: Vec<usize> = (0..n.div_ceil(len)).collect();
+    let pieces = 0..n.div_ceil(len);
     fork_tasks(pieces, |k| body(k * len..n.min((k + 1) * len)), combine)
         .unwrap_or_else(|| body(0..0))
 }
@@ -119,7 +119,7 @@ pub fn map_pieces<R: Send>(
 /// tasks than threads the waiting would keep a thread from the tasks still
 /// queued; none of the callers makes more.)
 pub fn fork_tasks<T: Send, R: Send>(
-    tasks: Vec<T>,
+    tasks: impl IntoParallelIterator<Item = T>,
     body: impl Fn(T) -> R + Sync + Send,
     combine: impl Fn(R, R) -> R + Sync + Send,
 ) -> Option<R> {

@@ -60,23 +60,34 @@ pub fn pin_thread(i: usize, n: usize) -> bool {
     if n < 2 || i >= n || turned_off() {
         return false;
     }
-    let size = std::mem::size_of::<libc::cpu_set_t>();
+    let Some(allowed) = allowed().filter(|a| a.len() >= n) else {
+        return false;
+    };
     // SAFETY: `cpu_set_t` is plain bits (all zeros is the empty set); the
-    // calls read and write only the set passed, for the calling thread.
+    // call reads only the set passed, for the calling thread.
     unsafe {
-        let mut set: libc::cpu_set_t = std::mem::zeroed();
-        if libc::sched_getaffinity(0, size, &mut set) != 0 {
-            return false;
-        }
-        let allowed: Vec<usize> = (0..libc::CPU_SETSIZE as usize)
-            .filter(|&c| libc::CPU_ISSET(c, &set))
-            .collect();
-        if allowed.len() < n {
-            return false;
-        }
         let mut one: libc::cpu_set_t = std::mem::zeroed();
         libc::CPU_SET(allowed[i], &mut one);
-        libc::sched_setaffinity(0, size, &one) == 0
+        libc::sched_setaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &one) == 0
+    }
+}
+
+/// The processors the calling thread may use (`None` if the system will
+/// not say).
+#[cfg(target_os = "linux")]
+fn allowed() -> Option<Vec<usize>> {
+    // SAFETY: `cpu_set_t` is plain bits (all zeros is the empty set); the
+    // call writes only the set passed, for the calling thread.
+    unsafe {
+        let mut set: libc::cpu_set_t = std::mem::zeroed();
+        if libc::sched_getaffinity(0, std::mem::size_of::<libc::cpu_set_t>(), &mut set) != 0 {
+            return None;
+        }
+        Some(
+            (0..libc::CPU_SETSIZE as usize)
+                .filter(|&c| libc::CPU_ISSET(c, &set))
+                .collect(),
+        )
     }
 }
 
@@ -93,15 +104,7 @@ mod tests {
 
     /// The processors the calling thread may use.
     fn allowed() -> Vec<usize> {
-        let size = std::mem::size_of::<libc::cpu_set_t>();
-        // SAFETY: as in `pin_thread`.
-        unsafe {
-            let mut set: libc::cpu_set_t = std::mem::zeroed();
-            assert_eq!(libc::sched_getaffinity(0, size, &mut set), 0);
-            (0..libc::CPU_SETSIZE as usize)
-                .filter(|&c| libc::CPU_ISSET(c, &set))
-                .collect()
-        }
+        super::allowed().expect("sched_getaffinity answers")
     }
 
     /// Each thread of a pinned pool may then use its own processor and no

@@ -25,6 +25,16 @@ impl Gravity {
     }
 }
 
+/// Sets each force of `out` to its particle's weight `m g` (`mass` the
+/// masses of the same particles): gravity on all of them starting the
+/// accumulator, instead of adding to zeros.
+#[inline]
+pub(crate) fn start_with_weights(g: DVec3, mass: &[f64], out: &mut [DVec3]) {
+    for (f, &m) in out.iter_mut().zip(mass) {
+        *f = m * g;
+    }
+}
+
 impl Default for Gravity {
     fn default() -> Self {
         Gravity::new(Gravity::STANDARD)

@@ -18,6 +18,7 @@
 
 use super::kernel::{run, Adds, Block, Scatter, Sink, Staged, Stages, BLOCK};
 use super::Slice;
+use crate::forces::gravity::start_with_weights;
 use crate::parallel::take_front;
 use glam::DVec3;
 use std::ops::Range;
@@ -194,9 +195,7 @@ impl Parallel {
             |mut task| {
                 if let Some((g, mass)) = start {
                     let piece = &mut *task.sink.scatter.forces;
-                    for (f, &m) in piece.iter_mut().zip(&mass[task.t * per_piece..]) {
-                        *f = m * g;
-                    }
+                    start_with_weights(g, &mass[task.t * per_piece..], piece);
                 }
                 run(
                     task.springs,
