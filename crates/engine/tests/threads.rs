@@ -80,6 +80,22 @@ fn cloth(kind: IntegratorKind, shuffle: bool) -> World {
 
 /// [`cloth`] without its floor.
 fn bare_cloth(kind: IntegratorKind, shuffle: bool) -> World {
+    cloth_of(kind, shuffle, false)
+}
+
+/// [`cloth`] with its springs listed as a mesh lists them, each from a
+/// particle to later ones (summed as families of springs).
+fn mesh_cloth(kind: IntegratorKind, floor: bool) -> World {
+    let mut w = cloth_of(kind, false, true);
+    if floor {
+        w.add_floor(FloorDef::default()).unwrap();
+    }
+    w
+}
+
+/// The cloth, its springs in mesh order or `shuffle`d; `forward`: every
+/// spring from its earlier particle to its later one.
+fn cloth_of(kind: IntegratorKind, shuffle: bool, forward: bool) -> World {
     let n = 64;
     let mut w = World::new();
     w.set_integrator(kind);
@@ -103,14 +119,15 @@ fn bare_cloth(kind: IntegratorKind, shuffle: bool) -> World {
             if j + 1 < n {
                 edges.push((p, p + 1));
             }
+            let turn = |a, b| if forward { (b, a) } else { (a, b) };
             if i + 1 < n {
-                edges.push((p + n, p));
+                edges.push(turn(p + n, p));
             }
             if i + 1 < n && j + 1 < n {
                 edges.push((p, p + n + 1));
             }
             if i + 1 < n && j > 0 {
-                edges.push((p + n - 1, p));
+                edges.push(turn(p + n - 1, p));
             }
         }
     }
@@ -157,6 +174,20 @@ fn a_mass_spring_world_is_the_same_bits_on_any_number_of_threads() {
             run_world(40, || world(kind, false), 20),
             run_world(1, || world(kind, false), 20)
         );
+    }
+    // Listed as a mesh lists them: summed as families, each thread its
+    // own run of particles (and the springs reaching into it).
+    for kind in IntegratorKind::ALL {
+        for floor in [false, true] {
+            let one = run_world(1, || mesh_cloth(kind, floor), 50);
+            for threads in [2, 3, 40] {
+                let many = run_world(threads, || mesh_cloth(kind, floor), 50);
+                assert_eq!(
+                    many, one,
+                    "mesh order, {kind}, floor {floor}, {threads} threads"
+                );
+            }
+        }
     }
     let golden = run_world(2, || cloth(IntegratorKind::Symplectic, true), 100);
     assert_eq!(golden, CLOTH_GOLDEN, "{golden:#018x}");

@@ -8,6 +8,7 @@ use crate::parallel::take_front;
 use crate::particle::{non_negative, ParticleId};
 use glam::DVec3;
 
+mod grid;
 mod kernel;
 mod threads;
 
@@ -190,6 +191,9 @@ struct Scratch {
     parallel: threads::Parallel,
     /// The stages of the springs and particles counted in `stages.0`.
     stages: ((usize, usize), kernel::Stages),
+    /// Whether the springs are a mesh's ([`grid::Grid`]), for the springs
+    /// and particles counted in `.0`.
+    grid: Option<((usize, usize), Option<grid::Grid>)>,
 }
 
 impl Clone for Scratch {
@@ -233,16 +237,25 @@ impl Springs {
     /// Sets the rest length of spring `id` (the muscle's activation).
     pub fn set_rest_length(&mut self, id: SpringId, rest_length: f64) {
         self.table.rest_length[id.index()] = rest_length;
+        self.changed(id);
     }
     /// Sets the stiffness of spring `id`.
     pub fn set_stiffness(&mut self, id: SpringId, stiffness: f64) {
         self.table.stiffness[id.index()] = stiffness;
         self.table.note(id.index());
+        self.changed(id);
     }
     /// Sets the damping of spring `id`.
     pub fn set_damping(&mut self, id: SpringId, damping: f64) {
         self.table.damping[id.index()] = damping;
         self.table.note(id.index());
+        self.changed(id);
+    }
+    /// Keeps the mesh's copy of spring `id`'s parameters (if any) up to date.
+    fn changed(&mut self, id: SpringId) {
+        if let Some((_, Some(grid))) = &mut self.scratch.grid {
+            grid.set(self.table.all(), id.index());
+        }
     }
     /// All springs, in the order they were added.
     pub fn iter(&self) -> impl Iterator<Item = Spring> + '_ {
@@ -281,12 +294,33 @@ impl Springs {
     }
 }
 
+impl Scratch {
+    /// The springs' mesh, if they are one (found once for each count of
+    /// springs and particles: a spring's ends never change).
+    fn grid(&mut self, springs: Slice, particles: usize) -> Option<&mut grid::Grid> {
+        let key = (springs.len(), particles);
+        if self.grid.as_ref().is_none_or(|(k, _)| *k != key) {
+            self.grid = Some((key, grid::Grid::find(springs, particles)));
+        }
+        self.grid.as_mut().and_then(|(_, g)| g.as_mut())
+    }
+}
+
 impl Springs {
     /// True if the springs are split among threads ([`Self::apply_from`]
     /// can then set gravity in the same fork).
     #[inline]
     pub(crate) fn on_threads(&self) -> bool {
         self.len() >= threads::MIN_SPRINGS && rayon::current_num_threads() > 1
+    }
+
+    /// The threads the springs are summed on: the pool's, or one.
+    fn threads(&self) -> usize {
+        if self.on_threads() {
+            rayon::current_num_threads()
+        } else {
+            1
+        }
     }
 
     /// Whether [`Self::apply_then`] may be used: the springs in blocks.
@@ -317,6 +351,12 @@ impl Springs {
         combine: impl Fn(R, R) -> R + Sync + Send,
     ) -> Option<R> {
         let springs = self.table.all();
+        let threads = self.threads();
+        if let Some(grid) = self.scratch.grid(springs, forces.len()) {
+            return grid.run(
+                springs, ctx.pos, ctx.vel, forces, threads, start, outs, then, combine,
+            );
+        }
         if self.on_threads() {
             let (pos, vel) = (ctx.pos, ctx.vel);
             let parallel = &mut self.scratch.parallel;
@@ -361,6 +401,24 @@ impl Springs {
         forces: &mut [DVec3],
     ) {
         let springs = self.table.all();
+        let threads = self.threads();
+        if let Some(grid) = self.scratch.grid(springs, forces.len()) {
+            let start = |r: std::ops::Range<usize>, f: &mut [DVec3]| {
+                crate::forces::gravity::start_with_weights(g, &mass[r], f)
+            };
+            grid.run(
+                springs,
+                ctx.pos,
+                ctx.vel,
+                forces,
+                threads,
+                start,
+                [&mut [], &mut []],
+                |_, _, _| (),
+                |_, _| (),
+            );
+            return;
+        }
         self.scratch
             .parallel
             .apply(springs, ctx.pos, ctx.vel, forces, Some((g, mass)));
@@ -372,10 +430,24 @@ impl Force for Springs {
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
         let (pos, vel) = (ctx.pos, ctx.vel);
         let springs = self.table.all();
-        if self.on_threads() {
-            self.scratch.parallel.apply(springs, pos, vel, forces, None);
-        } else if springs.len() < kernel::MIN_BLOCKED {
+        let threads = self.threads();
+        if springs.len() < kernel::MIN_BLOCKED {
             kernel::plain(springs, pos, vel, forces);
+        } else if let Some(grid) = self.scratch.grid(springs, forces.len()) {
+            let none = [&mut [][..], &mut []];
+            grid.run(
+                springs,
+                pos,
+                vel,
+                forces,
+                threads,
+                |_, _| {},
+                none,
+                |_, _, _| (),
+                |_, _| (),
+            );
+        } else if self.on_threads() {
+            self.scratch.parallel.apply(springs, pos, vel, forces, None);
         } else {
             let block = self.scratch.block.get_or_insert_with(Box::default);
             kernel::run(springs, block, pos, vel, &mut kernel::Scatter::new(forces));
