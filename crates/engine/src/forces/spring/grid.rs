@@ -62,8 +62,7 @@ pub(super) struct Grid {
     stiffness: Vec<Vec<f64>>,
     damping: Vec<Vec<f64>>,
     /// Runs of particles, each with all of its families' springs both
-    /// ways (summed in one vectorised loop) or not (one particle at a
-    /// time, each spring tested).
+    /// ways or not (summed again one at a time, each spring tested).
     runs: Vec<(Range<usize>, bool)>,
     /// The largest offset.
     reach: usize,
@@ -247,6 +246,7 @@ impl Grid {
             stiffness,
             damping,
             shared: springs.shared,
+            reach: *reach,
         };
         // Runs of whole chunks, no shorter than what they reach back.
         let per = n
@@ -306,6 +306,8 @@ struct Mesh<'a> {
     stiffness: &'a [Vec<f64>],
     damping: &'a [Vec<f64>],
     shared: Option<(f64, f64)>,
+    /// The largest offset.
+    reach: usize,
 }
 
 /// Working arrays for a window of particles that slides along a thread's
@@ -326,6 +328,8 @@ struct Work {
     /// `force[d][k][p − f0]`: coordinate `k` of family `d`'s force at `p`.
     force: Vec<[Vec<f64>; 3]>,
     sum: [Vec<f64>; 3],
+    /// A chunk's particles that lack a spring, with their starting forces.
+    lacking: Vec<(usize, [f64; 3])>,
 }
 
 impl Work {
@@ -595,7 +599,13 @@ impl Mesh<'_> {
         mut run: usize,
     ) -> usize {
         let len = chunk.len();
-        let Work { f0, force, sum, .. } = work;
+        let Work {
+            f0,
+            force,
+            sum,
+            lacking,
+            ..
+        } = work;
         let lo = *f0;
         {
             let [sx, sy, sz] = sum;
@@ -603,57 +613,69 @@ impl Mesh<'_> {
                 (sx[i], sy[i], sz[i]) = (f.x, f.y, f.z);
             }
         }
+        // The particles that lack a spring, and their starting forces.
+        lacking.clear();
         while run < runs.len() {
             let (r, full) = &runs[run];
-            let part = r.start.max(chunk.start)..r.end.min(chunk.end);
-            if *full {
-                // Every spring both ways.
-                let at = part.start - chunk.start..part.end - chunk.start;
-                for (s, k) in sum.iter_mut().zip(0..3) {
-                    let s = &mut s[at.clone()];
-                    let sub = |j: usize| {
-                        let (d, o) = (self.down[j], self.offsets[self.down[j]]);
-                        &force[d][k][part.start - o - lo..part.end - o - lo]
-                    };
-                    let add = |d: usize| &force[d][k][part.start - lo..part.end - lo];
-                    macro_rules! families {
-                        ($($d:literal)*) => {
-                            match self.offsets.len() {
-                                $($d => full_run::<$d>(
-                                    s,
-                                    std::array::from_fn(sub),
-                                    std::array::from_fn(add),
-                                ),)*
-                                _ => unreachable!("at most {MAX_FAMILIES} families"),
-                            }
-                        };
-                    }
-                    families!(1 2 3 4 5 6 7 8);
-                }
-            } else {
-                for p in part {
+            if !*full {
+                for p in r.start.max(chunk.start)..r.end.min(chunk.end) {
                     let i = p - chunk.start;
-                    for (s, k) in sum.iter_mut().zip(0..3) {
-                        let mut v = s[i];
-                        for &d in self.down {
-                            let o = self.offsets[d];
-                            if p >= o && self.index[d][p - o] != NONE {
-                                v -= force[d][k][p - o - lo];
-                            }
-                        }
-                        for (d, f) in force.iter().enumerate() {
-                            if self.index[d][p] != NONE {
-                                v += f[k][p - lo];
-                            }
-                        }
-                        s[i] = v;
-                    }
+                    lacking.push((p, [sum[0][i], sum[1][i], sum[2][i]]));
                 }
             }
             if r.end > chunk.end {
                 break;
             }
             run += 1;
+        }
+        // Every particle from where all of its springs' forces are in the
+        // window, as if it had every spring, in one vectorised loop a
+        // coordinate; then those that lack one again, one at a time, from
+        // their starting forces (what the loop read for a missing spring
+        // is dropped with its sum). Before `lo + reach` every particle
+        // lacks a spring.
+        let first = chunk.start.max(lo + self.reach);
+        if first < chunk.end {
+            let at = first - chunk.start..len;
+            for (s, k) in sum.iter_mut().zip(0..3) {
+                let s = &mut s[at.clone()];
+                let sub = |j: usize| {
+                    let (d, o) = (self.down[j], self.offsets[self.down[j]]);
+                    &force[d][k][first - o - lo..chunk.end - o - lo]
+                };
+                let add = |d: usize| &force[d][k][first - lo..chunk.end - lo];
+                macro_rules! families {
+                    ($($d:literal)*) => {
+                        match self.offsets.len() {
+                            $($d => full_run::<$d>(
+                                s,
+                                std::array::from_fn(sub),
+                                std::array::from_fn(add),
+                            ),)*
+                            _ => unreachable!("at most {MAX_FAMILIES} families"),
+                        }
+                    };
+                }
+                families!(1 2 3 4 5 6 7 8);
+            }
+        }
+        for &(p, start) in lacking.iter() {
+            let i = p - chunk.start;
+            for (s, (k, start)) in sum.iter_mut().zip(start.into_iter().enumerate()) {
+                let mut v = start;
+                for &d in self.down {
+                    let o = self.offsets[d];
+                    if p >= o && self.index[d][p - o] != NONE {
+                        v -= force[d][k][p - o - lo];
+                    }
+                }
+                for (d, f) in force.iter().enumerate() {
+                    if self.index[d][p] != NONE {
+                        v += f[k][p - lo];
+                    }
+                }
+                s[i] = v;
+            }
         }
         let [sx, sy, sz] = &*sum;
         for (i, f) in out[..len].iter_mut().enumerate() {
