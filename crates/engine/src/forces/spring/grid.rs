@@ -256,17 +256,6 @@ impl Grid {
             * CHUNK;
         let tasks = n.div_ceil(per).max(1);
         works.resize_with(tasks, Default::default);
-        let has_outs = !outs[0].is_empty();
-        let [mut x, mut v] = outs;
-        let mut rest_forces = forces;
-        let mut jobs = Vec::with_capacity(tasks);
-        for (t, work) in works.iter_mut().enumerate() {
-            let range = t * per..n.min((t + 1) * per);
-            let len = if has_outs { range.len() } else { 0 };
-            let (x, v) = (take_front(&mut x, len), take_front(&mut v, len));
-            let f = take_front(&mut rest_forces, range.len());
-            jobs.push((range, work, f, [x, v]));
-        }
         let (mesh, runs, reach) = (&mesh, &runs[..], *reach);
         let (start, then) = (&start, &then);
         let job = |(range, work, forces, outs): (
@@ -286,8 +275,20 @@ impl Grid {
             )
         };
         if tasks == 1 {
-            jobs.into_iter().next().and_then(job)
+            // No list of jobs: nothing allocated in a step.
+            job((0..n, &mut works[0], forces, outs))
         } else {
+            let has_outs = !outs[0].is_empty();
+            let [mut x, mut v] = outs;
+            let mut rest_forces = forces;
+            let mut jobs = Vec::with_capacity(tasks);
+            for (t, work) in works.iter_mut().enumerate() {
+                let range = t * per..n.min((t + 1) * per);
+                let len = if has_outs { range.len() } else { 0 };
+                let (x, v) = (take_front(&mut x, len), take_front(&mut v, len));
+                let f = take_front(&mut rest_forces, range.len());
+                jobs.push((range, work, f, [x, v]));
+            }
             crate::parallel::fork_tasks(jobs, job, |a, b| match (a, b) {
                 (Some(a), Some(b)) => Some(combine(a, b)),
                 (a, b) => a.or(b),
