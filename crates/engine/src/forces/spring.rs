@@ -406,17 +406,7 @@ impl Springs {
             let start = |r: std::ops::Range<usize>, f: &mut [DVec3]| {
                 crate::forces::gravity::start_with_weights(g, &mass[r], f)
             };
-            grid.run(
-                springs,
-                ctx.pos,
-                ctx.vel,
-                forces,
-                threads,
-                start,
-                [&mut [], &mut []],
-                |_, _, _| (),
-                |_, _| (),
-            );
+            grid.add(springs, ctx.pos, ctx.vel, forces, threads, start);
             return;
         }
         self.scratch
@@ -434,18 +424,7 @@ impl Force for Springs {
         if springs.len() < kernel::MIN_BLOCKED {
             kernel::plain(springs, pos, vel, forces);
         } else if let Some(grid) = self.scratch.grid(springs, forces.len()) {
-            let none = [&mut [][..], &mut []];
-            grid.run(
-                springs,
-                pos,
-                vel,
-                forces,
-                threads,
-                |_, _| {},
-                none,
-                |_, _, _| (),
-                |_, _| (),
-            );
+            grid.add(springs, pos, vel, forces, threads, |_, _| {});
         } else if self.on_threads() {
             self.scratch.parallel.apply(springs, pos, vel, forces, None);
         } else {

@@ -61,9 +61,9 @@ pub(super) struct Grid {
     rest: Vec<Vec<f64>>,
     stiffness: Vec<Vec<f64>>,
     damping: Vec<Vec<f64>>,
-    /// Runs of particles, each with all of its families' springs both
-    /// ways or not (summed again one at a time, each spring tested).
-    runs: Vec<(Range<usize>, bool)>,
+    /// The particles that lack one of their families' springs either way
+    /// (a mesh's edges), in order: summed again one at a time.
+    lacking: Vec<u32>,
     /// The largest offset.
     reach: usize,
     /// Working arrays, one per thread.
@@ -145,14 +145,9 @@ impl Grid {
                 .enumerate()
                 .all(|(d, &o)| index[d][p] != NONE && p >= o && index[d][p - o] != NONE)
         };
-        let mut runs: Vec<(Range<usize>, bool)> = Vec::new();
-        for p in 0..particles {
-            let f = full(p);
-            match runs.last_mut() {
-                Some((r, g)) if *g == f => r.end = p + 1,
-                _ => runs.push((p..p + 1, f)),
-            }
-        }
+        let lacking = (0..particles as u32)
+            .filter(|&p| !full(p as usize))
+            .collect();
         let families = offsets.len();
         let each = |v: &[f64]| {
             let mut by = vec![vec![0.0; particles]; families];
@@ -176,7 +171,7 @@ impl Grid {
             rest,
             stiffness,
             damping,
-            runs,
+            lacking,
         })
     }
 
@@ -199,6 +194,31 @@ impl Grid {
             self.stiffness[d][a] = springs.stiffness[i];
             self.damping[d][a] = springs.damping[i];
         }
+    }
+
+    /// [`Self::run`] with nothing handed on: `start(range, forces)` before
+    /// any spring adds to a chunk.
+    pub fn add(
+        &mut self,
+        springs: Slice,
+        pos: &[DVec3],
+        vel: &[DVec3],
+        forces: &mut [DVec3],
+        threads: usize,
+        start: impl Fn(Range<usize>, &mut [DVec3]) + Sync,
+    ) {
+        let none = [&mut [][..], &mut []];
+        self.run(
+            springs,
+            pos,
+            vel,
+            forces,
+            threads,
+            start,
+            none,
+            |_, _, _| (),
+            |_, _| (),
+        );
     }
 
     /// Adds the springs' forces to `forces` on `threads` threads (of the
@@ -233,7 +253,7 @@ impl Grid {
             rest,
             stiffness,
             damping,
-            runs,
+            lacking,
             reach,
             works,
             ..
@@ -256,7 +276,7 @@ impl Grid {
             * CHUNK;
         let tasks = n.div_ceil(per).max(1);
         works.resize_with(tasks, Default::default);
-        let (mesh, runs, reach) = (&mesh, &runs[..], *reach);
+        let (mesh, lacking, reach) = (&mesh, &lacking[..], *reach);
         let (start, then) = (&start, &then);
         let job = |(range, work, forces, outs): (
             Range<usize>,
@@ -269,7 +289,7 @@ impl Grid {
                 #[inline(always)]
                 || {
                     mesh.run(
-                        work, runs, reach, pos, vel, range, forces, start, outs, then, &combine,
+                        work, lacking, reach, pos, vel, range, forces, start, outs, then, &combine,
                     )
                 },
             )
@@ -424,9 +444,10 @@ fn full_run<const D: usize>(s: &mut [f64], sub: [&[f64]; D], add: [&[f64]; D]) {
 
 /// One family's springs: from the particles of `a` (x, y, z, then the
 /// velocity's) to those of `xb` … `vzb`, rest lengths `rest` and
-/// `kc(i) = (stiffness, damping, _)`, into `fx`, `fy`, `fz`. The slices
-/// are parameters so that the compiler knows the outputs apart from the
-/// inputs and vectorises the loop.
+/// `kc(i) = (stiffness, damping)`, into `fx`, `fy`, `fz`. The slices are
+/// parameters, each cut here to `rest`'s length, so that the compiler knows
+/// the outputs apart from the inputs, checks no bounds in the loop and
+/// vectorises it.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn family(
@@ -437,7 +458,7 @@ fn family(
     vxb: &[f64],
     vyb: &[f64],
     vzb: &[f64],
-    kc: impl Fn(usize) -> (f64, f64, f64),
+    kc: impl Fn(usize) -> (f64, f64),
     rest: &[f64],
     fx: &mut [f64],
     fy: &mut [f64],
@@ -455,7 +476,7 @@ fn family(
     );
     let (fx, fy, fz) = (&mut fx[..n], &mut fy[..n], &mut fz[..n]);
     for i in 0..n {
-        let (k, c, _) = kc(i);
+        let (k, c) = kc(i);
         [fx[i], fy[i], fz[i]] = force(
             [xb[i] - xa[i], yb[i] - ya[i], zb[i] - za[i]],
             [vxb[i] - vxa[i], vyb[i] - vya[i], vzb[i] - vza[i]],
@@ -474,7 +495,7 @@ impl Mesh<'_> {
     fn run<R>(
         &self,
         work: &mut Work,
-        runs: &[(Range<usize>, bool)],
+        lacking: &[u32],
         reach: usize,
         pos: &[DVec3],
         vel: &[DVec3],
@@ -493,7 +514,6 @@ impl Mesh<'_> {
             work.states(pos, vel, lo, n.min(range.start + reach));
             self.compute(work, lo..range.start, n);
         }
-        let mut next_run = runs.partition_point(|(r, _)| r.end <= range.start);
         let [mut x, mut v] = outs;
         let has_outs = !x.is_empty();
         let mut answer = None;
@@ -505,7 +525,9 @@ impl Mesh<'_> {
             let local = chunk.start - range.start..chunk.end - range.start;
             let f = &mut forces[local.clone()];
             start(chunk.clone(), f);
-            next_run = self.sum(work, runs, f, chunk.clone(), next_run);
+            let first = lacking.partition_point(|&p| (p as usize) < chunk.start);
+            let last = lacking.partition_point(|&p| (p as usize) < chunk.end);
+            self.sum(work, &lacking[first..last], f, chunk.clone());
             let len = if has_outs { chunk.len() } else { 0 };
             let out = [take_front(&mut x, len), take_front(&mut v, len)];
             let a = then(chunk.start, f, out);
@@ -528,7 +550,6 @@ impl Mesh<'_> {
             let r = chunk.start..chunk.end.min(n - o).max(chunk.start);
             let (a, b) = (r.start - s0..r.end - s0, r.start - s0 + o..r.end - s0 + o);
             let fa = r.start - f0..r.end - f0;
-            let len = r.len();
             let (xa, ya, za) = (&x[a.clone()], &y[a.clone()], &z[a.clone()]);
             let (xb, yb, zb) = (&x[b.clone()], &y[b.clone()], &z[b.clone()]);
             let (vxa, vya, vza) = (&vx[a.clone()], &vy[a.clone()], &vz[a.clone()]);
@@ -536,19 +557,6 @@ impl Mesh<'_> {
             let rest = &self.rest[d][r.clone()];
             let [fx, fy, fz] = &mut work.force[d];
             let (fx, fy, fz) = (&mut fx[fa.clone()], &mut fy[fa.clone()], &mut fz[fa]);
-            // Every slice exactly `len` long, where the compiler sees it:
-            // no bounds checks in the loops, which it then vectorises.
-            let (xa, ya, za, xb, yb, zb) = (
-                &xa[..len],
-                &ya[..len],
-                &za[..len],
-                &xb[..len],
-                &yb[..len],
-                &zb[..len],
-            );
-            let (vxa, vya, vza) = (&vxa[..len], &vya[..len], &vza[..len]);
-            let (vxb, vyb, vzb) = (&vxb[..len], &vyb[..len], &vzb[..len]);
-            let (rest, fx, fy, fz) = (&rest[..len], &mut fx[..len], &mut fy[..len], &mut fz[..len]);
             // A spring the mesh lacks is computed (from zeros) and never used.
             match self.shared {
                 Some((ks, cs)) => family(
@@ -559,7 +567,7 @@ impl Mesh<'_> {
                     vxb,
                     vyb,
                     vzb,
-                    |_| (ks, cs, 0.0),
+                    |_| (ks, cs),
                     rest,
                     fx,
                     fy,
@@ -567,7 +575,6 @@ impl Mesh<'_> {
                 ),
                 None => {
                     let (k, c) = (&self.stiffness[d][r.clone()], &self.damping[d][r]);
-                    let (k, c) = (&k[..len], &c[..len]);
                     family(
                         [xa, ya, za, vxa, vya, vza],
                         xb,
@@ -576,7 +583,7 @@ impl Mesh<'_> {
                         vxb,
                         vyb,
                         vzb,
-                        |i| (k[i], c[i], 0.0),
+                        |i| (k[i], c[i]),
                         rest,
                         fx,
                         fy,
@@ -588,17 +595,10 @@ impl Mesh<'_> {
     }
 
     /// Adds to the forces `out` of the particles `chunk` their springs'
-    /// forces, in list order; `run` is the first of `runs` not yet wholly
-    /// summed, and the answer is the next one's.
+    /// forces, in list order; `lacks` are the chunk's particles that lack a
+    /// spring.
     #[inline(always)]
-    fn sum(
-        &self,
-        work: &mut Work,
-        runs: &[(Range<usize>, bool)],
-        out: &mut [DVec3],
-        chunk: Range<usize>,
-        mut run: usize,
-    ) -> usize {
+    fn sum(&self, work: &mut Work, lacks: &[u32], out: &mut [DVec3], chunk: Range<usize>) {
         let len = chunk.len();
         let Work {
             f0,
@@ -616,19 +616,10 @@ impl Mesh<'_> {
         }
         // The particles that lack a spring, and their starting forces.
         lacking.clear();
-        while run < runs.len() {
-            let (r, full) = &runs[run];
-            if !*full {
-                for p in r.start.max(chunk.start)..r.end.min(chunk.end) {
-                    let i = p - chunk.start;
-                    lacking.push((p, [sum[0][i], sum[1][i], sum[2][i]]));
-                }
-            }
-            if r.end > chunk.end {
-                break;
-            }
-            run += 1;
-        }
+        lacking.extend(lacks.iter().map(|&p| {
+            let i = p as usize - chunk.start;
+            (p as usize, [sum[0][i], sum[1][i], sum[2][i]])
+        }));
         // Every particle from where all of its springs' forces are in the
         // window, as if it had every spring, in one vectorised loop a
         // coordinate; then those that lack one again, one at a time, from
@@ -682,7 +673,6 @@ impl Mesh<'_> {
         for (i, f) in out[..len].iter_mut().enumerate() {
             *f = DVec3::new(sx[i], sy[i], sz[i]);
         }
-        run
     }
 }
 
@@ -872,7 +862,7 @@ mod tests {
         let g = find(&chain, 300).expect("a mesh");
         assert_eq!(g.offsets, [1]);
         // Every particle but the ends has both springs.
-        assert_eq!(g.runs, [(0..1, false), (1..299, true), (299..300, false)]);
+        assert_eq!(g.lacking, [0, 299]);
     }
 
     #[test]
