@@ -423,6 +423,16 @@ fn split(v: &[DVec3], x: &mut [f64], y: &mut [f64], z: &mut [f64]) {
     }
 }
 
+/// `x`, `y`, `z` into the coordinates of `v` (parameters, as in [`split`]).
+#[inline(always)]
+fn join(x: &[f64], y: &[f64], z: &[f64], v: &mut [DVec3]) {
+    let n = v.len();
+    let (x, y, z) = (&x[..n], &y[..n], &z[..n]);
+    for (i, v) in v.iter_mut().enumerate() {
+        *v = DVec3::new(x[i], y[i], z[i]);
+    }
+}
+
 /// `s[i] − sub[0][i] − … + add[0][i] + …` into `s`, in that order: the
 /// particles of a run with every spring, `D` families.
 #[inline(always)]
@@ -610,9 +620,7 @@ impl Mesh<'_> {
         let lo = *f0;
         {
             let [sx, sy, sz] = sum;
-            for (i, f) in out.iter().enumerate() {
-                (sx[i], sy[i], sz[i]) = (f.x, f.y, f.z);
-            }
+            split(out, sx, sy, sz);
         }
         // The particles that lack a spring, and their starting forces.
         lacking.clear();
@@ -670,9 +678,7 @@ impl Mesh<'_> {
             }
         }
         let [sx, sy, sz] = &*sum;
-        for (i, f) in out[..len].iter_mut().enumerate() {
-            *f = DVec3::new(sx[i], sy[i], sz[i]);
-        }
+        join(sx, sy, sz, &mut out[..len]);
     }
 }
 
