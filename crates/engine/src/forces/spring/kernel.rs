@@ -211,15 +211,21 @@ fn run_any<S: Sink>(springs: Slice, block: &mut Block, pos: &[DVec3], vel: &[DVe
 /// thread's piece's: `threads.rs` gives its blocks ends counted from the
 /// piece's first particle, so that no end needs a subtraction here).
 ///
-/// Consecutive springs sharing their first end (a mesh lists a particle's
-/// springs together) add to a register instead of to memory: the same
-/// additions in the same order, without waiting for each store to reach the
-/// next load. No spring of such a run has that particle as its second end (a
-/// spring's ends differ), so memory and register never disagree about it.
+/// Two particles' sums are held in registers instead of memory: that of
+/// the open run of consecutive springs sharing their first end (a mesh
+/// lists a particle's springs together), and that of the last spring's
+/// second end, until a spring with another second end comes (a chain's
+/// next spring starts from it). The same additions in the same order,
+/// without waiting for each store to reach the next load. The two are
+/// never the same particle: a run that opens on the held second end
+/// takes its sum over, and no spring of a run has its first end as its
+/// second (a spring's ends differ).
 pub(super) struct Scatter<'a> {
     pub forces: &'a mut [DVec3],
     run: Option<usize>,
     acc: DVec3,
+    second: Option<usize>,
+    held: DVec3,
 }
 
 impl<'a> Scatter<'a> {
@@ -229,6 +235,8 @@ impl<'a> Scatter<'a> {
             forces,
             run: None,
             acc: DVec3::ZERO,
+            second: None,
+            held: DVec3::ZERO,
         }
     }
 }
@@ -237,28 +245,42 @@ impl Sink for Scatter<'_> {
     #[inline(always)]
     fn take(&mut self, _: usize, ends: &[[u32; 2]], block: &Block) {
         let (mut run, mut acc) = (self.run, self.acc);
+        let (mut second, mut held) = (self.second, self.held);
         let forces = &mut *self.forces;
         for (i, &[a, b]) in ends.iter().enumerate() {
             let f = block.force(i);
-            let a = a as usize;
+            let (a, b) = (a as usize, b as usize);
             if run != Some(a) {
                 if let Some(p) = run {
                     forces[p] = acc;
                 }
                 run = Some(a);
-                acc = forces[a];
+                acc = if second == Some(a) {
+                    second = None;
+                    held
+                } else {
+                    forces[a]
+                };
             }
             acc += f;
-            forces[b as usize] -= f;
+            if second != Some(b) {
+                if let Some(q) = second {
+                    forces[q] = held;
+                }
+                second = Some(b);
+                held = forces[b];
+            }
+            held -= f;
         }
         (self.run, self.acc) = (run, acc);
+        (self.second, self.held) = (second, held);
     }
 
     #[inline(always)]
     fn finish(&mut self) {
-        if let Some(p) = self.run.take() {
-            self.forces[p] = self.acc;
-        }
+        self.store_run();
+        self.run = None;
+        self.second = None;
     }
 }
 
@@ -328,7 +350,8 @@ impl Stages {
 pub(super) trait Adds: Sink {
     /// The forces it adds to.
     fn forces(&mut self) -> &mut [DVec3];
-    /// Stores the open run's sum so far, leaving the run open.
+    /// Stores the sums held in registers so far (the open run's and the
+    /// last second end's), leaving them held.
     fn store_run(&mut self);
 }
 
@@ -342,6 +365,9 @@ impl Adds for Scatter<'_> {
     fn store_run(&mut self) {
         if let Some(p) = self.run {
             self.forces[p] = self.acc;
+        }
+        if let Some(q) = self.second {
+            self.forces[q] = self.held;
         }
     }
 }
@@ -471,6 +497,22 @@ mod tests {
             let b = (a + 1 + (r >> 20) % (n - 1)) % n;
             push(a, b, &mut t, r >> 8);
         }
+        // Then the cases the one-thread sink holds in registers: a chain
+        // (each spring starting at the last one's second end), springs
+        // sharing their second end in a row, a run of one first end, and
+        // springs to particles whose sums were stored before.
+        let (mut a, mut b) = (0, 1);
+        for i in 0..300 {
+            let r = u();
+            let other = |x: u64| (x + 1 + (r >> 24) % (n - 1)) % n;
+            (a, b) = match r % 4 {
+                0 => (b, other(b)),
+                1 => (other(b), b),
+                2 => (a, other(a)),
+                _ => ((i * 7) % n, other((i * 7) % n)),
+            };
+            push(a, b, &mut t, r >> 8);
+        }
         (t, pos, vel)
     }
 
@@ -546,39 +588,48 @@ mod tests {
     /// not all at the end.
     #[test]
     fn staged_a_chain_in_order_is_handed_on_while_its_springs_are_added() {
-        let n = 2000;
-        let mut t = Table::default();
-        for i in 0..n as u32 - 1 {
-            t.ends.push([i, i + 1]);
-            t.stiffness.push(10.0);
-            t.damping.push(0.1);
-            t.rest_length.push(0.5);
+        // Listed forward, each spring starts where the last ended; listed
+        // backward, each spring's second end is complete once the next
+        // spring is added (handed on while the sink may hold its sum).
+        for backward in [false, true] {
+            let n = 2000;
+            let mut t = Table::default();
+            for i in 0..n as u32 - 1 {
+                t.ends.push(if backward { [i + 1, i] } else { [i, i + 1] });
+                t.stiffness.push(10.0);
+                t.damping.push(0.1);
+                t.rest_length.push(0.5);
+            }
+            let pos: Vec<DVec3> = (0..n)
+                .map(|i| DVec3::new(i as f64, 0.01 * i as f64, 0.0))
+                .collect();
+            let vel = vec![DVec3::ZERO; n];
+            let start = vec![DVec3::ZERO; n];
+            let mut want = start.clone();
+            plain(t.all(), &pos, &vel, &mut want);
+            let (forces, started, handed) = staged(&t, &pos, &vel, &start);
+            assert_eq!(bits(&forces), bits(&want), "backward {backward}");
+            assert!(started.len() > n / BLOCK / 2, "{} starts", started.len());
+            assert!(
+                handed.len() >= n / (STAGE + BLOCK),
+                "{} hand-ons",
+                handed.len()
+            );
+            for (r, f) in &handed {
+                assert_eq!(
+                    bits(f),
+                    bits(&want[r.clone()]),
+                    "{r:?} handed on complete (backward {backward})"
+                );
+            }
+            let (last, rest) = handed.split_last().unwrap();
+            assert!(rest.iter().all(|(r, _)| r.len() >= STAGE));
+            assert!(
+                last.0.len() <= STAGE + BLOCK,
+                "{:?} left to the end",
+                last.0
+            );
         }
-        let pos: Vec<DVec3> = (0..n)
-            .map(|i| DVec3::new(i as f64, 0.01 * i as f64, 0.0))
-            .collect();
-        let vel = vec![DVec3::ZERO; n];
-        let start = vec![DVec3::ZERO; n];
-        let mut want = start.clone();
-        plain(t.all(), &pos, &vel, &mut want);
-        let (forces, started, handed) = staged(&t, &pos, &vel, &start);
-        assert_eq!(bits(&forces), bits(&want));
-        assert!(started.len() > n / BLOCK / 2, "{} starts", started.len());
-        assert!(
-            handed.len() >= n / (STAGE + BLOCK),
-            "{} hand-ons",
-            handed.len()
-        );
-        for (r, f) in &handed {
-            assert_eq!(bits(f), bits(&want[r.clone()]), "{r:?} handed on complete");
-        }
-        let (last, rest) = handed.split_last().unwrap();
-        assert!(rest.iter().all(|(r, _)| r.len() >= STAGE));
-        assert!(
-            last.0.len() <= STAGE + BLOCK,
-            "{:?} left to the end",
-            last.0
-        );
     }
 
     #[test]
