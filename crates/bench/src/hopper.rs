@@ -53,8 +53,13 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         runs,
         || State::new(Config::thesis(6, generations, 1)).expect("valid configuration"),
         |s| {
+            // In batches, as `animats evolve` runs it.
+            let mut batch = animats_evolve::FIRST_BATCH;
             while !s.done() {
-                pool.install(|| s.advance(10)).expect("evaluations succeed");
+                let begun = std::time::Instant::now();
+                pool.install(|| s.advance(batch))
+                    .expect("evaluations succeed");
+                batch = animats_evolve::next_batch(batch, begun.elapsed());
             }
         },
     );

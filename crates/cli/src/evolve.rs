@@ -68,9 +68,6 @@ pub struct Args {
 const CHECKPOINT: &str = "checkpoint.json";
 /// Seconds between progress lines when stderr is not a terminal.
 const PROGRESS_EVERY: f64 = 5.0;
-/// Generations each roobot lane advances between progress updates and
-/// Ctrl-C checks (a scene's lanes advance one generation at a time).
-const BATCH: u64 = 10;
 
 fn input(m: impl Into<String>) -> Failure {
     Failure::Input(m.into())
@@ -304,18 +301,24 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let evals_at_start = state.evaluations;
     let mut last_save = Instant::now();
     let mut interrupted = false;
+    // Generations each roobot lane advances between progress updates and
+    // Ctrl-C checks, grown to about a quarter of a second's work (a
+    // scene's lanes advance one generation at a time: its generations are
+    // long).
+    let mut batch = animats_evolve::FIRST_BATCH;
     while !state.done() {
         if stop.load(Ordering::SeqCst) {
             interrupted = true;
             break;
         }
-        let batch = if state.config.problem.is_roobot() {
-            BATCH
-        } else {
-            1
-        };
-        pool.install(|| state.advance_with(problem.as_ref(), batch))
+        let roobot = state.config.problem.is_roobot();
+        let n = if roobot { batch } else { 1 };
+        let begun = Instant::now();
+        pool.install(|| state.advance_with(problem.as_ref(), n))
             .map_err(Failure::Other)?;
+        if roobot {
+            batch = animats_evolve::next_batch(batch, begun.elapsed());
+        }
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
         if let Some((watched, _)) = &viewing {

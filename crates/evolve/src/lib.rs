@@ -27,4 +27,4 @@ pub mod run;
 
 pub use optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 pub use problem::{Outcome, Problem};
-pub use run::{Best, Config, Lane, LogRow, ProblemSpec, State};
+pub use run::{next_batch, Best, Config, Lane, LogRow, ProblemSpec, State, FIRST_BATCH};

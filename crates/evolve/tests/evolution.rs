@@ -348,3 +348,20 @@ fn lanes_advance_together_and_a_failure_stops_the_batch() {
         assert!(evaluated <= 5 + threads, "{threads} threads: {evaluated}");
     }
 }
+
+/// A run advanced batch by batch grows its batches towards a quarter of a
+/// second's work, at most fourfold at a time, and never to zero.
+#[test]
+fn batches_grow_towards_a_quarter_second() {
+    use animats_evolve::next_batch;
+    use std::time::Duration;
+    // 10 generations in 10 ms: 250 would take 0.25 s; four times 10 first.
+    assert_eq!(next_batch(10, Duration::from_millis(10)), 40);
+    assert_eq!(next_batch(40, Duration::from_millis(40)), 160);
+    assert_eq!(next_batch(160, Duration::from_millis(160)), 250);
+    // Slower than that: fewer.
+    assert_eq!(next_batch(40, Duration::from_secs(1)), 10);
+    assert_eq!(next_batch(1, Duration::from_secs(10)), 1);
+    assert_eq!(next_batch(0, Duration::ZERO), 1);
+    assert!(next_batch(u64::MAX, Duration::ZERO) >= 1);
+}
