@@ -148,14 +148,7 @@ impl Grid {
         let lacking = (0..particles as u32)
             .filter(|&p| !full(p as usize))
             .collect();
-        let families = offsets.len();
-        let each = |v: &[f64]| {
-            let mut by = vec![vec![0.0; particles]; families];
-            for (&(d, a), &v) in place.iter().zip(v) {
-                by[d as usize][a as usize] = v;
-            }
-            by
-        };
+        let each = |v: &[f64]| by_family(&place, v, offsets.len(), particles);
         let rest = each(springs.rest_length);
         let (stiffness, damping) = match springs.shared {
             Some(_) => (Vec::new(), Vec::new()),
@@ -184,15 +177,12 @@ impl Grid {
             if self.stiffness.is_empty() {
                 // The springs no longer share theirs: copy them all.
                 let (n, families) = (self.index[0].len(), self.offsets.len());
-                self.stiffness = vec![vec![0.0; n]; families];
-                self.damping = vec![vec![0.0; n]; families];
-                for (j, &(d, a)) in self.place.iter().enumerate() {
-                    self.stiffness[d as usize][a as usize] = springs.stiffness[j];
-                    self.damping[d as usize][a as usize] = springs.damping[j];
-                }
+                self.stiffness = by_family(&self.place, springs.stiffness, families, n);
+                self.damping = by_family(&self.place, springs.damping, families, n);
+            } else {
+                self.stiffness[d][a] = springs.stiffness[i];
+                self.damping[d][a] = springs.damping[i];
             }
-            self.stiffness[d][a] = springs.stiffness[i];
-            self.damping[d][a] = springs.damping[i];
         }
     }
 
@@ -410,6 +400,17 @@ impl Work {
         }
         (self.f0, self.f_len) = (from, self.f_len - shift);
     }
+}
+
+/// Each spring's value `v[i]` at its place `place[i]` (family, first end)
+/// among `families` families of `particles` places; zero where the mesh
+/// lacks a spring.
+fn by_family(place: &[(u32, u32)], v: &[f64], families: usize, particles: usize) -> Vec<Vec<f64>> {
+    let mut by = vec![vec![0.0; particles]; families];
+    for (&(d, a), &v) in place.iter().zip(v) {
+        by[d as usize][a as usize] = v;
+    }
+    by
 }
 
 /// The coordinates of `v` into `x`, `y`, `z` (parameters, so that the
