@@ -12,7 +12,8 @@
 //! - A sphere dropped on one resting on the floor comes to rest on it, with
 //!   the pair's overlap under a micrometre; one set in the pocket of three
 //!   rests at the height of the tetrahedron, the base held by friction; a
-//!   square pyramid of 30 comes to rest and stays.
+//!   square pyramid of 30 comes to rest and stays; so does a column of 12,
+//!   taller than the handling's passes.
 //! - Spheres flung far away neither break the grid nor hide a collision.
 //!
 //! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
@@ -462,4 +463,54 @@ fn a_pyramid_of_spheres_comes_to_rest_and_stays() {
     // What a step's end still carries of that step's gravity (the passes
     // stop before every contact has taken it back), never more.
     assert!(speed <= 9.8 * h, "fastest {speed} m/s");
+}
+
+#[test]
+fn a_column_taller_than_the_passes_rests_on_the_floor() {
+    // Twelve spheres stacked on the floor, more than the handling's passes:
+    // each rests on the one below although the two merely touch when a
+    // step ends (both fell by the same g h²), so the push of the spheres
+    // above must reach the floor through contacts that do not overlap.
+    // The column comes to rest and stays there, each contact overlapping
+    // by less than a slow approach closes in a step (`rest_speed · h`).
+    // (The passes do not take back all of a step's gravity in so tall a
+    // column: its lower spheres end a step with a few g h of it, which
+    // the next step's contacts take back; positions repeat exactly.)
+    let (r, h, n) = (0.02, 1e-3, 12);
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    for k in 0..n {
+        let x = DVec3::new(0.0, r + 2.0 * r * k as f64, 0.0);
+        w.add_particle(ball(0.05, r, x, DVec3::ZERO).with_restitution(0.3))
+            .unwrap();
+    }
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    let start = w.state().pos.clone();
+    for _ in 0..1000 {
+        w.step(h).unwrap();
+    }
+    let settled = w.state().pos.clone();
+    let mut travelled = 0.0;
+    for _ in 0..1000 {
+        let before = w.state().pos.clone();
+        w.step(h).unwrap();
+        travelled += (w.state().pos[n - 1] - before[n - 1]).length();
+    }
+    let top = w.state().pos[n - 1];
+    let sag = start[n - 1].y - top.y;
+    let drift = (top - settled[n - 1]).length();
+    let speed = w.state().vel.iter().map(|v| v.length()).fold(0.0, f64::max);
+    println!("top: sag {sag:e} m, drift {drift:e} m, travelled {travelled:e} m in a second; fastest {speed:e} m/s");
+    let rest_speed = SphereContactDef::default().rest_speed;
+    assert!(
+        sag > 0.0 && sag < (n - 1) as f64 * rest_speed * h,
+        "the top sank {sag} m"
+    );
+    assert!(drift < 1e-12, "the top moved {drift} m in a second at rest");
+    assert!(
+        travelled < 1e-9,
+        "the top travelled {travelled} m step by step in a second"
+    );
 }

@@ -26,6 +26,14 @@
 //!   each coefficient the geometric mean of the two spheres' (as Box2D mixes
 //!   them).
 //!
+//! The contacts handled are the pairs that overlap or come within
+//! `rest_speed · h` of each other, and every pass visits each of them,
+//! whether an earlier pass has already parted it or not: a resting sphere
+//! pushed down by the one above passes that on to the one below in the
+//! same handling, even where the two below merely touch. Across a gap a
+//! slow approach is limited to what closes the gap within the next step
+//! (a speculative contact); a fast one is left to bounce once they touch.
+//!
 //! A chain of touching spheres (Newton's cradle) passes an impulse along in
 //! one handling, since each contact is recomputed after the ones before it.
 //! With a floor, a sphere resting on it that a contact pushes down is held
@@ -159,6 +167,15 @@ pub struct SphereContact {
     impacts: Vec<Impact>,
     /// The spheres that moved further than their radius in the trial.
     fast: Vec<u32>,
+    /// The step of the last check, s.
+    h: f64,
+    /// How far apart (m) a pair still counts as a contact: two spheres
+    /// closing more slowly than `rest_speed` cannot cross a wider gap
+    /// within one step, and a faster approach is an impact, handled once
+    /// they touch.
+    margin: f64,
+    /// How many of `pairs` overlapped at the last check.
+    overlapping: usize,
     /// Every colliding sphere with the box of its path in the trial.
     moving: Vec<(u32, DVec3, DVec3)>,
 }
@@ -269,6 +286,9 @@ impl SphereContact {
             impacts: Vec::new(),
             fast: Vec::new(),
             moving: Vec::new(),
+            h: 1.0,
+            margin: 0.0,
+            overlapping: 0,
         })
     }
 
@@ -289,7 +309,7 @@ impl SphereContact {
 
     /// How many pairs overlapped at the last check (resting contacts too).
     pub fn touching(&self) -> usize {
-        self.pairs.len()
+        self.overlapping
     }
 
     /// The impacts of the last step (approaches at `rest_speed` or faster;
@@ -304,8 +324,8 @@ impl SphereContact {
         self.find(pos, particles)
     }
 
-    /// Fills `pairs` with the overlapping pairs at `pos`; returns the
-    /// deepest overlap.
+    /// Fills `pairs` with the pairs at `pos` that overlap or are less than
+    /// `margin` apart; returns the deepest overlap.
     fn find(&mut self, pos: &[DVec3], p: &Properties) -> f64 {
         self.pairs.clear();
         self.cells.clear();
@@ -435,8 +455,15 @@ impl SphereContact {
             let i = i as usize;
             (pos[i], p.radius[i], p.inv_mass[i] == 0.0)
         }));
-        let (cells, near, pairs, excluded) =
-            (&self.cells, &self.near, &mut self.pairs, &self.excluded);
+        let margin = self.margin;
+        self.overlapping = 0;
+        let (cells, near, pairs, excluded, overlapping) = (
+            &self.cells,
+            &self.near,
+            &mut self.pairs,
+            &self.excluded,
+            &mut self.overlapping,
+        );
         let mut test = |x: usize, y: usize| {
             let ((pa, ra, fa), (pb, rb, fb)) = (near[x], near[y]);
             if fa && fb {
@@ -444,7 +471,8 @@ impl SphereContact {
             }
             let reach = ra + rb;
             let d2 = (pb - pa).length_squared();
-            if d2 >= reach * reach {
+            let outer = reach + margin;
+            if d2 >= outer * outer {
                 return;
             }
             let (a, b) = (cells[x].1, cells[y].1);
@@ -452,6 +480,9 @@ impl SphereContact {
                 return;
             }
             deepest = deepest.max(reach - d2.sqrt());
+            if d2 < reach * reach {
+                *overlapping += 1;
+            }
             let (a, b) = if a < b { (a, b) } else { (b, a) };
             pairs.push(Pair { a, b });
         };
@@ -552,6 +583,8 @@ impl SphereContact {
 
 impl DiscreteEvent for SphereContact {
     fn check(&mut self, ctx: &EventContext) -> EventState {
+        self.h = ctx.step;
+        self.margin = self.def.rest_speed * ctx.step;
         let mut deepest = self.find(ctx.pos, ctx.particles);
         if deepest <= self.def.envelope {
             deepest = deepest.max(self.swept(ctx));
@@ -571,14 +604,16 @@ impl DiscreteEvent for SphereContact {
                 .as_ref()
                 .is_some_and(|f| f.get(i).copied().unwrap_or(false))
         };
+        let h = self.h;
         for pass in 0..PASSES {
             let mut largest = 0.0f64;
             for q in &self.pairs {
                 let (a, b) = (q.a as usize, q.b as usize);
                 let d = pos[b] - pos[a];
                 let dist = d.length();
-                let overlap = p.radius[a] + p.radius[b] - dist;
-                if overlap <= 0.0 || dist == 0.0 {
+                let reach = p.radius[a] + p.radius[b];
+                let overlap = reach - dist;
+                if overlap <= -self.margin || dist == 0.0 {
                     continue; // parted by an earlier contact, or no direction
                 }
                 let n = d / dist;
@@ -599,14 +634,16 @@ impl DiscreteEvent for SphereContact {
                 if w == 0.0 {
                     continue;
                 }
-                largest = largest.max(overlap);
-                let [ka, kb] = div2([overlap * wa, overlap * wb], [w, w]);
-                pos[a] -= n * ka;
-                pos[b] += n * kb;
                 let u = vel[b] - vel[a];
                 let un = u.dot(n);
-                if un < 0.0 {
-                    let e = if -un < self.def.rest_speed {
+                // Touching or overlapping, they must not approach; across
+                // a gap, not close it within the next step. Only a slow
+                // approach is limited across a gap: a fast one bounces
+                // once they touch.
+                let allowed = overlap.min(0.0) / h;
+                let resting = -un < self.def.rest_speed;
+                if un < allowed && (overlap >= 0.0 || resting) {
+                    let e = if resting || overlap < 0.0 {
                         0.0
                     } else {
                         self.def
@@ -617,7 +654,12 @@ impl DiscreteEvent for SphereContact {
                     let slide = ut.length();
                     // The normal impulse and the one that would stop the
                     // sliding, in one division.
-                    let [jn, stop] = div2([-(1.0 + e) * un, slide], [w, w]);
+                    let target = if overlap < 0.0 {
+                        allowed - un
+                    } else {
+                        -(1.0 + e) * un
+                    };
+                    let [jn, stop] = div2([target, slide], [w, w]);
                     let mut impulse = n * jn;
                     if slide > 0.0 {
                         // Against what friction can give.
@@ -627,13 +669,19 @@ impl DiscreteEvent for SphereContact {
                     }
                     vel[a] -= impulse * wa;
                     vel[b] += impulse * wb;
-                    if pass == 0 && -un >= self.def.rest_speed {
+                    if pass == 0 && !resting {
                         self.impacts.push(Impact {
                             spheres: (ParticleId(q.a), ParticleId(q.b)),
                             t,
                             speed: -un,
                         });
                     }
+                }
+                if overlap > 0.0 {
+                    largest = largest.max(overlap);
+                    let [ka, kb] = div2([overlap * wa, overlap * wb], [w, w]);
+                    pos[a] -= n * ka;
+                    pos[b] += n * kb;
                 }
                 for i in [a, b] {
                     if held(i) && pos[i].y < p.radius[i] && p.inv_mass[i] != 0.0 {
