@@ -6,7 +6,9 @@
 //! more than 1 mm; how far they travelled step by step (mean) and how far
 //! they sank (mean fall of the centres); the fastest sphere's speed at the
 //! step's end; the deepest overlap the contacts' passes left at a step's
-//! end; and how many spheres are outside the ring.
+//! end; and how many spheres are outside the ring. `--layers` adds, for
+//! each layer of the heap (by the height of the centres, a diameter a
+//! layer), how far its spheres moved in the second, in all and sideways.
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
@@ -14,16 +16,20 @@ use animats_bench::pile::{outside_ring, pile_walled};
 use animats_engine::{SphereContact, SphereContactDef};
 
 fn main() {
-    let (mut rows, mut seconds) = (1usize, 12usize);
+    let (mut rows, mut seconds, mut layers) = (1usize, 12usize, false);
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
+        if flag == "--layers" {
+            layers = true;
+            continue;
+        }
         let value = args.next().and_then(|v| v.parse::<usize>().ok());
         match (flag.as_str(), value) {
             ("--rows", Some(v)) if v >= 1 => rows = v,
             ("--seconds", Some(v)) if v >= 1 => seconds = v,
             _ => {
                 eprintln!(
-                    "pile_rest: expected --rows N (>= 1) and --seconds S (>= 1), got {flag:?}"
+                    "pile_rest: expected --rows N (>= 1), --seconds S (>= 1) and --layers, got {flag:?}"
                 );
                 std::process::exit(2);
             }
@@ -73,6 +79,27 @@ fn main() {
             "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  travelled {travelled:.2e} m  sank {sank:+.1e} m  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
             w.energy().kinetic
         );
+        if layers {
+            // (spheres, moved, moved sideways) by layer.
+            let mut bins: Vec<(usize, f64, f64)> = Vec::new();
+            for (k, &i) in free.iter().enumerate() {
+                let layer = (st.pos[i].y / (2.0 * r)).max(0.0) as usize;
+                if bins.len() <= layer {
+                    bins.resize(layer + 1, (0, 0.0, 0.0));
+                }
+                let d = st.pos[i] - before[i];
+                bins[layer].0 += 1;
+                bins[layer].1 += moved[k];
+                bins[layer].2 += d.x.hypot(d.z);
+            }
+            for (l, &(n, all, sideways)) in bins.iter().enumerate().filter(|(_, b)| b.0 > 0) {
+                println!(
+                    "    layer {l}: {n:>4} spheres, moved {:.2e} m, sideways {:.2e} m",
+                    all / n as f64,
+                    sideways / n as f64
+                );
+            }
+        }
         before = st.pos.clone();
     }
 }
