@@ -8,7 +8,9 @@
 //! step's end; the deepest overlap the contacts' passes left at a step's
 //! end; and how many spheres are outside the ring. `--layers` adds, for
 //! each layer of the heap (by the height of the centres, a diameter a
-//! layer), how far its spheres moved in the second, in all and sideways.
+//! layer), how far its spheres moved in the second, in all and sideways,
+//! and how far their mean position moved (a drift common to the layer,
+//! against each sphere wandering its own way).
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
@@ -80,23 +82,26 @@ fn main() {
             w.energy().kinetic
         );
         if layers {
-            // (spheres, moved, moved sideways) by layer.
-            let mut bins: Vec<(usize, f64, f64)> = Vec::new();
+            // (spheres, moved, moved sideways, sum of the moves) by layer.
+            let mut bins: Vec<(usize, f64, f64, animats_engine::DVec3)> = Vec::new();
             for (k, &i) in free.iter().enumerate() {
                 let layer = (st.pos[i].y / (2.0 * r)).max(0.0) as usize;
                 if bins.len() <= layer {
-                    bins.resize(layer + 1, (0, 0.0, 0.0));
+                    bins.resize(layer + 1, (0, 0.0, 0.0, animats_engine::DVec3::ZERO));
                 }
                 let d = st.pos[i] - before[i];
                 bins[layer].0 += 1;
                 bins[layer].1 += moved[k];
                 bins[layer].2 += d.x.hypot(d.z);
+                bins[layer].3 += d;
             }
-            for (l, &(n, all, sideways)) in bins.iter().enumerate().filter(|(_, b)| b.0 > 0) {
+            for (l, &(n, all, sideways, sum)) in bins.iter().enumerate().filter(|(_, b)| b.0 > 0) {
+                let n = n as f64;
                 println!(
-                    "    layer {l}: {n:>4} spheres, moved {:.2e} m, sideways {:.2e} m",
-                    all / n as f64,
-                    sideways / n as f64
+                    "    layer {l}: {n:>4} spheres, moved {:.2e} m, sideways {:.2e} m, their mean {:.2e} m",
+                    all / n,
+                    sideways / n,
+                    (sum / n).length()
                 );
             }
         }
