@@ -167,13 +167,8 @@ pub struct SphereContact {
     impacts: Vec<Impact>,
     /// The spheres that moved further than their radius in the trial.
     fast: Vec<u32>,
-    /// The step of the last check, s.
+    /// The step of the last check, s (0 before any).
     h: f64,
-    /// How far apart (m) a pair still counts as a contact: two spheres
-    /// closing more slowly than `rest_speed` cannot cross a wider gap
-    /// within one step, and a faster approach is an impact, handled once
-    /// they touch.
-    margin: f64,
     /// How many of `pairs` overlapped at the last check.
     overlapping: usize,
     /// Every colliding sphere with the box of its path in the trial.
@@ -286,8 +281,7 @@ impl SphereContact {
             impacts: Vec::new(),
             fast: Vec::new(),
             moving: Vec::new(),
-            h: 1.0,
-            margin: 0.0,
+            h: 0.0,
             overlapping: 0,
         })
     }
@@ -300,6 +294,14 @@ impl SphereContact {
         let mut held = vec![false; n];
         targets.for_each(n, |i| held[i] = true);
         self.floor = Some(held);
+    }
+
+    /// How far apart (m) a pair still counts as a contact: two spheres
+    /// closing more slowly than `rest_speed` cannot cross a wider gap
+    /// within one step, and a faster approach is an impact, handled once
+    /// they touch.
+    fn margin(&self) -> f64 {
+        self.def.rest_speed * self.h
     }
 
     /// The settings.
@@ -325,7 +327,7 @@ impl SphereContact {
     }
 
     /// Fills `pairs` with the pairs at `pos` that overlap or are less than
-    /// `margin` apart; returns the deepest overlap.
+    /// [`Self::margin`] apart; returns the deepest overlap.
     fn find(&mut self, pos: &[DVec3], p: &Properties) -> f64 {
         self.pairs.clear();
         self.cells.clear();
@@ -455,7 +457,7 @@ impl SphereContact {
             let i = i as usize;
             (pos[i], p.radius[i], p.inv_mass[i] == 0.0)
         }));
-        let margin = self.margin;
+        let margin = self.margin();
         self.overlapping = 0;
         let (cells, near, pairs, excluded, overlapping) = (
             &self.cells,
@@ -584,7 +586,6 @@ impl SphereContact {
 impl DiscreteEvent for SphereContact {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.h = ctx.step;
-        self.margin = self.def.rest_speed * ctx.step;
         let mut deepest = self.find(ctx.pos, ctx.particles);
         if deepest <= self.def.envelope {
             deepest = deepest.max(self.swept(ctx));
@@ -604,7 +605,7 @@ impl DiscreteEvent for SphereContact {
                 .as_ref()
                 .is_some_and(|f| f.get(i).copied().unwrap_or(false))
         };
-        let h = self.h;
+        let (h, margin) = (self.h, self.margin());
         for pass in 0..PASSES {
             let mut largest = 0.0f64;
             for q in &self.pairs {
@@ -613,7 +614,7 @@ impl DiscreteEvent for SphereContact {
                 let dist = d.length();
                 let reach = p.radius[a] + p.radius[b];
                 let overlap = reach - dist;
-                if overlap <= -self.margin || dist == 0.0 {
+                if overlap <= -margin || dist == 0.0 {
                     continue; // parted by an earlier contact, or no direction
                 }
                 let n = d / dist;
