@@ -1,7 +1,8 @@
 //! Does a heap come to rest? 1,000 spheres poured into the ring of
 //! [`animats_bench::pile`], the ring `--rows` spheres tall (default 1, the
 //! benchmark's; 8 holds the whole heap in), simulated for `--seconds`
-//! (default 12) at 1 ms. Each second it prints the kinetic energy; how far
+//! (default 12) at 1 ms, with sleeping at `--sleep` m/s (default off).
+//! Each second it prints how many spheres sleep; the kinetic energy; how far
 //! the spheres moved in that second (mean and largest) and how many moved
 //! more than 1 mm; how far they travelled step by step (mean) and how far
 //! they sank (mean fall of the centres); the fastest sphere's speed at the
@@ -14,15 +15,26 @@
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
 
-use animats_bench::pile::{outside_ring, pile_walled};
+use animats_bench::pile::{outside_ring, pile_walled_with};
 use animats_engine::{SphereContact, SphereContactDef};
 
 fn main() {
     let (mut rows, mut seconds, mut layers) = (1usize, 12usize, false);
+    let mut contact = SphereContactDef::default();
     let mut args = std::env::args().skip(1);
     while let Some(flag) = args.next() {
         if flag == "--layers" {
             layers = true;
+            continue;
+        }
+        if flag == "--sleep" {
+            match args.next().and_then(|v| v.parse::<f64>().ok()) {
+                Some(v) if v > 0.0 && v.is_finite() => contact.sleep_speed = v,
+                _ => {
+                    eprintln!("pile_rest: expected --sleep SPEED (m/s, > 0)");
+                    std::process::exit(2);
+                }
+            }
             continue;
         }
         let value = args.next().and_then(|v| v.parse::<usize>().ok());
@@ -31,14 +43,14 @@ fn main() {
             ("--seconds", Some(v)) if v >= 1 => seconds = v,
             _ => {
                 eprintln!(
-                    "pile_rest: expected --rows N (>= 1), --seconds S (>= 1) and --layers, got {flag:?}"
+                    "pile_rest: expected --rows N (>= 1), --seconds S (>= 1), --sleep SPEED and --layers, got {flag:?}"
                 );
                 std::process::exit(2);
             }
         }
     }
     let (r, h) = (0.02, 1e-3);
-    let mut w = pile_walled(1000, r, 10, rows);
+    let mut w = pile_walled_with(1000, r, 10, rows, contact);
     let free: Vec<usize> = (0..w.len())
         .filter(|&i| w.particles().inv_mass[i] > 0.0)
         .collect();
@@ -77,8 +89,9 @@ fn main() {
         let sank = free.iter().map(|&i| before[i].y - st.pos[i].y).sum::<f64>() / free.len() as f64;
         let fastest = free.iter().map(|&i| st.vel[i].length()).fold(0.0, f64::max);
         let outside = outside_ring(&w);
+        let asleep = w.event::<SphereContact>().map_or(0, |c| c.sleeping());
         println!(
-            "t = {s:>2} s  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  travelled {travelled:.2e} m  sank {sank:+.1e} m  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
+            "t = {s:>2} s  asleep {asleep:>4}  {:.2e} J  moved {mean:.2e} / {largest:.2e} m  > 1 mm: {over:>4}  travelled {travelled:.2e} m  sank {sank:+.1e} m  fastest {fastest:.2e} m/s  overlap {left:.1e} m  outside {outside}",
             w.energy().kinetic
         );
         if layers {

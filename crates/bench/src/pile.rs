@@ -23,6 +23,17 @@ pub fn pile_layers(n: usize, r: f64, layers: usize) -> World {
 /// stacked in columns): with one row the heap of 1,000 (about five layers
 /// deep once fallen) spills over the ring; with eight none can.
 pub fn pile_walled(n: usize, r: f64, layers: usize, rows: usize) -> World {
+    pile_walled_with(n, r, layers, rows, SphereContactDef::default())
+}
+
+/// [`pile_walled`] with the given contact settings (sleeping, say).
+pub fn pile_walled_with(
+    n: usize,
+    r: f64,
+    layers: usize,
+    rows: usize,
+    contact: SphereContactDef,
+) -> World {
     let mut w = World::new();
     w.set_integrator(IntegratorKind::Symplectic);
     w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
@@ -62,7 +73,7 @@ pub fn pile_walled(n: usize, r: f64, layers: usize, rows: usize) -> World {
         .unwrap();
     }
     w.add_floor(FloorDef::default()).unwrap();
-    w.add_sphere_contact(SphereContactDef::default()).unwrap();
+    w.add_sphere_contact(contact).unwrap();
     w
 }
 

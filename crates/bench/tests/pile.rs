@@ -2,15 +2,16 @@
 //! tall enough to hold them: none gets out, no overlap is ever deeper than
 //! the envelope, none goes below the floor, the pile loses nearly all the
 //! kinetic energy of the fall, and in the fourth second the heap does not
-//! shake in place. It does not come fully to rest: resting spheres end each
-//! step with up to the velocity g·h of the step's gravity, and the heap
-//! still settles by about a millimetre a second (a known gap: `cargo run
-//! --release -p animats-bench --example pile_rest -- --rows 8` shows it
-//! second by second; an ordered pyramid does rest, see
+//! shake in place. Awake, it does not come fully to rest: resting spheres
+//! end each step with up to the velocity g·h of the step's gravity, and the
+//! heap still creeps by about a millimetre a second (`cargo run --release
+//! -p animats-bench --example pile_rest -- --rows 8` shows it second by
+//! second; an ordered pyramid does rest, see
 //! `crates/engine/tests/sphere_contact.rs` and docs/DESIGN.md
-//! "Sphere–sphere contact").
+//! "Sphere–sphere contact"). With sleeping on (`sleep_speed` twice g·h),
+//! the same heap falls asleep and then does not move by a bit.
 
-use animats_bench::pile::{outside_ring, pile_walled};
+use animats_bench::pile::{outside_ring, pile_walled, pile_walled_with};
 use animats_engine::{SphereContact, SphereContactDef};
 
 #[test]
@@ -86,4 +87,45 @@ fn a_thousand_spheres_poured_into_a_ring_lose_their_energy_without_deep_overlaps
         late < 20.0 * 9.81 * h * h,
         "overlap {late} m left at a step's end"
     );
+}
+
+#[test]
+fn a_thousand_spheres_that_may_sleep_come_to_rest_and_stay() {
+    let (r, h) = (0.02, 1e-3);
+    // Twice a step's gravity g h: above what a resting sphere trembles by
+    // (with half of g h the heap never sleeps: docs/DESIGN.md "Sleeping").
+    let def = SphereContactDef {
+        sleep_speed: 2.0 * 9.8 * h,
+        ..SphereContactDef::default()
+    };
+    let mut w = pile_walled_with(1000, r, 10, 8, def);
+    let mut probe = SphereContact::new(SphereContactDef::default()).unwrap();
+    let mut deepest = 0.0f64;
+    for _ in 0..6000 {
+        w.step(h).unwrap();
+        deepest = deepest.max(probe.deepest_overlap(&w.state().pos, w.particles()));
+    }
+    let asleep = w.event::<SphereContact>().unwrap().sleeping();
+    let settled = w.state().clone();
+    for _ in 0..1000 {
+        w.step(h).unwrap();
+    }
+    let moved = w
+        .state()
+        .pos
+        .iter()
+        .zip(&settled.pos)
+        .filter(|(x, y)| x != y)
+        .count();
+    let late = probe.deepest_overlap(&w.state().pos, w.particles());
+    println!(
+        "asleep at 6 s: {asleep}; moved in the 7th second: {moved}; kinetic energy {:e} J; deepest overlap {deepest:e} m, {late:e} m at 7 s; outside {}",
+        w.energy().kinetic,
+        outside_ring(&w)
+    );
+    assert_eq!(moved, 0, "spheres moved after the heap fell asleep");
+    assert_eq!(w.energy().kinetic, 0.0);
+    assert_eq!(outside_ring(&w), 0);
+    assert!(deepest <= SphereContactDef::default().envelope);
+    assert!(late < 20.0 * 9.81 * h * h, "overlap {late} m left at rest");
 }

@@ -180,6 +180,17 @@ pub fn run(args: Args) -> Result<(), Failure> {
         }
     }
     println!("backtracks: {}", stats.backtracks);
+    if let Some(c) = world.event::<animats_engine::SphereContact>() {
+        let asleep = if c.def().sleep_speed > 0.0 {
+            format!(", {} spheres asleep", c.sleeping())
+        } else {
+            String::new()
+        };
+        println!(
+            "sphere contacts at the end: {} pairs touching{asleep}",
+            c.touching()
+        );
+    }
     println!(
         "wall time: {wall:.4} s ({:.1} simulated s per wall s)",
         world.time() / wall.max(1e-9)

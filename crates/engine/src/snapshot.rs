@@ -9,7 +9,10 @@
 //! is restored into the world it came from, or into one built the same way
 //! (from the same scene file), and a restored world continues bit for bit as
 //! the original did. Fluid currents and user forces and events keep their
-//! own state. Formats must round-trip `f64` exactly (serde_json with
+//! own state. One exception: sphere contact's sleep (`sleep_speed`) is not
+//! held, and every sphere is awake after a restore, so a world in which
+//! some slept continues as the original would have with them all woken,
+//! not bit for bit. Formats must round-trip `f64` exactly (serde_json with
 //! `float_roundtrip`, bincode, ...).
 
 use crate::error::ModelError;

@@ -291,6 +291,17 @@ pub struct ContactsEntry {
     /// m/s: approaches slower than this do not bounce; default 0.05.
     #[serde(default = "default_rest_speed")]
     pub rest_speed: f64,
+    /// m/s: a sphere in contact that moves slower than this for
+    /// `sleep_time` falls asleep; default 0 (never).
+    #[serde(default)]
+    pub sleep_speed: f64,
+    /// s: default 0.5.
+    #[serde(default = "default_sleep_time")]
+    pub sleep_time: f64,
+}
+
+fn default_sleep_time() -> f64 {
+    0.5
 }
 
 /// `[fluid]`: drag and buoyancy.

@@ -1,6 +1,7 @@
 //! `[contacts]`: spheres collide with each other (the two free ones here);
-//! the pair joined by a spring does not; a bad restitution is refused with
-//! the field named; and an implicit world takes `implicit_tolerance`.
+//! the pair joined by a spring does not; a bad restitution or sleep setting
+//! is refused with the field named; and an implicit world takes
+//! `implicit_tolerance`.
 
 use animats_engine::{IntegratorKind, SphereContact};
 
@@ -73,6 +74,12 @@ fn a_restitution_above_one_is_refused_naming_the_field() {
         e.contains("bad.toml") && e.contains("restitution") && e.contains("[0, 1]"),
         "{e}"
     );
+    let bad = SCENE.replace("restitution = 1.0", "sleep_speed = -0.02");
+    let e = error(&bad);
+    assert!(e.contains("bad.toml") && e.contains("sleep_speed"), "{e}");
+    let bad = SCENE.replace("restitution = 1.0", "sleep_speed = 0.02\nsleep_time = nan");
+    let e = error(&bad);
+    assert!(e.contains("bad.toml") && e.contains("sleep_time"), "{e}");
     let bad = SCENE.replace("implicit_tolerance = 1e-6", "implicit_tolerance = 2.0");
     let e = error(&bad);
     assert!(e.contains("implicit_tolerance"), "{e}");

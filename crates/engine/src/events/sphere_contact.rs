@@ -48,6 +48,21 @@
 //! counting sort; when they are spread far apart, a hash map of the
 //! occupied cells. Pairs given as excluded (the scene excludes the pairs
 //! joined by a spring or a joint) never collide.
+//!
+//! Sleeping (opt-in, `sleep_speed` > 0; Box2D's and Rapier's remedy for a
+//! heap that an iterative solve leaves creeping): a sphere in contact that
+//! has stayed within `sleep_speed · sleep_time` of one place for
+//! `sleep_time` sleeps, held where it fell asleep at rest and immovable to
+//! its contacts, until something disturbs it: a strike (an approach at
+//! `rest_speed` or faster, which wakes it within the handling, so a blow
+//! passes on as through awake spheres), a neighbour moving faster than
+//! `sleep_speed`, a change of the forces on it (its trial's acceleration
+//! from rest differs from its first one asleep), a hand (its position or
+//! velocity set from outside), or the loss of every contact. Stillness is
+//! judged over `sleep_time`, not step by step, because a resting sphere
+//! trembles by a step's sag under gravity. Per sphere, not per island:
+//! a heap's solve keeps a few spheres moving for seconds, which would keep
+//! a whole island awake.
 
 use crate::error::ModelError;
 use crate::event::{DiscreteEvent, EventContext, EventState};
@@ -71,6 +86,13 @@ pub struct SphereContactDef {
     pub targets: Targets,
     /// Pairs that never collide.
     pub excluded: Vec<(ParticleId, ParticleId)>,
+    /// Sleeping, m/s: a sphere in contact that stays within `sleep_speed ·
+    /// sleep_time` of one place for `sleep_time` falls asleep (see
+    /// [`SphereContact`]); 0 (the default): none ever does.
+    pub sleep_speed: f64,
+    /// How long a sphere must stay that still to fall asleep, s (default
+    /// 0.5, Box2D's).
+    pub sleep_time: f64,
 }
 
 impl Default for SphereContactDef {
@@ -81,6 +103,8 @@ impl Default for SphereContactDef {
             restitution: None,
             targets: Targets::All,
             excluded: Vec::new(),
+            sleep_speed: 0.0,
+            sleep_time: 0.5,
         }
     }
 }
@@ -173,6 +197,51 @@ pub struct SphereContact {
     overlapping: usize,
     /// Every colliding sphere with the box of its path in the trial.
     moving: Vec<(u32, DVec3, DVec3)>,
+    /// Which spheres sleep (empty unless `sleep_speed` > 0).
+    sleep: Sleep,
+}
+
+/// The spheres' sleep: see [`SphereContact`].
+#[derive(Clone, Debug, Default)]
+struct Sleep {
+    /// Each sphere's position at the start of the last step.
+    last: Vec<DVec3>,
+    /// When the last step started, s (NaN before the first).
+    t_last: f64,
+    /// Where each sphere's stillness began.
+    origin: Vec<DVec3>,
+    /// How long it has stayed within `sleep_speed · sleep_time` of there, s.
+    still: Vec<f64>,
+    /// Whether it is moving: faster than `sleep_speed` in the last step,
+    /// and not for long within one place (a sphere that merely trembles
+    /// there is not).
+    moving: Vec<bool>,
+    /// Whether it sleeps.
+    asleep: Vec<bool>,
+    /// Where it fell asleep, and where it stays while asleep.
+    anchor: Vec<DVec3>,
+    /// The acceleration its forces gave it in its first trial asleep (NaN
+    /// until then): a different one means the forces on it changed.
+    pull: Vec<DVec3>,
+    /// Whether it is in a contact (scratch, for each check).
+    touched: Vec<bool>,
+    /// Whether something disturbs it (scratch, for each check).
+    wake: Vec<bool>,
+    /// How many sleep.
+    count: usize,
+    /// The next check is a step's first.
+    fresh: bool,
+}
+
+impl Sleep {
+    fn wake(&mut self, i: usize) {
+        if self.asleep[i] {
+            self.asleep[i] = false;
+            self.still[i] = 0.0;
+            self.origin[i] = self.anchor[i];
+            self.count -= 1;
+        }
+    }
 }
 
 /// 21 bits per coordinate, offset so that cells from −2²⁰ to 2²⁰ pack.
@@ -251,6 +320,8 @@ impl SphereContact {
             ));
         }
         non_negative("rest_speed", def.rest_speed)?;
+        non_negative("sleep_speed", def.sleep_speed)?;
+        non_negative("sleep_time", def.sleep_time)?;
         if let Some(e) = def.restitution {
             non_negative("restitution", e)?;
             if e > 1.0 {
@@ -283,6 +354,7 @@ impl SphereContact {
             moving: Vec::new(),
             h: 0.0,
             overlapping: 0,
+            sleep: Sleep::default(),
         })
     }
 
@@ -312,6 +384,135 @@ impl SphereContact {
     /// How many pairs overlapped at the last check (resting contacts too).
     pub fn touching(&self) -> usize {
         self.overlapping
+    }
+
+    /// How many spheres sleep.
+    pub fn sleeping(&self) -> usize {
+        self.sleep.count
+    }
+
+    /// Whether sphere `i` sleeps.
+    pub fn is_asleep(&self, i: ParticleId) -> bool {
+        self.sleep
+            .asleep
+            .get(i.0 as usize)
+            .copied()
+            .unwrap_or(false)
+    }
+
+    /// Sleeping and waking, sphere by sphere: at a step's first check,
+    /// times each sphere's stillness over the step before and puts to
+    /// sleep each sphere in contact that has been still for `sleep_time`;
+    /// at every check, wakes each sleeper that something disturbs: a
+    /// moving neighbour, a change of the forces on it, a hand (its position
+    /// or velocity set from outside), or the loss of every contact.
+    fn sleep_or_wake(&mut self, ctx: &EventContext) {
+        let (speed, time, p) = (self.def.sleep_speed, self.def.sleep_time, ctx.particles);
+        let (x0, v0) = (ctx.start_pos, ctx.start_vel);
+        let n = x0.len().min(ctx.pos.len());
+        let s = &mut self.sleep;
+        // New spheres, or the clock set back (a snapshot restored): every
+        // sphere starts awake.
+        if s.last.len() != n || (s.fresh && ctx.t - ctx.h < s.t_last) {
+            *s = Sleep {
+                last: x0[..n].to_vec(),
+                t_last: f64::NAN,
+                origin: x0[..n].to_vec(),
+                still: vec![0.0; n],
+                moving: vec![false; n],
+                asleep: vec![false; n],
+                anchor: vec![DVec3::ZERO; n],
+                pull: vec![DVec3::NAN; n],
+                touched: vec![false; n],
+                wake: vec![false; n],
+                count: 0,
+                fresh: true,
+            };
+        }
+        let movable = |i: usize| p.inv_mass[i] != 0.0 && p.radius[i] > 0.0;
+        s.touched.iter_mut().for_each(|t| *t = false);
+        for q in &self.pairs {
+            s.touched[q.a as usize] = true;
+            s.touched[q.b as usize] = true;
+        }
+        // `wake`: the sleepers disturbed.
+        s.wake.iter_mut().for_each(|w| *w = false);
+        if std::mem::take(&mut s.fresh) {
+            let dt = if s.t_last.is_nan() {
+                0.0
+            } else {
+                ctx.t - ctx.h - s.t_last
+            };
+            s.t_last = ctx.t - ctx.h;
+            // Stillness is judged over `sleep_time`, not step by step: a
+            // resting sphere trembles by about a step's sag under gravity
+            // (g h², as far as `sleep_speed` goes in a step at the
+            // defaults), but goes nowhere.
+            let reach = speed * time;
+            self.def.targets.for_each(n, |i| {
+                if !movable(i) {
+                    return;
+                }
+                if s.asleep[i] {
+                    // Moved by hand?
+                    s.wake[i] = x0[i] != s.anchor[i] || v0[i] != DVec3::ZERO;
+                } else {
+                    if (x0[i] - s.origin[i]).length() <= reach {
+                        s.still[i] += dt;
+                    } else {
+                        s.still[i] = 0.0;
+                        s.origin[i] = x0[i];
+                    }
+                    s.moving[i] =
+                        (x0[i] - s.last[i]).length() > speed * dt && s.still[i] < 0.5 * time;
+                    if s.still[i] >= time && s.touched[i] {
+                        s.asleep[i] = true;
+                        s.anchor[i] = x0[i];
+                        s.pull[i] = DVec3::NAN;
+                        s.count += 1;
+                    }
+                }
+                s.last[i] = x0[i];
+            });
+        }
+        if s.count == 0 {
+            return;
+        }
+        // A moving neighbour disturbs a sleeper (one that strikes it wakes
+        // it in the handling).
+        for q in &self.pairs {
+            let (a, b) = (q.a as usize, q.b as usize);
+            if s.asleep[a] != s.asleep[b] {
+                let (sleeper, other) = if s.asleep[a] { (a, b) } else { (b, a) };
+                s.wake[sleeper] |= s.moving[other] && movable(other);
+            }
+        }
+        let sleepers = (s.asleep.iter().zip(&s.touched))
+            .zip(s.pull.iter_mut().zip(s.wake.iter_mut()))
+            .zip(ctx.vel.iter().zip(v0));
+        for (((&asleep, &touched), (first, wake)), (v1, v0)) in sleepers {
+            if !asleep {
+                continue;
+            }
+            // Its forces over a trial from rest: the same while nothing
+            // around it changes. (The first is taken from rest, not from
+            // the step it fell asleep in.)
+            let pull = (*v1 - *v0) / ctx.h;
+            if !touched {
+                *wake = true;
+            } else if first.is_nan() {
+                if *v0 == DVec3::ZERO {
+                    *first = pull;
+                }
+            } else if (pull - *first).length() > 1e-9 * first.length() {
+                *wake = true;
+            }
+        }
+        for i in 0..n {
+            if s.wake[i] {
+                s.wake(i);
+            }
+        }
     }
 
     /// The impacts of the last step (approaches at `rest_speed` or faster;
@@ -587,6 +788,9 @@ impl DiscreteEvent for SphereContact {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.h = ctx.step;
         let mut deepest = self.find(ctx.pos, ctx.particles);
+        if self.def.sleep_speed > 0.0 {
+            self.sleep_or_wake(ctx);
+        }
         if deepest <= self.def.envelope {
             deepest = deepest.max(self.swept(ctx));
         }
@@ -600,12 +804,21 @@ impl DiscreteEvent for SphereContact {
     }
 
     fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        let (h, margin) = (self.h, self.margin());
+        let floor = &self.floor;
         let held = |i: usize| {
-            self.floor
+            floor
                 .as_ref()
                 .is_some_and(|f| f.get(i).copied().unwrap_or(false))
         };
-        let (h, margin) = (self.h, self.margin());
+        // Sleepers stay where they fell asleep, at rest.
+        let sleep = &mut self.sleep;
+        if sleep.count > 0 {
+            for (i, _) in sleep.asleep.iter().enumerate().filter(|(_, &z)| z) {
+                pos[i] = sleep.anchor[i];
+                vel[i] = DVec3::ZERO;
+            }
+        }
         for pass in 0..PASSES {
             let mut largest = 0.0f64;
             for q in &self.pairs {
@@ -621,16 +834,32 @@ impl DiscreteEvent for SphereContact {
                 // A sphere resting on the floor, pushed down into it, is
                 // held by the floor: immovable for this contact.
                 let on_floor = |i: usize| held(i) && pos[i].y <= p.radius[i] + FLOOR_TOLERANCE;
-                let wa = if n.y > 0.0 && on_floor(a) {
+                let mut wa = if n.y > 0.0 && on_floor(a) {
                     0.0
                 } else {
                     p.inv_mass[a]
                 };
-                let wb = if n.y < 0.0 && on_floor(b) {
+                let mut wb = if n.y < 0.0 && on_floor(b) {
                     0.0
                 } else {
                     p.inv_mass[b]
                 };
+                if sleep.count > 0 && (sleep.asleep[a] || sleep.asleep[b]) {
+                    // A sleeper is immovable, unless struck: then it wakes
+                    // and takes its part from this contact on (so a blow
+                    // passes through a sleeping heap as through an awake
+                    // one, waking only what it reaches).
+                    let struck = -(vel[b] - vel[a]).dot(n) >= self.def.rest_speed;
+                    for (i, wi) in [(a, &mut wa), (b, &mut wb)] {
+                        if sleep.asleep[i] {
+                            if struck {
+                                sleep.wake(i);
+                            } else {
+                                *wi = 0.0;
+                            }
+                        }
+                    }
+                }
                 let w = wa + wb;
                 if w == 0.0 {
                     continue;
@@ -699,6 +928,7 @@ impl DiscreteEvent for SphereContact {
 
     fn begin_step(&mut self) {
         self.impacts.clear();
+        self.sleep.fresh = true;
     }
 
     fn is_passive(&self) -> bool {

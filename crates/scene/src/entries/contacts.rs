@@ -14,6 +14,8 @@ impl Build for ContactsEntry {
                 restitution: self.restitution,
                 targets,
                 excluded: Vec::new(),
+                sleep_speed: self.sleep_speed,
+                sleep_time: self.sleep_time,
             })
             .map_err(|e| at.model(e))?;
         Ok(())

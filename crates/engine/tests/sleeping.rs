@@ -1,0 +1,217 @@
+//! Sleeping spheres (`SphereContactDef::sleep_speed`), against what an
+//! awake world does:
+//!
+//! - a resting column falls asleep once still for `sleep_time`, where it
+//!   rests awake, and then does not move by a bit;
+//! - a blow passes through a row of sleeping spheres as through awake ones
+//!   (Newton's cradle on the floor: the same velocities after it);
+//! - a sleeper whose support is taken away by hand falls freely;
+//! - a change of the forces (gravity turned round) wakes sleepers;
+//! - a snapshot restored wakes them, and they sleep again as before;
+//! - bad settings are refused, naming the field.
+//!
+//! The heap of a thousand is in `crates/bench/tests/pile.rs`.
+
+use animats_engine::{
+    FloorDef, IntegratorKind, ParticleDef, ParticleId, SphereContact, SphereContactDef, World,
+};
+use glam::DVec3;
+
+const R: f64 = 0.02;
+const H: f64 = 1e-3;
+const G: f64 = 9.8;
+/// Twice a step's gravity g h: above what a resting sphere trembles by.
+const SLEEP: f64 = 0.02;
+
+fn contact(sleep_speed: f64) -> SphereContactDef {
+    SphereContactDef {
+        sleep_speed,
+        ..SphereContactDef::default()
+    }
+}
+
+/// `n` spheres stacked on the floor, each resting on the one below.
+fn column(n: usize, sleep_speed: f64) -> (World, Vec<ParticleId>) {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -G, 0.0));
+    let ids = (0..n)
+        .map(|k| {
+            let x = DVec3::new(0.0, R + 2.0 * R * k as f64, 0.0);
+            w.add_particle(
+                ParticleDef::new(0.05)
+                    .with_radius(R)
+                    .at(x)
+                    .with_restitution(0.3),
+            )
+            .unwrap()
+        })
+        .collect();
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(contact(sleep_speed)).unwrap();
+    (w, ids)
+}
+
+fn sleeping(w: &World) -> usize {
+    w.event::<SphereContact>().unwrap().sleeping()
+}
+
+fn run(w: &mut World, steps: usize) {
+    for _ in 0..steps {
+        w.step(H).unwrap();
+    }
+}
+
+#[test]
+fn a_resting_column_falls_asleep_where_it_rests_and_stays_to_the_bit() {
+    let (mut w, _) = column(3, SLEEP);
+    let (mut awake, _) = column(3, 0.0);
+    let mut fell_asleep = None;
+    for step in 1..=1000 {
+        w.step(H).unwrap();
+        awake.step(H).unwrap();
+        if fell_asleep.is_none() && sleeping(&w) == 3 {
+            fell_asleep = Some(step);
+        }
+    }
+    let fell_asleep = fell_asleep.expect("the column fell asleep within a second");
+    println!("asleep after {fell_asleep} steps");
+    // Still from the first step on, so asleep as soon as `sleep_time` is up.
+    let time = SphereContactDef::default().sleep_time;
+    assert!(fell_asleep as f64 * H >= time && fell_asleep as f64 * H <= time + 2.0 * H);
+    assert_eq!(w.energy().kinetic, 0.0);
+    // Where the awake column rests (which rests to the bit as well).
+    for (x, y) in w.state().pos.iter().zip(&awake.state().pos) {
+        assert!((*x - *y).length() < 1e-6, "asleep at {x}, awake at {y}");
+    }
+    let before = w.state().clone();
+    run(&mut w, 1000);
+    assert_eq!(w.state().pos, before.pos);
+    assert_eq!(w.state().vel, before.vel);
+    assert_eq!(sleeping(&w), 3);
+}
+
+/// Four spheres in a row on a frictionless floor, touching, and a fifth
+/// sent into them at 1 m/s after `wait` steps (restitution 1).
+fn cradle(sleep_speed: f64, wait: usize) -> (World, Vec<ParticleId>) {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -G, 0.0));
+    let ids: Vec<ParticleId> = (0..5)
+        .map(|k| {
+            let x = if k == 0 {
+                DVec3::new(-0.3, R, 0.0)
+            } else {
+                DVec3::new(2.0 * R * k as f64, R, 0.0)
+            };
+            w.add_particle(
+                ParticleDef::new(0.05)
+                    .with_radius(R)
+                    .at(x)
+                    .with_restitution(1.0)
+                    .with_friction(0.0, 0.0),
+            )
+            .unwrap()
+        })
+        .collect();
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(contact(sleep_speed)).unwrap();
+    run(&mut w, wait);
+    w.set_velocity(ids[0], DVec3::X).unwrap();
+    (w, ids)
+}
+
+#[test]
+fn a_blow_passes_through_sleeping_spheres_as_through_awake_ones() {
+    let (mut w, ids) = cradle(SLEEP, 1000);
+    let (mut awake, _) = cradle(0.0, 1000);
+    assert_eq!(sleeping(&w), 4, "the row sleeps before the blow");
+    run(&mut w, 500);
+    run(&mut awake, 500);
+    for (k, &b) in ids.iter().enumerate() {
+        let (v, u) = (w.velocity(b), awake.velocity(b));
+        println!("ball {k}: {v} asleep before, {u} awake");
+        assert!((v - u).length() < 1e-9, "ball {k}: {v} against {u}");
+    }
+    // And it is the cradle's answer: the last ball leaves with the blow.
+    assert!((w.velocity(ids[4]) - DVec3::X).length() < 1e-6);
+    assert!(!w.event::<SphereContact>().unwrap().is_asleep(ids[4]));
+}
+
+#[test]
+fn a_sleeper_whose_support_is_taken_away_falls_freely() {
+    let (mut w, ids) = column(2, SLEEP);
+    run(&mut w, 1000);
+    assert_eq!(sleeping(&w), 2);
+    let top = w.position(ids[1]);
+    w.set_position(ids[0], DVec3::new(1.0, R, 0.0)).unwrap();
+    let n = 50;
+    run(&mut w, n);
+    // Symplectic Euler from rest: y falls by g h² n (n + 1) / 2.
+    let fallen = G * H * H * (n * (n + 1)) as f64 / 2.0;
+    let y = w.position(ids[1]).y;
+    assert!(
+        (top.y - y - fallen).abs() < 1e-12,
+        "fell {} m, free fall {fallen} m",
+        top.y - y
+    );
+    assert_eq!(sleeping(&w), 0);
+}
+
+#[test]
+fn gravity_turned_round_wakes_sleepers() {
+    let (mut w, ids) = column(2, SLEEP);
+    run(&mut w, 1000);
+    assert_eq!(sleeping(&w), 2);
+    let start: Vec<DVec3> = ids.iter().map(|&i| w.position(i)).collect();
+    w.set_gravity(DVec3::new(0.0, G, 0.0));
+    let n = 100;
+    run(&mut w, n);
+    let risen = G * H * H * (n * (n + 1)) as f64 / 2.0;
+    for (k, &i) in ids.iter().enumerate() {
+        let up = w.position(i).y - start[k].y;
+        assert!(
+            (up - risen).abs() < 1e-9,
+            "sphere {k} rose {up} m, not {risen} m"
+        );
+    }
+}
+
+#[test]
+fn a_restored_snapshot_wakes_sleepers_and_they_sleep_again() {
+    let (mut w, _) = column(2, SLEEP);
+    run(&mut w, 100);
+    let early = w.snapshot();
+    run(&mut w, 900);
+    assert_eq!(sleeping(&w), 2);
+    let asleep_at = w.state().pos.clone();
+    w.restore(&early).unwrap();
+    w.step(H).unwrap();
+    assert_eq!(sleeping(&w), 0, "asleep across a restore");
+    // Still since the start, so asleep again `sleep_time` after the restore.
+    run(&mut w, 600);
+    assert_eq!(sleeping(&w), 2);
+    for (x, y) in w.state().pos.iter().zip(&asleep_at) {
+        assert!((*x - *y).length() < 1e-6, "asleep at {x}, before at {y}");
+    }
+}
+
+#[test]
+fn bad_sleep_settings_are_refused_naming_the_field() {
+    for (speed, time, field) in [
+        (-1.0, 0.5, "sleep_speed"),
+        (f64::NAN, 0.5, "sleep_speed"),
+        (0.02, -0.1, "sleep_time"),
+        (0.02, f64::INFINITY, "sleep_time"),
+    ] {
+        let def = SphereContactDef {
+            sleep_speed: speed,
+            sleep_time: time,
+            ..SphereContactDef::default()
+        };
+        match SphereContact::new(def) {
+            Ok(_) => panic!("accepted sleep_speed {speed}, sleep_time {time}"),
+            Err(e) => assert!(e.to_string().contains(field), "{e}"),
+        }
+    }
+}
