@@ -6,6 +6,8 @@
 //! - a blow passes through a row of sleeping spheres as through awake ones
 //!   (Newton's cradle on the floor: the same velocities after it);
 //! - a sleeper whose support is taken away by hand falls freely;
+//! - a sleeper pushed slowly by a driven neighbour moves with it, as if
+//!   awake (not as a nailed wall);
 //! - a change of the forces (gravity turned round) wakes sleepers;
 //! - a snapshot restored wakes them, and they sleep again as before;
 //! - bad settings are refused, naming the field.
@@ -156,6 +158,61 @@ fn a_sleeper_whose_support_is_taken_away_falls_freely() {
         top.y - y
     );
     assert_eq!(sleeping(&w), 0);
+}
+
+/// Two spheres touching side by side on a frictionless floor, and a
+/// sideways force on the first (0 until `wait` steps, then growing by
+/// 0.012 N/s: slow enough that the pair stays under the sleep speed for
+/// half a second).
+fn pushed(sleep_speed: f64, wait: usize, steps: usize) -> (World, Vec<ParticleId>) {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -G, 0.0));
+    let ids: Vec<ParticleId> = (0..2)
+        .map(|k| {
+            w.add_particle(
+                ParticleDef::new(0.05)
+                    .with_radius(R)
+                    .at(DVec3::new(2.0 * R * k as f64, R, 0.0))
+                    .with_friction(0.0, 0.0),
+            )
+            .unwrap()
+        })
+        .collect();
+    let push = w.add_constant_force(vec![ids[0]], DVec3::ZERO).unwrap();
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(contact(sleep_speed)).unwrap();
+    run(&mut w, wait);
+    for k in 1..=steps {
+        let f = DVec3::new(0.012 * k as f64 * H, 0.0, 0.0);
+        w.forces_mut().constant_forces.set(push, f);
+        w.step(H).unwrap();
+    }
+    (w, ids)
+}
+
+#[test]
+fn a_sleeper_pushed_slowly_moves_as_if_awake() {
+    let (w0, _) = pushed(SLEEP, 1000, 0);
+    assert_eq!(sleeping(&w0), 2, "the pair sleeps before the push");
+    let (w, ids) = pushed(SLEEP, 1000, 500);
+    let (awake, _) = pushed(0.0, 1000, 500);
+    let start = w0.position(ids[1]).x;
+    let (moved, expected) = (
+        w.position(ids[1]).x - start,
+        awake.position(ids[1]).x - start,
+    );
+    // Both pushed together from rest: x = k t³ / (6 · 2m), 2.5 mm.
+    println!("pushed sphere moved {moved} m asleep before, {expected} m awake");
+    assert!(
+        (expected - 2.5e-3).abs() < 0.05 * 2.5e-3,
+        "awake: {expected} m"
+    );
+    assert!(
+        (moved - expected).abs() < 0.01 * expected,
+        "moved {moved} m, awake {expected} m"
+    );
+    assert!(w.velocity(ids[1]).x < SLEEP, "faster than the sleep speed");
 }
 
 #[test]

@@ -56,9 +56,11 @@
 //! its contacts, until something disturbs it: a strike (an approach at
 //! `rest_speed` or faster, which wakes it within the handling, so a blow
 //! passes on as through awake spheres), a neighbour moving faster than
-//! `sleep_speed`, a change of the forces on it (its trial's acceleration
-//! from rest differs from its first one asleep), a hand (its position or
-//! velocity set from outside), or the loss of every contact. Stillness is
+//! `sleep_speed` or driven (the forces on it changing from step to step,
+//! so that it pushes however slowly it goes), a change of the forces on it
+//! (its trial's acceleration from rest differs from its first one asleep),
+//! a hand (its position or velocity set from outside), or the loss of
+//! every contact. A driven sphere never falls asleep. Stillness is
 //! judged over `sleep_time`, not step by step, because a resting sphere
 //! trembles by a step's sag under gravity. Per sphere, not per island:
 //! a heap's solve keeps a few spheres moving for seconds, which would keep
@@ -216,6 +218,13 @@ struct Sleep {
     /// and not for long within one place (a sphere that merely trembles
     /// there is not).
     moving: Vec<bool>,
+    /// The acceleration its forces gave it in the last step's trial (NaN
+    /// before the first).
+    accel: Vec<DVec3>,
+    /// Whether that changed since the step before: something drives it
+    /// (a muscle, a hand on a force), and it wakes the sleepers it
+    /// touches, however slowly it moves.
+    driven: Vec<bool>,
     /// Whether it sleeps.
     asleep: Vec<bool>,
     /// Where it fell asleep, and where it stays while asleep.
@@ -420,6 +429,8 @@ impl SphereContact {
                 origin: x0[..n].to_vec(),
                 still: vec![0.0; n],
                 moving: vec![false; n],
+                accel: vec![DVec3::NAN; n],
+                driven: vec![false; n],
                 asleep: vec![false; n],
                 anchor: vec![DVec3::ZERO; n],
                 pull: vec![DVec3::NAN; n],
@@ -430,6 +441,9 @@ impl SphereContact {
             };
         }
         let movable = |i: usize| p.inv_mass[i] != 0.0 && p.radius[i] > 0.0;
+        // Steady forces give the same acceleration to the bit, step after
+        // step; the margin only forgives rounding.
+        let changed = |a: DVec3, b: DVec3| (a - b).length() > 1e-9 * b.length();
         s.touched.iter_mut().for_each(|t| *t = false);
         for q in &self.pairs {
             s.touched[q.a as usize] = true;
@@ -457,7 +471,13 @@ impl SphereContact {
                     // Moved by hand?
                     s.wake[i] = x0[i] != s.anchor[i] || v0[i] != DVec3::ZERO;
                 } else {
-                    if (x0[i] - s.origin[i]).length() <= reach {
+                    let a = (ctx.vel[i] - v0[i]) / ctx.h;
+                    let before = std::mem::replace(&mut s.accel[i], a);
+                    s.driven[i] = !before.is_nan() && changed(a, before);
+                    if s.driven[i] {
+                        s.still[i] = 0.0;
+                        s.origin[i] = x0[i];
+                    } else if (x0[i] - s.origin[i]).length() <= reach {
                         s.still[i] += dt;
                     } else {
                         s.still[i] = 0.0;
@@ -478,13 +498,13 @@ impl SphereContact {
         if s.count == 0 {
             return;
         }
-        // A moving neighbour disturbs a sleeper (one that strikes it wakes
-        // it in the handling).
+        // A moving or driven neighbour disturbs a sleeper (one that strikes
+        // it wakes it in the handling).
         for q in &self.pairs {
             let (a, b) = (q.a as usize, q.b as usize);
             if s.asleep[a] != s.asleep[b] {
                 let (sleeper, other) = if s.asleep[a] { (a, b) } else { (b, a) };
-                s.wake[sleeper] |= s.moving[other] && movable(other);
+                s.wake[sleeper] |= (s.moving[other] || s.driven[other]) && movable(other);
             }
         }
         let sleepers = (s.asleep.iter().zip(&s.touched))
@@ -504,7 +524,7 @@ impl SphereContact {
                 if *v0 == DVec3::ZERO {
                     *first = pull;
                 }
-            } else if (pull - *first).length() > 1e-9 * first.length() {
+            } else if changed(pull, *first) {
                 *wake = true;
             }
         }
