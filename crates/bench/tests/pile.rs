@@ -129,3 +129,59 @@ fn a_thousand_spheres_that_may_sleep_come_to_rest_and_stay() {
     assert!(deepest <= SphereContactDef::default().envelope);
     assert!(late < 20.0 * 9.81 * h * h, "overlap {late} m left at rest");
 }
+
+#[test]
+fn extreme_sleep_settings_neither_backtrack_forever_nor_overlap_deeply() {
+    // `sleep_time = 0` (asleep as soon as still for a step), and a sleep
+    // speed nothing exceeds: spheres must not fall asleep in mid-air, and
+    // holding one back where it was must not leave overlaps that the next
+    // check calls missed, step after step.
+    let (r, h) = (0.02, 1e-3);
+    let mut awake = pile_walled(200, r, 5, 8);
+    for _ in 0..2000 {
+        awake.step(h).unwrap();
+    }
+    let heap = {
+        let p = &awake.state().pos;
+        let free: Vec<usize> = (0..awake.len())
+            .filter(|&i| awake.particles().inv_mass[i] > 0.0)
+            .collect();
+        free.iter().map(|&i| p[i].y).sum::<f64>() / free.len() as f64
+    };
+    // (sleep speed, sleep time, whether the heap must be the awake one's):
+    // at 1e300 m/s every touching sphere calm in its trial sleeps after
+    // half a second, moving or not, so the heap freezes as it lands.
+    for (speed, time, like_awake) in [(0.02, 0.0, true), (1e300, 0.5, false)] {
+        let def = SphereContactDef {
+            sleep_speed: speed,
+            sleep_time: time,
+            ..SphereContactDef::default()
+        };
+        let mut w = pile_walled_with(200, r, 5, 8, def);
+        let free: Vec<usize> = (0..w.len())
+            .filter(|&i| w.particles().inv_mass[i] > 0.0)
+            .collect();
+        let mean_y = |w: &animats_engine::World| {
+            free.iter().map(|&i| w.state().pos[i].y).sum::<f64>() / free.len() as f64
+        };
+        let start = mean_y(&w);
+        let mut probe = SphereContact::new(SphereContactDef::default()).unwrap();
+        let mut deepest = 0.0f64;
+        for _ in 0..2000 {
+            w.step(h).unwrap();
+            deepest = deepest.max(probe.deepest_overlap(&w.state().pos, w.particles()));
+        }
+        let backtracks = w.stats().backtracks;
+        let asleep = w.event::<SphereContact>().unwrap().sleeping();
+        let end = mean_y(&w);
+        println!("sleep_speed {speed:e}, sleep_time {time}: {backtracks} backtracks in 2,000 steps, deepest overlap {deepest:e} m, {asleep} asleep, mean height {start} -> {end} m");
+        // Fallen into a heap like the one awake, not held in the air.
+        assert!(
+            !like_awake || (end - heap).abs() < 0.1 * heap,
+            "mean height {end} m, awake {heap} m"
+        );
+        assert!(backtracks < 200, "{backtracks} backtracks");
+        assert!(deepest <= SphereContactDef::default().envelope);
+        assert_eq!(outside_ring(&w), 0);
+    }
+}

@@ -417,6 +417,7 @@ impl SphereContact {
     /// or velocity set from outside), or the loss of every contact.
     fn sleep_or_wake(&mut self, ctx: &EventContext) {
         let (speed, time, p) = (self.def.sleep_speed, self.def.sleep_time, ctx.particles);
+        let envelope = self.def.envelope;
         let (x0, v0) = (ctx.start_pos, ctx.start_vel);
         let n = x0.len().min(ctx.pos.len());
         let s = &mut self.sleep;
@@ -485,7 +486,13 @@ impl SphereContact {
                     }
                     s.moving[i] =
                         (x0[i] - s.last[i]).length() > speed * dt && s.still[i] < 0.5 * time;
-                    if s.still[i] >= time && s.touched[i] {
+                    // Still for a step at least (so not at once when
+                    // `sleep_time` is 0), and not so fast in the trial
+                    // that holding it back where it was could leave an
+                    // overlap deeper than the envelope (a backtrack at
+                    // every step).
+                    let calm = (ctx.pos[i] - x0[i]).length() <= 0.25 * envelope;
+                    if s.still[i] >= time && s.still[i] > 0.0 && calm && s.touched[i] {
                         s.asleep[i] = true;
                         s.anchor[i] = x0[i];
                         s.pull[i] = DVec3::NAN;
