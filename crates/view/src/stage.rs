@@ -236,6 +236,18 @@ impl Stage for SceneStage {
         self.scene.world.steps_on_pool()
     }
 
+    /// With sleeping spheres (`[contacts] sleep_speed`), how many sleep.
+    fn note(&self) -> Option<String> {
+        let c = self.scene.world.event::<animats_engine::SphereContact>()?;
+        (c.def().sleep_speed > 0.0).then(|| {
+            format!(
+                "{} spheres asleep, {} pairs touching",
+                c.sleeping(),
+                c.touching()
+            )
+        })
+    }
+
     fn step(&mut self, dt: f64) -> Result<(), String> {
         self.scene.step(dt).map(|_| ()).map_err(|e| match e {
             animats_engine::SimError::NonFinite { particle, time } => format!(

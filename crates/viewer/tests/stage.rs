@@ -1,5 +1,6 @@
 //! What the viewer runs: a scene file's stage (moving the food steers the
-//! jellyfish) and the exhibition of an evolution's champions.
+//! jellyfish; the pile's overlay counts its sleeping rocks) and the
+//! exhibition of an evolution's champions.
 
 use animats_creatures::roobot::evaluate::EvalSettings;
 use animats_creatures::roobot::HopParams;
@@ -178,4 +179,32 @@ fn a_scene_exhibition_replays_the_newest_best_brain() {
         show.note()
     );
     assert!(show.focus().is_some(), "it follows the [evolve] particles");
+}
+
+#[test]
+fn the_piles_overlay_counts_the_rocks_asleep() {
+    // `scenes/pile.toml` lets its rocks sleep: none at the start, most once
+    // the heap has settled (the count is the contact's own).
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pile.toml");
+    let mut stage = SceneStage::load(path).expect("scene");
+    let count = |stage: &SceneStage| -> usize {
+        let note = stage.note().expect("a note about sleeping");
+        note.split_whitespace()
+            .next()
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no count in {note:?}"))
+    };
+    assert_eq!(count(&stage), 0);
+    let dt = stage.dt();
+    while stage.time() < 6.0 {
+        stage.step(dt).expect("the pile steps");
+    }
+    let asleep = count(&stage);
+    println!("{:?}", stage.note());
+    assert!(
+        asleep > 100 && asleep <= 200,
+        "{asleep} of 200 rocks asleep"
+    );
+    // SeaWorld has no sleeping spheres, and no note.
+    assert_eq!(seaworld().note(), None);
 }

@@ -216,6 +216,11 @@ try {
     check(contact.deepest <= 0.01 + 1e-6 && contact.lowest >= -1e-6,
       'view pile.toml: no overlap deeper than the envelope, none below the floor',
       `deepest overlap ${(1000 * contact.deepest).toFixed(2)} mm, lowest sphere bottom ${contact.lowest.toExponential(2)} m`);
+    // The scene lets its rocks sleep; the overlay counts them (161 of 200
+    // by 3 s in `animats simulate scenes/pile.toml --duration 3`).
+    const note = await tab.evaluate(() => document.getElementById('note').textContent);
+    const asleep = Number((/^(\d+) spheres asleep/.exec(note) || [])[1]);
+    check(asleep >= 100 && asleep <= 200, 'view pile.toml: the overlay counts the rocks asleep', `note: ${JSON.stringify(note)}`);
     const drawn = await canvasStats(tab);
     check(drawn.variance > 50 && drawn.colours > 100 && tabErrors.length === 0, 'view pile.toml: drawn, no script errors',
       `luminance variance ${drawn.variance.toFixed(0)}, ${drawn.colours} colours; ${tabErrors.join('; ')}`);
