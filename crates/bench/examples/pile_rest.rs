@@ -58,7 +58,7 @@ fn main() {
     let Ok(mut probe) = SphereContact::new(SphereContactDef::default()) else {
         unreachable!("the default contact settings are valid")
     };
-    println!("ring {rows} tall; per second: kinetic energy, distance moved (mean, largest), moved > 1 mm, travelled step by step (mean), sank (mean), fastest at a step's end, deepest overlap left, outside the ring");
+    println!("ring {rows} tall; per second: spheres asleep, kinetic energy, distance moved (mean, largest), moved > 1 mm, travelled step by step (mean), sank (mean), fastest at a step's end, deepest overlap left, outside the ring");
     let mut path = vec![0.0f64; w.len()];
     let mut last = w.state().pos.clone();
     for s in 1..=seconds {

@@ -291,8 +291,9 @@ pub struct ContactsEntry {
     /// m/s: approaches slower than this do not bounce; default 0.05.
     #[serde(default = "default_rest_speed")]
     pub rest_speed: f64,
-    /// m/s: a sphere in contact that moves slower than this for
-    /// `sleep_time` falls asleep; default 0 (never).
+    /// m/s: a sphere in contact that stays within `sleep_speed ·
+    /// sleep_time` of one place for `sleep_time` falls asleep; default 0
+    /// (never).
     #[serde(default)]
     pub sleep_speed: f64,
     /// s: default 0.5.
