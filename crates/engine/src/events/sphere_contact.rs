@@ -218,8 +218,9 @@ struct Sleep {
     /// and not for long within one place (a sphere that merely trembles
     /// there is not).
     moving: Vec<bool>,
-    /// The acceleration its forces gave it in the last step's trial (NaN
-    /// before the first).
+    /// The acceleration its forces gave it: awake, in the last step's
+    /// trial; asleep, in its first trial from rest (NaN until there is
+    /// one). A different one means the forces on it changed.
     accel: Vec<DVec3>,
     /// Whether that changed since the step before: something drives it
     /// (a muscle, a hand on a force), and it wakes the sleepers it
@@ -229,9 +230,6 @@ struct Sleep {
     asleep: Vec<bool>,
     /// Where it fell asleep, and where it stays while asleep.
     anchor: Vec<DVec3>,
-    /// The acceleration its forces gave it in its first trial asleep (NaN
-    /// until then): a different one means the forces on it changed.
-    pull: Vec<DVec3>,
     /// Whether it is in a contact (scratch, for each check).
     touched: Vec<bool>,
     /// Whether something disturbs it (scratch, for each check).
@@ -434,7 +432,6 @@ impl SphereContact {
                 driven: vec![false; n],
                 asleep: vec![false; n],
                 anchor: vec![DVec3::ZERO; n],
-                pull: vec![DVec3::NAN; n],
                 touched: vec![false; n],
                 wake: vec![false; n],
                 count: 0,
@@ -495,7 +492,7 @@ impl SphereContact {
                     if s.still[i] >= time && s.still[i] > 0.0 && calm && s.touched[i] {
                         s.asleep[i] = true;
                         s.anchor[i] = x0[i];
-                        s.pull[i] = DVec3::NAN;
+                        s.accel[i] = DVec3::NAN;
                         s.count += 1;
                     }
                 }
@@ -515,7 +512,7 @@ impl SphereContact {
             }
         }
         let sleepers = (s.asleep.iter().zip(&s.touched))
-            .zip(s.pull.iter_mut().zip(s.wake.iter_mut()))
+            .zip(s.accel.iter_mut().zip(s.wake.iter_mut()))
             .zip(ctx.vel.iter().zip(v0));
         for (((&asleep, &touched), (first, wake)), (v1, v0)) in sleepers {
             if !asleep {
@@ -524,14 +521,14 @@ impl SphereContact {
             // Its forces over a trial from rest: the same while nothing
             // around it changes. (The first is taken from rest, not from
             // the step it fell asleep in.)
-            let pull = (*v1 - *v0) / ctx.h;
+            let a = (*v1 - *v0) / ctx.h;
             if !touched {
                 *wake = true;
             } else if first.is_nan() {
                 if *v0 == DVec3::ZERO {
-                    *first = pull;
+                    *first = a;
                 }
-            } else if changed(pull, *first) {
+            } else if changed(a, *first) {
                 *wake = true;
             }
         }
