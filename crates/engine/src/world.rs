@@ -655,6 +655,9 @@ impl World {
         let n = self.len();
         self.next.resize(n);
         self.scratch.resize(n);
+        if n < SMALL && self.events.is_empty() {
+            return self.step_alone(dt);
+        }
         for e in &mut self.events {
             e.begin_step();
         }
@@ -682,6 +685,52 @@ impl World {
         self.stats.unresolved += report.unresolved as u64;
         self.last = report;
         Ok(report)
+    }
+
+    /// [`World::step_here`] for a small world without events: nothing to
+    /// check, nothing to backtrack, so the trial is integrated and kept
+    /// (or, not finite, refused) with none of the passes and closures that
+    /// serve events and pieces. They cost a third of a five-body step
+    /// whose force does nothing (the `step_floor` example of
+    /// `animats-bench`). The same bits as the general path.
+    #[inline(always)]
+    fn step_alone(&mut self, dt: f64) -> Result<StepReport, SimError> {
+        let t0 = self.time;
+        self.scratch.implicit.iterations = 0;
+        self.forces.one_piece = self.one_piece();
+        let mut dynamics = Dynamics {
+            forces: &mut self.forces,
+            particles: &self.particles,
+            scratch: &mut self.scratch,
+            solver: self.solver,
+        };
+        let (from, to) = (&self.state, &mut self.next);
+        let finite = match self.integrator {
+            // The commonest, inlined whole.
+            IntegratorKind::Symplectic => {
+                crate::integrators::symplectic::step_small(&mut dynamics, t0, dt, from, to)
+            }
+            kind => integrate_then(kind, &mut dynamics, t0, dt, from, to, None).finite(),
+        };
+        if !finite {
+            if let Some(i) = first_non_finite(&self.next, &self.particles.fixed) {
+                // The world stays at its last finite state.
+                return Err(SimError::NonFinite {
+                    particle: ParticleId(i as u32),
+                    time: t0 + dt,
+                });
+            }
+        }
+        std::mem::swap(&mut self.state, &mut self.next);
+        self.advance_clock(dt);
+        self.stats.steps += 1;
+        self.last = StepReport {
+            backtracks: 0,
+            pieces: 1,
+            unresolved: 0,
+            solver_iterations: self.scratch.implicit.iterations,
+        };
+        Ok(self.last)
     }
 
     /// Integrates from the current state over `[t, t + h]` (part of a step

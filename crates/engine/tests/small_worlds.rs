@@ -75,3 +75,82 @@ fn a_blow_up_is_named_on_both_paths() {
         assert_eq!(names[0], names[1], "{kind}");
     }
 }
+
+/// An event that never happens: a world that has one takes the general
+/// step (trial, check, accept), one without it the step of a small world
+/// alone.
+#[derive(Clone)]
+struct Never;
+
+impl animats_engine::DiscreteEvent for Never {
+    fn check(&mut self, _: &animats_engine::EventContext) -> animats_engine::EventState {
+        animats_engine::EventState::None
+    }
+    fn handle(&mut self, _: f64, _: &mut [DVec3], _: &mut [DVec3], _: &animats_engine::Properties) {
+    }
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// A push that changes with the time and the velocity, so that a step
+/// evaluating it at the wrong time or state gives other bits.
+#[derive(Clone)]
+struct Push;
+
+impl animats_engine::Force for Push {
+    fn apply(&mut self, ctx: &animats_engine::ForceContext, forces: &mut [DVec3]) {
+        forces[5] += DVec3::new((40.0 * ctx.t).sin(), 0.0, 0.0) - 0.3 * ctx.vel[5];
+    }
+    fn name(&self) -> &str {
+        "push"
+    }
+}
+
+#[test]
+fn a_small_world_without_events_steps_as_one_with_an_event_that_never_happens() {
+    // Every integrator, the implicit one included (alone and beside the
+    // event, its solves see the same particles).
+    for kind in IntegratorKind::ALL {
+        let (mut alone, mut general) = (chain(0, 200.0), chain(0, 200.0));
+        general.add_event(Box::new(Never));
+        for w in [&mut alone, &mut general] {
+            w.set_integrator(kind);
+            w.add_force(Box::new(Push));
+        }
+        for step in 0..2000 {
+            let (a, g) = (alone.step(1e-3).unwrap(), general.step(1e-3).unwrap());
+            assert_eq!(a, g, "{kind}, step {step}");
+            assert_eq!(
+                alone.state().pos,
+                general.state().pos,
+                "{kind}, step {step}"
+            );
+            assert_eq!(
+                alone.state().vel,
+                general.state().vel,
+                "{kind}, step {step}"
+            );
+        }
+        assert_eq!(alone.time().to_bits(), general.time().to_bits(), "{kind}");
+        assert_eq!(alone.stats(), general.stats(), "{kind}");
+    }
+    // A blow-up: the same particle named at the same time, and both worlds
+    // left at the same last finite state.
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let (mut alone, mut general) = (chain(0, 1e12), chain(0, 1e12));
+        general.add_event(Box::new(Never));
+        for w in [&mut alone, &mut general] {
+            w.set_integrator(kind);
+        }
+        let a = (0..10_000).find_map(|_| alone.step(1e-2).err());
+        let g = (0..10_000).find_map(|_| general.step(1e-2).err());
+        assert!(
+            matches!(a, Some(SimError::NonFinite { .. })),
+            "{kind}: {a:?}"
+        );
+        assert_eq!(format!("{a:?}"), format!("{g:?}"), "{kind}");
+        assert_eq!(alone.state().pos, general.state().pos, "{kind}");
+        assert_eq!(alone.time().to_bits(), general.time().to_bits(), "{kind}");
+    }
+}

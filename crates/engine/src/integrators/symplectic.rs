@@ -51,17 +51,16 @@ pub(crate) fn step_then(
             None => Written::Known(false),
         };
     }
-    d.forces
-        .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
-    let f = &*f;
     if from.pos.len() < SMALL {
-        let w = &d.particles.inv_mass;
-        let finite = update(&from.pos, &from.vel, f, w, h, &mut to.pos, &mut to.vel);
+        let finite = step_small(d, t, h, from, to);
         return match finish {
             Some(finish) => Written::Settled(finish(0, &mut to.pos, &mut to.vel)),
             None => Written::Known(finite),
         };
     }
+    d.forces
+        .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
+    let f = &*f;
     let w3 = &d.particles.inv_mass3;
     let piece = |first: usize, out: [&mut [DVec3]; 2]| {
         let r = first..first + out[0].len();
@@ -83,6 +82,17 @@ pub(crate) fn step_then(
             Written::Known(false)
         }
     }
+}
+
+/// [`step`] of a world of fewer than [`SMALL`] particles, particle by
+/// particle; true if every new coordinate is finite.
+#[inline(always)]
+pub(crate) fn step_small(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
+    let f = &mut d.scratch.force;
+    d.forces
+        .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
+    let w = &d.particles.inv_mass;
+    update(&from.pos, &from.vel, f, w, h, &mut to.pos, &mut to.vel)
 }
 
 /// [`update`] of the particles `first..first + x1.len()` from `from`, with
