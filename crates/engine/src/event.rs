@@ -193,6 +193,13 @@ pub trait DiscreteEvent: Send + Sync + CloneEvent {
     /// Lets a caller that knows the concrete type read its records back
     /// (e.g. the floor's collisions of the last step).
     fn as_any(&self) -> &dyn std::any::Any;
+
+    /// [`as_any`](Self::as_any), mutably, for an event whose state the
+    /// world restores from a snapshot (sphere contact's sleep); `None`, the
+    /// default, for the others.
+    fn as_any_mut(&mut self) -> Option<&mut dyn std::any::Any> {
+        None
+    }
 }
 
 /// Clones a boxed event; implemented for every `DiscreteEvent + Clone`.

@@ -48,7 +48,7 @@ pub use error::{ModelError, SimError};
 pub use event::{DiscreteEvent, EventContext, EventState, TrialPiece};
 pub use events::floor_collision::{Collision, FloorCollision};
 pub use events::plane_constraint::PlaneConstraint;
-pub use events::sphere_contact::{Impact, SphereContact, SphereContactDef};
+pub use events::sphere_contact::{Impact, SleepState, SphereContact, SphereContactDef};
 pub use force::{Force, ForceContext, Stage, Targets};
 pub use force_set::Forces;
 pub use forces::{

@@ -8,14 +8,14 @@
 //! structure (which particles, which forces join them, the integrator): it
 //! is restored into the world it came from, or into one built the same way
 //! (from the same scene file), and a restored world continues bit for bit as
-//! the original did. Fluid currents and user forces and events keep their
-//! own state. One exception: sphere contact's sleep (`sleep_speed`) is not
-//! held, and every sphere is awake after a restore, so a world in which
-//! some slept continues as the original would have with them all woken,
-//! not bit for bit. Formats must round-trip `f64` exactly (serde_json with
-//! `float_roundtrip`, bincode, ...).
+//! the original did. It holds sphere contact's sleep too (`sleep_speed`:
+//! which spheres sleep, where, and what each was doing), so a pile whose
+//! rocks had fallen asleep goes on asleep. Fluid currents and user forces
+//! and events keep their own state. Formats must round-trip `f64` exactly
+//! (serde_json with `float_roundtrip`, bincode, ...).
 
 use crate::error::ModelError;
+use crate::events::sphere_contact::{SleepState, SphereContact};
 use crate::forces::{angle_joint::AngleJointId, constant_force::ConstantForceId};
 use crate::forces::{spring::SpringId, torque_joint::TorqueJointId};
 use crate::particle::sphere_radius;
@@ -50,6 +50,11 @@ pub struct Snapshot {
     pub constant_forces: Vec<[f64; 3]>,
     /// The gravitational acceleration, if the world has gravity.
     pub gravity: Option<[f64; 3]>,
+    /// Sphere contact's sleep, when its spheres may sleep and the world
+    /// has stepped (absent from snapshots of other worlds, and from those
+    /// written before it was held).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sleep: Option<SleepState>,
 }
 
 fn mismatch(field: &'static str, got: usize, want: usize) -> ModelError {
@@ -102,6 +107,9 @@ impl World {
                 .map(|c| c.force.to_array())
                 .collect(),
             gravity: f.gravity.as_ref().map(|g| g.g.to_array()),
+            sleep: self
+                .event::<SphereContact>()
+                .and_then(SphereContact::sleep_state),
         }
     }
 
@@ -164,7 +172,20 @@ impl World {
             ));
         }
 
+        if let Some(sleep) = &s.sleep {
+            if self.event::<SphereContact>().is_none() {
+                return Err(ModelError::new(
+                    "sleep",
+                    "the snapshot has sleeping spheres, this world no sphere contact: it is of another world",
+                ));
+            }
+            sleep.check(n)?;
+        }
+
         // Everything checked: apply.
+        if let Some(contact) = self.event_mut::<SphereContact>() {
+            contact.restore_sleep(s.sleep.as_ref());
+        }
         self.time = s.time;
         self.time_carry = s.time_carry;
         self.stats = s.stats;

@@ -539,6 +539,14 @@ impl World {
             .find_map(|e| e.as_any().downcast_ref::<E>())
     }
 
+    /// The first event of type `E`, mutably, if it gives itself
+    /// ([`DiscreteEvent::as_any_mut`]).
+    pub(crate) fn event_mut<E: DiscreteEvent + 'static>(&mut self) -> Option<&mut E> {
+        self.events
+            .iter_mut()
+            .find_map(|e| e.as_any_mut().and_then(|a| a.downcast_mut::<E>()))
+    }
+
     // ----- stepping --------------------------------------------------------
 
     /// The integration method used by [`step`](World::step).

@@ -9,7 +9,8 @@
 //! - a sleeper pushed slowly by a driven neighbour moves with it, as if
 //!   awake (not as a nailed wall);
 //! - a change of the forces (gravity turned round) wakes sleepers;
-//! - a snapshot restored wakes them, and they sleep again as before;
+//! - a snapshot holds the sleep: restored, a world goes on bit for bit
+//!   (and one that does not fit is refused, naming it);
 //! - bad settings are refused, naming the field.
 //!
 //! The heap of a thousand is in `crates/bench/tests/pile.rs`.
@@ -234,23 +235,96 @@ fn gravity_turned_round_wakes_sleepers() {
     }
 }
 
-#[test]
-fn a_restored_snapshot_wakes_sleepers_and_they_sleep_again() {
-    let (mut w, _) = column(2, SLEEP);
-    run(&mut w, 100);
-    let early = w.snapshot();
-    run(&mut w, 900);
-    assert_eq!(sleeping(&w), 2);
-    let asleep_at = w.state().pos.clone();
-    w.restore(&early).unwrap();
-    w.step(H).unwrap();
-    assert_eq!(sleeping(&w), 0, "asleep across a restore");
-    // Still since the start, so asleep again `sleep_time` after the restore.
-    run(&mut w, 600);
-    assert_eq!(sleeping(&w), 2);
-    for (x, y) in w.state().pos.iter().zip(&asleep_at) {
-        assert!((*x - *y).length() < 1e-6, "asleep at {x}, before at {y}");
+/// A column of two on the floor and a ball dropped from 2 m onto it, which
+/// lands (about 0.62 s) after the column has fallen asleep (0.5 s).
+fn column_and_ball() -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    w.set_gravity(DVec3::new(0.0, -G, 0.0));
+    for y in [R, 3.0 * R, 2.0] {
+        let sphere = ParticleDef::new(0.05).with_radius(R).with_restitution(0.3);
+        w.add_particle(sphere.at(DVec3::new(0.0, y, 0.0))).unwrap();
     }
+    w.add_floor(FloorDef::default()).unwrap();
+    w.add_sphere_contact(contact(SLEEP)).unwrap();
+    w
+}
+
+/// Every step's positions, velocities and sleepers from now to `until` steps.
+fn record(w: &mut World, until: usize) -> Vec<(Vec<DVec3>, Vec<DVec3>, usize)> {
+    let mut out = Vec::new();
+    while w.stats().steps < until as u64 {
+        w.step(H).unwrap();
+        out.push((w.state().pos.clone(), w.state().vel.clone(), sleeping(w)));
+    }
+    out
+}
+
+#[test]
+fn a_restored_snapshot_goes_on_bit_for_bit_with_its_sleepers() {
+    let mut w = column_and_ball();
+    run(&mut w, 300);
+    let timing = w.snapshot(); // the column still, not yet asleep
+    let mut from_timing = record(&mut w, 550);
+    let asleep = w.snapshot(); // the column asleep, the ball falling
+    assert_eq!(sleeping(&w), 2);
+    assert!(asleep.sleep.is_some());
+    let from_asleep = record(&mut w, 1500);
+    assert!(
+        from_asleep.iter().any(|s| s.2 == 0),
+        "the ball never woke the column"
+    );
+    from_timing.extend_from_slice(&from_asleep);
+    for (name, snap, expected) in [
+        ("at 0.3 s", &timing, &from_timing),
+        ("at 0.55 s", &asleep, &from_asleep),
+    ] {
+        // Into the same world, and through JSON into one built anew.
+        w.restore(snap).unwrap();
+        assert_eq!(&record(&mut w, 1500), expected, "restored {name}");
+        let text = serde_json::to_string(snap).unwrap();
+        let mut fresh = column_and_ball();
+        fresh
+            .restore(&serde_json::from_str(&text).unwrap())
+            .unwrap();
+        assert_eq!(
+            &record(&mut fresh, 1500),
+            expected,
+            "restored {name} from JSON"
+        );
+    }
+    // Without its sleep the restored world goes another way: the snapshot
+    // is what carries it.
+    let mut forgetful = asleep.clone();
+    forgetful.sleep = None;
+    w.restore(&forgetful).unwrap();
+    assert_eq!(sleeping(&w), 0);
+    assert_ne!(record(&mut w, 1500), from_asleep);
+}
+
+#[test]
+fn a_snapshot_whose_sleep_does_not_fit_is_refused_naming_it() {
+    let mut w = column_and_ball();
+    run(&mut w, 600);
+    let snap = w.snapshot();
+    // Of a world with one sphere fewer.
+    let mut text: serde_json::Value = serde_json::to_value(&snap).unwrap();
+    text["sleep"]["asleep"].as_array_mut().unwrap().pop();
+    let short: animats_engine::Snapshot = serde_json::from_value(text).unwrap();
+    let before = w.snapshot();
+    let e = w.restore(&short).unwrap_err().to_string();
+    assert!(e.contains("sleep") && e.contains("asleep"), "{e}");
+    assert_eq!(w.snapshot(), before, "a refused snapshot changed the world");
+    // Into a world without sphere contact.
+    let mut plain = World::new();
+    for _ in 0..3 {
+        plain
+            .add_particle(ParticleDef::new(0.05).with_radius(R))
+            .unwrap();
+    }
+    plain.set_gravity(DVec3::new(0.0, -G, 0.0));
+    let e = plain.restore(&snap).unwrap_err().to_string();
+    assert!(e.contains("sleep"), "{e}");
 }
 
 #[test]

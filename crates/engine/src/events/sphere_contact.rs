@@ -71,6 +71,7 @@ use crate::event::{DiscreteEvent, EventContext, EventState};
 use crate::force::Targets;
 use crate::particle::{non_negative, ParticleId, Properties};
 use glam::DVec3;
+use serde::{Deserialize, Serialize};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
@@ -201,6 +202,65 @@ pub struct SphereContact {
     moving: Vec<(u32, DVec3, DVec3)>,
     /// Which spheres sleep (empty unless `sleep_speed` > 0).
     sleep: Sleep,
+}
+
+/// The spheres' sleep as a [`Snapshot`](crate::Snapshot) holds it: what
+/// sphere contact remembers from step to step to put spheres to sleep and
+/// wake them, so that a restored world goes on as the original did. Read
+/// it only through the snapshot; a value that is not yet a number (before
+/// a sphere's first trial) is `None`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SleepState {
+    last: Vec<[f64; 3]>,
+    t_last: Option<f64>,
+    origin: Vec<[f64; 3]>,
+    still: Vec<f64>,
+    moving: Vec<bool>,
+    accel: Vec<Option<[f64; 3]>>,
+    driven: Vec<bool>,
+    asleep: Vec<bool>,
+    anchor: Vec<[f64; 3]>,
+}
+
+/// `x` as an array, `None` if not a number.
+fn known(x: DVec3) -> Option<[f64; 3]> {
+    (!x.is_nan()).then(|| x.to_array())
+}
+
+impl SleepState {
+    /// Checks it against a world of `n` particles; the field named is
+    /// `sleep.<its field>`.
+    pub(crate) fn check(&self, n: usize) -> Result<(), ModelError> {
+        let lengths = [
+            ("last", self.last.len()),
+            ("origin", self.origin.len()),
+            ("still", self.still.len()),
+            ("moving", self.moving.len()),
+            ("accel", self.accel.len()),
+            ("driven", self.driven.len()),
+            ("asleep", self.asleep.len()),
+            ("anchor", self.anchor.len()),
+        ];
+        for (field, len) in lengths {
+            if len != n {
+                return Err(ModelError::new(
+                    "sleep",
+                    format!("{field} has {len} spheres, this world {n}: the snapshot is of another world"),
+                ));
+            }
+        }
+        let vectors = [&self.last, &self.origin, &self.anchor];
+        let finite = vectors
+            .iter()
+            .all(|v| v.as_flattened().iter().all(|x| x.is_finite()))
+            && self.still.iter().all(|x| x.is_finite() && *x >= 0.0)
+            && self.t_last.is_none_or(f64::is_finite)
+            && self.accel.iter().flatten().flatten().all(|x| x.is_finite());
+        if !finite {
+            return Err(ModelError::new("sleep", "holds a value that is not finite"));
+        }
+        Ok(())
+    }
 }
 
 /// The spheres' sleep: see [`SphereContact`].
@@ -398,6 +458,57 @@ impl SphereContact {
         self.sleep.count
     }
 
+    /// The sleep, for a snapshot: `None` when spheres do not sleep or
+    /// before the first step.
+    pub(crate) fn sleep_state(&self) -> Option<SleepState> {
+        let s = &self.sleep;
+        if self.def.sleep_speed <= 0.0 || s.last.is_empty() {
+            return None;
+        }
+        let arrays = |v: &[DVec3]| v.iter().map(|x| x.to_array()).collect();
+        Some(SleepState {
+            last: arrays(&s.last),
+            t_last: (!s.t_last.is_nan()).then_some(s.t_last),
+            origin: arrays(&s.origin),
+            still: s.still.clone(),
+            moving: s.moving.clone(),
+            accel: s.accel.iter().map(|&a| known(a)).collect(),
+            driven: s.driven.clone(),
+            asleep: s.asleep.clone(),
+            anchor: arrays(&s.anchor),
+        })
+    }
+
+    /// Takes the sleep of a snapshot ([`SleepState::check`]ed); `None`:
+    /// every sphere awake, as before the first step.
+    pub(crate) fn restore_sleep(&mut self, state: Option<&SleepState>) {
+        let Some(st) = state else {
+            self.sleep = Sleep::default();
+            return;
+        };
+        let vectors = |v: &[[f64; 3]]| v.iter().map(|&x| DVec3::from_array(x)).collect();
+        let n = st.asleep.len();
+        self.sleep = Sleep {
+            last: vectors(&st.last),
+            t_last: st.t_last.unwrap_or(f64::NAN),
+            origin: vectors(&st.origin),
+            still: st.still.clone(),
+            moving: st.moving.clone(),
+            accel: st
+                .accel
+                .iter()
+                .map(|a| a.map_or(DVec3::NAN, DVec3::from_array))
+                .collect(),
+            driven: st.driven.clone(),
+            asleep: st.asleep.clone(),
+            anchor: vectors(&st.anchor),
+            touched: vec![false; n],
+            wake: vec![false; n],
+            count: st.asleep.iter().filter(|&&a| a).count(),
+            fresh: false,
+        };
+    }
+
     /// Whether sphere `i` sleeps.
     pub fn is_asleep(&self, i: ParticleId) -> bool {
         self.sleep
@@ -419,8 +530,9 @@ impl SphereContact {
         let (x0, v0) = (ctx.start_pos, ctx.start_vel);
         let n = x0.len().min(ctx.pos.len());
         let s = &mut self.sleep;
-        // New spheres, or the clock set back (a snapshot restored): every
-        // sphere starts awake.
+        // New spheres, or the clock set back by hand (`World::set_time`;
+        // a restored snapshot brings its own sleep): every sphere starts
+        // awake.
         if s.last.len() != n || (s.fresh && ctx.t - ctx.h < s.t_last) {
             *s = Sleep {
                 last: x0[..n].to_vec(),
@@ -968,6 +1080,10 @@ impl DiscreteEvent for SphereContact {
 
     fn as_any(&self) -> &dyn std::any::Any {
         self
+    }
+
+    fn as_any_mut(&mut self) -> Option<&mut dyn std::any::Any> {
+        Some(self)
     }
 }
 
