@@ -173,10 +173,17 @@ impl World {
         }
 
         if let Some(sleep) = &s.sleep {
-            if self.event::<SphereContact>().is_none() {
+            let why = match self.event::<SphereContact>() {
+                None => Some("this world has no sphere contact"),
+                Some(c) if c.def().sleep_speed <= 0.0 => {
+                    Some("this world's spheres never sleep (sleep_speed 0)")
+                }
+                Some(_) => None,
+            };
+            if let Some(why) = why {
                 return Err(ModelError::new(
                     "sleep",
-                    "the snapshot has sleeping spheres, this world no sphere contact: it is of another world",
+                    format!("the snapshot has sleeping spheres, {why}: it is of another world"),
                 ));
             }
             sleep.check(n)?;

@@ -324,7 +324,14 @@ fn a_snapshot_whose_sleep_does_not_fit_is_refused_naming_it() {
     }
     plain.set_gravity(DVec3::new(0.0, -G, 0.0));
     let e = plain.restore(&snap).unwrap_err().to_string();
-    assert!(e.contains("sleep"), "{e}");
+    assert!(
+        e.contains("sleep") && e.contains("no sphere contact"),
+        "{e}"
+    );
+    // Into a world whose spheres never sleep (it would hold them forever).
+    let (mut awake, _) = column(3, 0.0);
+    let e = awake.restore(&snap).unwrap_err().to_string();
+    assert!(e.contains("never sleep"), "{e}");
 }
 
 #[test]
