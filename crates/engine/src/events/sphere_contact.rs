@@ -228,8 +228,8 @@ fn known(x: DVec3) -> Option<[f64; 3]> {
 }
 
 impl SleepState {
-    /// Checks it against a world of `n` particles; the field named is
-    /// `sleep.<its field>`.
+    /// Checks it against a world of `n` particles; an error names `sleep`
+    /// and the list that does not fit.
     pub(crate) fn check(&self, n: usize) -> Result<(), ModelError> {
         let lengths = [
             ("last", self.last.len()),
