@@ -2,7 +2,7 @@
 //! bodies stepped by symplectic Euler with a user force that does nothing,
 //!
 //! - by the engine, as a world without events steps
-//!   (`World::step_alone`);
+//!   (`World::trial_alone`);
 //! - by the engine with an event that never happens, which takes the
 //!   general step (trial, events, accept);
 //! - by hand: the forces zeroed, the force called through `dyn Force`, the

@@ -50,6 +50,18 @@ pub struct StepReport {
     pub solver_iterations: u32,
 }
 
+impl StepReport {
+    /// A step taken whole, with `solver_iterations`.
+    fn whole(solver_iterations: u32) -> StepReport {
+        StepReport {
+            backtracks: 0,
+            pieces: 1,
+            unresolved: 0,
+            solver_iterations,
+        }
+    }
+}
+
 /// Totals since the world was created.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Stats {
@@ -663,13 +675,15 @@ impl World {
         let n = self.len();
         self.next.resize(n);
         self.scratch.resize(n);
+        let t0 = self.time;
         if n < SMALL && self.events.is_empty() {
-            return self.step_alone(dt);
+            let finite = self.trial_alone(t0, dt);
+            self.accept(EventState::None, finite, t0 + dt)?;
+            return Ok(self.end_step(dt, StepReport::whole(self.scratch.implicit.iterations)));
         }
         for e in &mut self.events {
             e.begin_step();
         }
-        let t0 = self.time;
         // The whole step first; pieces only after a missed event.
         let (events, finite) = self.trial(t0, dt, dt, false);
         let report = if events == EventState::Missed {
@@ -680,32 +694,35 @@ impl World {
             r
         } else {
             self.accept(events, finite, t0 + dt)?;
-            StepReport {
-                backtracks: 0,
-                pieces: 1,
-                unresolved: 0,
-                solver_iterations: self.scratch.implicit.iterations,
-            }
+            StepReport::whole(self.scratch.implicit.iterations)
         };
+        Ok(self.end_step(dt, report))
+    }
+
+    /// Advances the clock past a step that ended with `report`, and counts it.
+    #[inline(always)]
+    fn end_step(&mut self, dt: f64, report: StepReport) -> StepReport {
         self.advance_clock(dt);
         self.stats.steps += 1;
         self.stats.backtracks += report.backtracks as u64;
         self.stats.unresolved += report.unresolved as u64;
         self.last = report;
-        Ok(report)
+        report
     }
 
-    /// [`World::step_here`] for a small world without events: nothing to
-    /// check, nothing to backtrack, so the trial is integrated and kept
-    /// (or, not finite, refused) with none of the passes and closures that
-    /// serve events and pieces. They cost a third of a five-body step
-    /// whose force does nothing (the `step_floor` example of
-    /// `animats-bench`). The same bits as the general path.
+    /// [`World::trial`] for a small world without events: nothing to
+    /// check, handle or backtrack, so the trial is integrated with none of
+    /// the closures and passes that serve events and pieces (they cost a
+    /// third of a five-body step whose force does nothing: the `step_floor`
+    /// example of `animats-bench`), then kept or refused by `accept`. The
+    /// same bits as the general path. Returns whether the integrator knows
+    /// the trial to be finite.
     #[inline(always)]
-    fn step_alone(&mut self, dt: f64) -> Result<StepReport, SimError> {
-        let t0 = self.time;
+    fn trial_alone(&mut self, t0: f64, dt: f64) -> bool {
         self.scratch.implicit.iterations = 0;
         self.forces.one_piece = self.one_piece();
+        self.handle_by_pieces = false;
+        self.settled = false;
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,
@@ -713,32 +730,13 @@ impl World {
             solver: self.solver,
         };
         let (from, to) = (&self.state, &mut self.next);
-        let finite = match self.integrator {
+        match self.integrator {
             // The commonest, inlined whole.
             IntegratorKind::Symplectic => {
                 crate::integrators::symplectic::step_small(&mut dynamics, t0, dt, from, to)
             }
             kind => integrate_then(kind, &mut dynamics, t0, dt, from, to, None).finite(),
-        };
-        if !finite {
-            if let Some(i) = first_non_finite(&self.next, &self.particles.fixed) {
-                // The world stays at its last finite state.
-                return Err(SimError::NonFinite {
-                    particle: ParticleId(i as u32),
-                    time: t0 + dt,
-                });
-            }
         }
-        std::mem::swap(&mut self.state, &mut self.next);
-        self.advance_clock(dt);
-        self.stats.steps += 1;
-        self.last = StepReport {
-            backtracks: 0,
-            pieces: 1,
-            unresolved: 0,
-            solver_iterations: self.scratch.implicit.iterations,
-        };
-        Ok(self.last)
     }
 
     /// Integrates from the current state over `[t, t + h]` (part of a step
