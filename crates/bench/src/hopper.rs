@@ -1,11 +1,13 @@
-//! `hopper`: the roobot's evolution workload (issue 3). One 20 s fitness
-//! evaluation of the shipped evolved gait (RK4, 8 ms, 2500 steps), and the
-//! thesis's experiment: 6 lanes × 1000 generations from Appendix B's initial
-//! parameters (quick: 100 generations), on every core.
+//! `hopper`: the roobot's evolution workload (issue 3), the built-in
+//! `scenes/hop_evolver.toml`. One 20 s fitness evaluation of the shipped
+//! evolved gait (RK4, 8 ms, 2500 steps; the scene built afresh, as
+//! evolution does), and the thesis's experiment: 6 lanes × 1000
+//! generations from Appendix B's initial parameters (quick: 100
+//! generations), on every core.
 
 use crate::{measure, Check, Row, Timing};
-use animats_creatures::roobot::evaluate::{evaluate, EvalSettings, Evaluation};
 use animats_evolve::{Config, State};
+use animats_scene::evaluate::{Evaluation, SceneProblem};
 
 /// Evaluations timed per run of the single-evaluation measurement.
 const EVALS_PER_RUN: usize = 20;
@@ -13,33 +15,35 @@ const EVALS_PER_RUN: usize = 20;
 /// Runs the workload: one row per measurement.
 pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let params = animats_scene::params::load("evolved", None).map_err(|e| e.to_string())?;
-    let settings = EvalSettings::default();
+    let problem = SceneProblem::parse(animats_scene::HOP_EVOLVER, animats_scene::HOP_EVOLVER_FILE)
+        .map_err(|e| e.to_string())?;
+    let (seconds, dt) = (problem.spec().duration, problem.fresh()?.dt);
     let (timing, last): (Timing, Option<Evaluation>) = measure(
         runs,
         || None,
         |out| {
             for _ in 0..EVALS_PER_RUN {
-                *out = evaluate(params, &settings).ok();
+                *out = problem.evaluate(&params.0).ok();
             }
         },
     );
     let per_eval = timing.divided(EVALS_PER_RUN as f64);
     let e = last.ok_or("the evolved gait could not be evaluated")?;
-    let steps = (settings.seconds / settings.dt).round() as usize;
+    let steps = (seconds / dt).round() as usize;
     let eval_row = Row {
         workload: "hopper".into(),
         variant: "1 evaluation, 20 s, rk4".into(),
         particles: 5,
         springs: 4,
         steps,
-        dt: settings.dt,
+        dt,
         evaluations: 4,
         pairs: 0,
         engine: per_eval.clone(),
         baseline: None,
         checks: vec![
-            Check::new("time upright", e.time_up, 20.0, 0.0),
-            Check::target("times real time", settings.seconds / per_eval.median, 15e3),
+            Check::new("time upright", e.time, 20.0, 0.0),
+            Check::target("times real time", seconds / per_eval.median, 15e3),
         ],
     };
 
@@ -49,15 +53,17 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         .num_threads(threads)
         .build()
         .map_err(|e| e.to_string())?;
+    let config = Config::thesis(6, generations, 1);
+    let evolved = config.problem.build()?;
     let (evo, state) = measure(
         runs,
-        || State::new(Config::thesis(6, generations, 1)).expect("valid configuration"),
+        || State::new(config.clone()).expect("valid configuration"),
         |s| {
             // In batches, as `animats evolve` runs it.
             let mut batch = animats_evolve::FIRST_BATCH;
             while !s.done() {
                 let begun = std::time::Instant::now();
-                pool.install(|| s.advance(batch))
+                pool.install(|| s.advance_with(evolved.as_ref(), batch))
                     .expect("evaluations succeed");
                 batch = animats_evolve::next_batch(batch, begun.elapsed());
             }
@@ -79,7 +85,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         particles: 5,
         springs: 4,
         steps: 6 * generations as usize * steps,
-        dt: settings.dt,
+        dt,
         evaluations: 4,
         pairs: 0,
         engine: evo,

@@ -2,7 +2,8 @@
 //! (issue 10, docs/ROOBOT.md): for every seed, one lane of 6000
 //! evaluations with the thesis's hill climber, the GA and CMA-ES, tuning
 //! the thesis's hopping FSM (14 parameters) and Raibert's three-part
-//! controller (8 gains, `roobot::raibert`); how many evaluations until the
+//! controller (8 gains, `roobot::raibert`), each the roobot's brain in the
+//! thesis's scene (`scenes/hop_evolver.toml`); how many evaluations until the
 //! first stable hop (20 s upright), and the best fitness after 600 and 6000
 //! evaluations. Prints a Markdown table and plots the median best fitness
 //! against evaluations.
@@ -12,17 +13,17 @@
 //! ```
 //!
 //! `-- one raibert|fsm OPTIMISER SEED BUDGET` reruns one case and prints its
-//! best genome and what it does (hops, distance, why it ended), also at a
-//! half and a quarter of the evaluation's step.
+//! best genome and what it does (distance, why it ended), also at a half
+//! and a quarter of the evaluation's step.
 //!
 //! The hill climber of run k mutates as the thesis's lane (k − 1) mod 6
 //! does (±25 % to ±150 %), so the 20 runs cover all six of its lanes.
 
-use animats_creatures::roobot::evaluate::Evaluation;
 use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind};
-use animats_evolve::problem::{Problem, RaibertProblem};
+use animats_evolve::problem::{Problem, SceneEvolution};
 use animats_evolve::Config;
 use animats_render::{step_plot_png, Plot, Series};
+use animats_scene::evaluate::{evaluate, Evaluation, SceneProblem};
 use rayon::prelude::*;
 
 /// What one run saw: every evaluation's fitness and time upright, in order,
@@ -47,17 +48,23 @@ impl Controller {
             Controller::Raibert => "Raibert",
         }
     }
+
+    /// The thesis's scene with this brain.
+    fn problem(self) -> SceneProblem {
+        let text = match self {
+            Controller::Fsm => animats_scene::HOP_EVOLVER.to_string(),
+            Controller::Raibert => {
+                animats_scene::HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"")
+            }
+        };
+        SceneProblem::parse(&text, animats_scene::HOP_EVOLVER_FILE).expect("the thesis's scene")
+    }
 }
 
 fn run(controller: Controller, kind: OptimiserKind, seed: u64, budget: usize) -> Run {
     let mut config = Config::thesis(1, u64::MAX, seed);
     config.optimiser = kind;
-    let problem: Box<dyn Problem> = match controller {
-        Controller::Fsm => config.problem.build().expect("the roobot problem"),
-        Controller::Raibert => Box::new(RaibertProblem {
-            settings: config.settings(),
-        }),
-    };
+    let problem: Box<dyn Problem> = Box::new(SceneEvolution(controller.problem()));
     let lane = ((seed - 1) % 6) as usize;
     let mut setup = config.setup(problem.as_ref(), 0);
     if kind == OptimiserKind::HillClimber {
@@ -94,26 +101,16 @@ fn run(controller: Controller, kind: OptimiserKind, seed: u64, budget: usize) ->
 /// `genome` for `controller` evaluated at the thesis's step divided by
 /// `divide`.
 fn evaluate_at(controller: Controller, genome: &[f64], divide: f64) -> Option<Evaluation> {
-    let mut settings = Config::thesis(1, 1, 1).settings();
-    settings.dt /= divide;
-    match controller {
-        Controller::Raibert => {
-            animats_creatures::roobot::raibert::evaluate(genome.try_into().ok()?, &settings)
-        }
-        Controller::Fsm => {
-            let mut p = animats_creatures::roobot::HopParams::INITIAL;
-            p.0.copy_from_slice(genome);
-            animats_creatures::roobot::evaluate::evaluate(p, &settings)
-        }
-    }
-    .ok()
+    let mut scene = controller.problem().scene(genome).ok()?;
+    scene.dt /= divide;
+    evaluate(scene).ok()
 }
 
 /// The run's best genome evaluated at a quarter of the step (2 ms): its
 /// distance if it stays up for the 20 s, else `None`.
 fn at_quarter_step(controller: Controller, genome: &[f64]) -> Option<f64> {
     let e = evaluate_at(controller, genome, 4.0)?;
-    (e.time_up >= 20.0).then_some(e.distance)
+    (e.time >= 20.0).then_some(e.distance)
 }
 
 fn best_after(r: &Run, n: usize) -> f64 {
@@ -155,14 +152,13 @@ fn one(args: &[String]) {
     for divide in [1.0, 2.0, 4.0] {
         let e = evaluate_at(controller, &r.best, divide).expect("an evaluation");
         println!(
-            "dt {} s: fitness {}, upright {} s, distance {} m, {} hops, mean speed {:.3} m/s, ended: {}",
-            Config::thesis(1, 1, 1).settings().dt / divide,
+            "dt {} s: fitness {}, upright {} s, distance {} m, mean speed {:.3} m/s, ended: {}",
+            0.008 / divide,
             e.fitness,
-            e.time_up,
+            e.time,
             e.distance,
-            e.hops,
-            e.mean_speed(),
-            e.ending
+            e.distance / e.time.max(1e-9),
+            e.ended
         );
     }
 }

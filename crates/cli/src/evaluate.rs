@@ -1,24 +1,25 @@
 //! `animats evaluate SCENE [--json]`: the scene's `[evolve]` evaluation,
 //! once, as `animats evolve SCENE` scores a candidate. `animats evaluate
-//! roobot [--params P] [--lane K]`: the roobot's, as `animats evolve` (and
-//! Python's `animats.evaluate("roobot", …)`) scores its parameters.
+//! roobot [--params P] [--lane K]`: the thesis's scene
+//! (`scenes/hop_evolver.toml`, built in) with those hopping parameters, as
+//! `animats evolve` (and Python's `animats.evaluate("roobot", …)`) scores
+//! them.
 
 use crate::Failure;
-use animats_creatures::roobot::evaluate::{evaluate as evaluate_roobot, EvalSettings};
-use animats_creatures::roobot::params_file;
-use animats_scene::evaluate::evaluate;
+use animats_scene::evaluate::{evaluate, SceneProblem};
 use std::path::PathBuf;
 
 /// Arguments of `animats evaluate`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A scene file with an `[evolve]` table, or `roobot` (when no file of
-    /// that name exists) for the roobot's hopping gait.
+    /// that name exists): the thesis's scene, scenes/hop_evolver.toml, built
+    /// in.
     scene: PathBuf,
-    /// The roobot's parameters: `initial`, `evolved` or a file (roobot only).
+    /// `roobot` only: its hopping parameters, `initial`, `evolved` or a file.
     #[arg(long, default_value = "evolved")]
     params: String,
-    /// Which lane's best to take from a best.toml (roobot only).
+    /// `roobot` only: which lane's set to take from a parameter file.
     #[arg(long)]
     lane: Option<usize>,
     /// Print one JSON object (`fitness`, `distance`, `time`, `ended`).
@@ -28,36 +29,32 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
-    let (fitness, distance, time, ended) = if args.scene.as_os_str() == "roobot"
-        && !args.scene.exists()
-    {
-        let params = params_file::load(&args.params, args.lane)
-            .map_err(|e| Failure::Input(e.to_string()))?;
-        let e = evaluate_roobot(params, &EvalSettings::default())
-            .map_err(|e| Failure::Other(e.to_string()))?;
-        (
-            e.fitness,
-            e.distance,
-            e.time_up,
-            e.ending.name().to_string(),
-        )
+    let input = |e: String| Failure::Input(e);
+    let scene = if args.scene.as_os_str() == "roobot" && !args.scene.exists() {
+        let params = animats_scene::params::load(&args.params, args.lane)
+            .map_err(|e| input(e.to_string()))?;
+        let thesis =
+            SceneProblem::parse(animats_scene::HOP_EVOLVER, animats_scene::HOP_EVOLVER_FILE)
+                .map_err(|e| Failure::Other(e.to_string()))?;
+        thesis.scene(&params.0).map_err(Failure::Other)?
     } else {
         if args.lane.is_some() || args.params != "evolved" {
-            return Err(Failure::Input(
+            return Err(input(
                 "--params and --lane are the roobot's: a scene's parameters are in its file".into(),
             ));
         }
-        let scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+        let scene = animats_scene::load(&args.scene).map_err(|e| input(e.to_string()))?;
         crate::warn(&args.scene, &scene.warnings);
         if scene.evolve.is_none() {
-            return Err(Failure::Input(format!(
+            return Err(input(format!(
                 "{}: the scene has no [evolve] table: nothing to evaluate (docs/SCENES.md)",
                 args.scene.display()
             )));
         }
-        let e = evaluate(scene).map_err(Failure::Other)?;
-        (e.fitness, e.distance, e.time, e.ended.to_string())
+        scene
     };
+    let e = evaluate(scene).map_err(Failure::Other)?;
+    let (fitness, distance, time, ended) = (e.fitness, e.distance, e.time, e.ended.to_string());
     if args.json {
         let out = serde_json::json!({
             "fitness": fitness,

@@ -1,15 +1,13 @@
-//! `animats evolve [SCENE]`: the thesis's evolution of hopping gaits (no
-//! scene), or of a scene's `[evolve]` controller, in parallel lanes with
-//! the hill climber, a GA or CMA-ES; a progress bar (a line every few
-//! seconds when stderr is not a terminal), checkpoints, and Ctrl-C to stop
-//! cleanly.
+//! `animats evolve [SCENE]`: a scene's `[evolve]` controller (without a
+//! scene, the thesis's evolution of hopping gaits, the built-in
+//! `scenes/hop_evolver.toml`), in parallel lanes with the hill climber, a
+//! GA or CMA-ES; a progress bar (a line every few seconds when stderr is
+//! not a terminal), checkpoints, and Ctrl-C to stop cleanly.
 
 use crate::Failure;
-use animats_evolve::{checkpoint, Config, OptimiserKind, ProblemSpec, State};
+use animats_evolve::{checkpoint, Choices, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
-use animats_scene::evaluate::SceneProblem;
-use animats_viewer::exhibition::Showcase;
-use animats_viewer::{BestBrain, Exhibition, SceneExhibition};
+use animats_viewer::{BestBrain, Exhibition};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -20,7 +18,8 @@ use std::time::Instant;
 /// Arguments of `animats evolve`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// A scene file with an `[evolve]` table; without one, the roobot.
+    /// A scene file with an `[evolve]` table; without one, the thesis's
+    /// roobot (scenes/hop_evolver.toml, built in).
     scene: Option<PathBuf>,
     /// hill-climber (the thesis's), ga or cma-es.
     #[arg(long, value_parser = OptimiserKind::parse)]
@@ -36,14 +35,16 @@ pub struct Args {
     /// Generations per lane (a resumed run can be given a new total).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     generations: Option<u64>,
-    /// Independent lanes (default 6 for the roobot, 1 for a scene; the hill
-    /// climber's lane k mutates by up to ±25 (k + 1) %).
+    /// Independent lanes (default: the scene's `[evolve] lanes`, else 1;
+    /// the thesis's roobot: 6); the hill climber's lane k mutates by up to
+    /// ±25 (k + 1) % where the scene says `mutation = "relative"`.
     #[arg(long)]
     lanes: Option<usize>,
     /// Seed of every random choice.
     #[arg(long)]
     seed: Option<u64>,
-    /// Directory to write log.csv, best.toml, fitness.png and the checkpoint.
+    /// Directory to write log.csv, best.toml (the best lane's scene),
+    /// lanes/K.toml (each lane's), fitness.png and the checkpoint.
     #[arg(long, default_value = "evolution")]
     out: PathBuf,
     /// Continue the run in this directory from its checkpoint.
@@ -55,10 +56,9 @@ pub struct Args {
     /// Seconds between checkpoints (0: after every batch of generations).
     #[arg(long, default_value_t = 5.0, value_parser = crate::non_negative_f64)]
     checkpoint_every: f64,
-    /// Watch it live in the browser: the roobot's lanes' current bests
-    /// hopping side by side, or the scene driven by its best brain so far
-    /// (restarted with the newest best when each run ends). The view stays
-    /// open after the run until Ctrl-C.
+    /// Watch it live in the browser: the scene driven by its best brain so
+    /// far (restarted with the newest best when each run ends). The view
+    /// stays open after the run until Ctrl-C.
     #[arg(long)]
     view: bool,
     #[command(flatten)]
@@ -92,20 +92,28 @@ fn writable(dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Writes log.csv, best.toml, fitness.png and the checkpoint.
-fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
+/// Writes log.csv, best.toml and the checkpoint; at the end of a run (or
+/// of this part of it) fitness.png and each lane's best, lanes/K.toml, too.
+fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
     let io = Failure::Other;
     animats_files::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes())
         .map_err(io)?;
     if let Some(best) = state.best_toml().map_err(Failure::Other)? {
         animats_files::write_atomically(&dir.join("best.toml"), best.as_bytes()).map_err(io)?;
     }
-    if with_plot {
-        let y_label = if state.config.problem.is_roobot() {
-            "best fitness (time upright + 50 × distance)"
-        } else {
-            "best fitness"
-        };
+    if at_end && state.config.lanes > 1 {
+        let lanes = dir.join("lanes");
+        std::fs::create_dir_all(&lanes)
+            .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", lanes.display())))?;
+        for l in &state.lanes {
+            if let Some(text) = state.lane_toml(l.lane).map_err(Failure::Other)? {
+                let path = lanes.join(format!("{}.toml", l.lane));
+                animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
+            }
+        }
+    }
+    if at_end {
+        let y_label = "best fitness";
         let plot = Plot {
             title: format!(
                 "Best fitness per lane ({}, seed {})",
@@ -131,112 +139,66 @@ fn save(dir: &Path, state: &State, with_plot: bool) -> Result<(), Failure> {
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
 }
 
-/// What the live view shows: the roobot's lanes side by side, or a scene
-/// driven by its best brain.
-enum Watched {
-    Roobot(Showcase),
-    Scene(BestBrain),
-}
-
-/// Shows the bests so far to the viewer.
-fn publish(watched: &Watched, state: &State) {
-    match watched {
-        Watched::Roobot(showcase) => {
-            for l in &state.lanes {
-                if let Some(b) = &l.best {
-                    let mut params = animats_creatures::roobot::HopParams::INITIAL;
-                    params.0.copy_from_slice(&b.genome);
-                    showcase.set_best(l.lane, params, b.fitness);
-                }
-            }
-            showcase.set_generation(state.generation(), state.config.generations);
-        }
-        Watched::Scene(board) => {
-            if let Some(l) = state.best_lane() {
-                if let Some(b) = &l.best {
-                    board.set_best(&b.genome, b.fitness, l.lane);
-                }
-            }
-            board.set_generation(state.generation(), state.config.generations);
+/// Shows the best so far to the viewer.
+fn publish(board: &BestBrain, state: &State) {
+    if let Some(l) = state.best_lane() {
+        if let Some(b) = &l.best {
+            board.set_best(&b.genome, b.fitness, l.lane);
         }
     }
+    board.set_generation(state.generation(), state.config.generations);
+}
+
+/// The state of a new run, or of the run in `dir` continued.
+fn start(args: &Args) -> Result<(PathBuf, State), Failure> {
+    let choices = Choices {
+        lanes: args.lanes,
+        generations: args.generations,
+        seed: args.seed,
+        optimiser: args.optimiser,
+        population: args.population.map(|p| p as usize),
+        restarts: args.restarts,
+    };
+    if let Some(dir) = &args.resume {
+        if args.scene.is_some() {
+            return Err(input(format!(
+                "{}: a resumed run keeps its scene; give only --resume and --generations",
+                dir.display()
+            )));
+        }
+        let mut state = checkpoint::load(&dir.join(CHECKPOINT)).map_err(input)?;
+        state
+            .resume(&choices)
+            .map_err(|e| input(format!("{}: {e}", dir.display())))?;
+        writable(dir)?;
+        return Ok((dir.clone(), state));
+    }
+    let dir = args.out.clone();
+    if dir.join(CHECKPOINT).exists() {
+        return Err(input(format!(
+            "{}: already holds an evolution run; continue it with --resume {} or choose another --out",
+            dir.display(),
+            dir.display()
+        )));
+    }
+    // Read once; refused here, before any output exists, if it does not
+    // parse.
+    let problem = match &args.scene {
+        Some(path) => ProblemSpec {
+            file: path.display().to_string(),
+            text: animats_scene::read(path).map_err(|e| input(e.to_string()))?,
+        },
+        None => ProblemSpec::thesis(),
+    };
+    let config = Config::new(problem, &choices).map_err(input)?;
+    let state = State::new(config).map_err(input)?;
+    writable(&dir)?;
+    Ok((dir, state))
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
-    let (dir, mut state) = match &args.resume {
-        Some(dir) => {
-            let state = checkpoint::load(&dir.join(CHECKPOINT)).map_err(input)?;
-            if args.lanes.is_some_and(|l| l != state.config.lanes)
-                || args.seed.is_some_and(|s| s != state.config.seed)
-                || args.optimiser.is_some_and(|o| o != state.config.optimiser)
-                || args
-                    .population
-                    .is_some_and(|p| Some(p as usize) != state.config.population)
-                || args.scene.is_some()
-            {
-                return Err(input(format!(
-                    "{}: a resumed run keeps its scene, optimiser ({}), population, lanes ({}) and seed ({}); give only --resume and --generations",
-                    dir.display(),
-                    state.config.optimiser.name(),
-                    state.config.lanes,
-                    state.config.seed
-                )));
-            }
-            let mut state = state;
-            if let Some(g) = args.generations {
-                if g < state.generation() {
-                    return Err(input(format!(
-                        "--generations {g} is fewer than the {} already done",
-                        state.generation()
-                    )));
-                }
-                state.config.generations = g;
-            }
-            writable(dir)?;
-            (dir.clone(), state)
-        }
-        None => {
-            let dir = args.out.clone();
-            if dir.join(CHECKPOINT).exists() {
-                return Err(input(format!(
-                    "{}: already holds an evolution run; continue it with --resume {} or choose another --out",
-                    dir.display(),
-                    dir.display()
-                )));
-            }
-            let mut config = Config::thesis(
-                args.lanes
-                    .unwrap_or(if args.scene.is_some() { 1 } else { 6 }),
-                args.generations.unwrap_or(100),
-                args.seed.unwrap_or(1),
-            );
-            if let Some(path) = &args.scene {
-                // Read once; refused here, before any output exists, if it
-                // does not parse (State::new builds it).
-                config.problem = ProblemSpec::Scene {
-                    file: path.display().to_string(),
-                    text: animats_scene::read(path).map_err(|e| input(e.to_string()))?,
-                };
-            }
-            if let Some(o) = args.optimiser {
-                config.optimiser = o;
-            }
-            config.population = args.population.map(|p| p as usize);
-            if let Some(r) = args.restarts {
-                if config.optimiser != OptimiserKind::CmaEs {
-                    return Err(input(format!(
-                        "--restarts is for --optimiser cma-es, not {}",
-                        config.optimiser.name()
-                    )));
-                }
-                config.restarts = r;
-            }
-            let state = State::new(config).map_err(input)?;
-            writable(&dir)?;
-            (dir, state)
-        }
-    };
+    let (dir, mut state) = start(&args)?;
 
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -254,28 +216,14 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
     let viewing = if args.view {
-        let (watched, stage): (Watched, Box<dyn animats_viewer::Stage>) =
-            match &state.config.problem {
-                ProblemSpec::Roobot { .. } => {
-                    let showcase = Showcase::new(state.config.lanes);
-                    let exhibition = Exhibition::new(showcase.clone(), state.config.settings())
-                        .map_err(Failure::Other)?;
-                    (Watched::Roobot(showcase), Box::new(exhibition))
-                }
-                ProblemSpec::Scene { file, text } => {
-                    let problem =
-                        SceneProblem::parse(text, file).map_err(|e| input(e.to_string()))?;
-                    let board = BestBrain::default();
-                    let exhibition =
-                        SceneExhibition::new(problem, board.clone()).map_err(Failure::Other)?;
-                    (Watched::Scene(board), Box::new(exhibition))
-                }
-            };
-        publish(&watched, &state);
+        let problem = state.config.problem.parse().map_err(input)?;
+        let board = BestBrain::default();
+        let stage = Exhibition::new(problem, board.clone()).map_err(Failure::Other)?;
+        publish(&board, &state);
         let server = args.serving.bind(1.0)?;
         let stop = stop.clone();
-        let thread = std::thread::spawn(move || server.serve(stage, stop));
-        Some((watched, thread))
+        let thread = std::thread::spawn(move || server.serve(Box::new(stage), stop));
+        Some((board, thread))
     } else {
         None
     };
@@ -301,28 +249,23 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let evals_at_start = state.evaluations;
     let mut last_save = Instant::now();
     let mut interrupted = false;
-    // Generations each roobot lane advances between progress updates and
-    // Ctrl-C checks, grown to about a quarter of a second's work (a
-    // scene's lanes advance one generation at a time: its generations are
-    // long).
+    // Generations each lane advances between progress updates and Ctrl-C
+    // checks: one at first, then as many as take about a quarter of a
+    // second.
     let mut batch = animats_evolve::FIRST_BATCH;
     while !state.done() {
         if stop.load(Ordering::SeqCst) {
             interrupted = true;
             break;
         }
-        let roobot = state.config.problem.is_roobot();
-        let n = if roobot { batch } else { 1 };
         let begun = Instant::now();
-        pool.install(|| state.advance_with(problem.as_ref(), n))
+        pool.install(|| state.advance_with(problem.as_ref(), batch))
             .map_err(Failure::Other)?;
-        if roobot {
-            batch = animats_evolve::next_batch(batch, begun.elapsed());
-        }
+        batch = animats_evolve::next_batch(batch, begun.elapsed());
         let rate =
             (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
-        if let Some((watched, _)) = &viewing {
-            publish(watched, &state);
+        if let Some((board, _)) = &viewing {
+            publish(board, &state);
         }
         bar.set_position(state.generation());
         let message = format!(
@@ -356,21 +299,21 @@ pub fn run(args: Args) -> Result<(), Failure> {
         state.config.seed,
         evals as f64 / wall.max(1e-9)
     );
-    let time_name = if state.config.problem.is_roobot() {
-        "upright"
-    } else {
-        "time"
-    };
     for l in &state.lanes {
         let Some(b) = &l.best else { continue };
         println!(
-            "  lane {}: best fitness {:>8.2}  {time_name} {:>6.3} s  distance {:>7.3} m  ({})",
+            "  lane {}: best fitness {:>8.2}  time {:>6.3} s  distance {:>7.3} m  ({})",
             l.lane, b.fitness, b.time, b.distance, b.ended
         );
     }
     println!(
-        "wrote {}/log.csv, best.toml, fitness.png, {CHECKPOINT}",
-        dir.display()
+        "wrote {}/log.csv, best.toml, {}fitness.png, {CHECKPOINT}",
+        dir.display(),
+        if state.config.lanes > 1 {
+            "lanes/, "
+        } else {
+            ""
+        }
     );
     if let Some((_, thread)) = viewing {
         if !interrupted {

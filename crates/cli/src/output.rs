@@ -216,9 +216,11 @@ impl Drop for Trajectory {
 /// The JSON-lines fields of a scene's brains, `,"controllers":[...],
 /// "sensors":{...},"actuators":{...}`, or `None` for a scene without any:
 /// each controller's name, kind, state (FSM state name, else null), the
-/// levels of its input sensors now and of the actuators it set for the step
-/// just taken; then every sensor's and actuator's level by name.
+/// levels of its input sensors now (a creature's own senses: as its brain
+/// read them for the step just taken) and of the actuators it set for that
+/// step; then every sensor's and actuator's level by name.
 pub fn brains_json(scene: &animats_scene::Scene) -> Option<String> {
+    use animats_creatures::nervous_system::Inputs;
     let ns = &scene.nervous;
     if ns.is_empty() {
         return None;
@@ -233,7 +235,10 @@ pub fn brains_json(scene: &animats_scene::Scene) -> Option<String> {
                 "name": c.name,
                 "kind": c.brain.kind(),
                 "state": c.brain.state(),
-                "inputs": c.inputs.iter().map(|&i| sensors[i]).collect::<Vec<_>>(),
+                "inputs": match &c.inputs {
+                    Inputs::Sensors(list) => list.iter().map(|&i| sensors[i]).collect::<Vec<_>>(),
+                    Inputs::Senses(_) => c.inputs_read().to_vec(),
+                },
                 "outputs": c.outputs.iter().map(|&i| actuators[i]).collect::<Vec<_>>(),
             })
         })

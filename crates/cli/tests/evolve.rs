@@ -16,7 +16,7 @@ fn hop_reports_the_initial_and_evolved_gaits() {
         "distance:",
         "hops:",
         "speed:",
-        "ended:      fell",
+        "ended:      touch roobot.head",
     ] {
         assert!(out.contains(key), "missing `{key}` in:\n{out}");
     }
@@ -122,13 +122,24 @@ fn evolve_writes_its_outputs_and_is_identical_on_one_or_two_threads() {
     }
     assert_eq!(log(&a), log(&b));
     assert!(log(&a).starts_with("lane,generation,fitness,time_up,distance,p0,p1,"));
-    for file in ["best.toml", "fitness.png", "checkpoint.json"] {
+    for file in [
+        "best.toml",
+        "fitness.png",
+        "checkpoint.json",
+        "lanes/0.toml",
+        "lanes/3.toml",
+    ] {
         assert!(a.join(file).exists(), "{file}");
     }
+    assert_eq!(
+        std::fs::read(a.join("lanes/2.toml")).unwrap(),
+        std::fs::read(b.join("lanes/2.toml")).unwrap()
+    );
     let png = std::fs::read(a.join("fitness.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
-    // best.toml loads back into `animats hop`, and scores what the log says.
-    let o = animats(&["hop", a.join("best.toml").to_str().unwrap(), "--lane", "2"]);
+    // Each lane's best (a whole scene) loads back into `animats hop`, and
+    // scores what the log says.
+    let o = animats(&["hop", a.join("lanes/2.toml").to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o).1);
     let best_of_lane_2 = log(&a)
         .lines()

@@ -50,8 +50,48 @@ pub trait Brain: Send {
         Vec::new()
     }
 
+    /// Where the genome is written in the brain's table of a scene file,
+    /// in genome order: the keys' lengths add up to the genome's.
+    fn genome_keys(&self) -> Vec<GenomeKey> {
+        Vec::new()
+    }
+
     /// Returns to the state it started in (time, FSM state).
     fn reset(&mut self) {}
+}
+
+/// A key of a brain's table in a scene file that holds genes: a number or
+/// an array of numbers.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GenomeKey {
+    /// The key's path below the brain's table: `frequency`, `weights`,
+    /// `state[0].levels`, `state[1].transition[0].above`.
+    pub path: String,
+    /// `None`: one number; `Some(n)`: an array of `n`.
+    pub len: Option<usize>,
+}
+
+impl GenomeKey {
+    /// A key holding one number.
+    pub fn number(path: impl Into<String>) -> GenomeKey {
+        GenomeKey {
+            path: path.into(),
+            len: None,
+        }
+    }
+
+    /// A key holding an array of `n` numbers.
+    pub fn array(path: impl Into<String>, n: usize) -> GenomeKey {
+        GenomeKey {
+            path: path.into(),
+            len: Some(n),
+        }
+    }
+
+    /// Genes it holds.
+    pub fn genes(&self) -> usize {
+        self.len.unwrap_or(1)
+    }
 }
 
 /// Checks a genome's length against the brain's.

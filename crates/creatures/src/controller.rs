@@ -9,12 +9,6 @@
 
 use animats_engine::World;
 
-/// Reads sensors and sets actuators once per step.
-pub trait Controller {
-    /// Decides and acts for the step of length `dt` about to be taken.
-    fn control(&mut self, world: &mut World, dt: f64);
-}
-
 /// What a creature reports about itself after a step (for viewers, logs and
 /// tests): its controller's state and, where it has one, its energy.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,7 +26,7 @@ pub struct Status {
 /// Something in a world that acts once per step: a creature's brain, or an
 /// environment process.
 pub trait Actor: Send {
-    /// Acts for the next step (see [`Controller::control`]).
+    /// Decides and acts for the step of length `dt` about to be taken.
     fn act(&mut self, world: &mut World, dt: f64);
     /// A creature's state now; `None` for things that are not creatures.
     fn status(&self) -> Option<Status> {

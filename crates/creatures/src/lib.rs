@@ -10,8 +10,9 @@
 //!   file in [`actuators`];
 //! - [`brain::Brain`] (sensor levels in, actuator levels out) and the
 //!   kinds a scene declares in [`brains`], wired by [`nervous_system`];
-//! - [`controller::Controller`] and [`controller::Actor`];
-//! - [`roobot`]: the hopping monopod and its FSM.
+//! - [`controller::Actor`]: whatever acts once per step beside the nervous
+//!   system (a jellyfish's own FSM, a bubble column);
+//! - [`roobot`]: the hopping monopod, its FSM and Raibert's controller.
 
 #![warn(missing_docs)]
 
@@ -32,5 +33,5 @@ pub mod sensors;
 pub mod vec_env;
 
 pub use brain::Brain;
-pub use controller::{Actor, Controller, Status};
+pub use controller::{Actor, Status};
 pub use nervous_system::NervousSystem;

@@ -1,21 +1,85 @@
-//! The sensors, actuators and controllers a scene file declares, wired
-//! together: once per step, before the world advances, every sensor is read,
-//! then each controller (in the order declared) turns its inputs' levels
-//! into its outputs' levels, and the actuators drive their parameters.
+//! A scene's sensors, actuators and controllers wired together: once per
+//! step, before the world advances, every sensor is read, then each
+//! controller (in the order declared) turns its inputs into its outputs'
+//! levels, the actuators drive their parameters, and gated actuators act
+//! only while their gate is open.
+//!
+//! A controller's inputs are sensor levels, or a creature's own senses
+//! ([`Senses`]: readings its brain takes raw, as the roobot's hopping FSM
+//! reads the hip's velocity). An output of NaN leaves its actuator as it is.
 //!
 //! An actuator may have a top speed (`rate`, levels per second): a
 //! controller's order then moves it at most `rate × dt` per step, as a
-//! muscle cannot change its length at once.
+//! muscle cannot change its length at once. It may have a gate: a motor
+//! that acts only while a sensor's level is above a threshold (or only
+//! while it is not), as the roobot's hip motor acts only in flight.
 //!
 //! Each actuator is driven by at most one controller; one that none drives
 //! stays at its level (which a program may set, [`NervousSystem::set_levels`]).
 
 use crate::actuators::AnyActuator;
 use crate::brain::Brain;
-use crate::controller::Actor;
 use crate::sensor::{unit, Sensor};
-use crate::sensors::ScaledSensor;
 use animats_engine::World;
+
+/// A creature's own senses: what its brain reads from the world, in the
+/// brain's own order and units (levels, raw readings, its actuators'
+/// levels).
+pub trait Senses: Send {
+    /// Inputs it gives.
+    fn count(&self) -> usize;
+    /// Reads them into `out`; `levels` are every sensor's level this step
+    /// (the scene's order) and `actuators` every actuator.
+    fn read(
+        &self,
+        world: &World,
+        levels: &[f64],
+        actuators: &[(String, AnyActuator)],
+        out: &mut [f64],
+    );
+}
+
+/// Where a controller's inputs come from.
+pub enum Inputs {
+    /// These sensors' levels (indices into [`NervousSystem::sensors`]).
+    Sensors(Vec<usize>),
+    /// A creature's own senses.
+    Senses(Box<dyn Senses>),
+}
+
+impl Inputs {
+    fn len(&self) -> usize {
+        match self {
+            Inputs::Sensors(s) => s.len(),
+            Inputs::Senses(s) => s.count(),
+        }
+    }
+}
+
+/// When a gated actuator acts: while sensor `sensor`'s level is above
+/// `threshold` (`above`), or while it is not (`!above`). A closed gate
+/// holds its motor's torque or its force at zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gate {
+    /// The sensor read (an index into [`NervousSystem::sensors`]).
+    pub sensor: usize,
+    /// The level compared.
+    pub threshold: f64,
+    /// Open above the threshold (else open at or below it).
+    pub above: bool,
+}
+
+impl Gate {
+    /// Whether the gate is open with the sensors at `levels`.
+    pub fn open(&self, levels: &[f64]) -> bool {
+        let l = levels[self.sensor];
+        if self.above {
+            l > self.threshold
+        } else {
+            l <= self.threshold
+        }
+    }
+}
 
 /// A controller and what it is wired to.
 pub struct Wired {
@@ -23,8 +87,8 @@ pub struct Wired {
     pub name: String,
     /// The brain.
     pub brain: Box<dyn Brain>,
-    /// Indices of its input sensors.
-    pub inputs: Vec<usize>,
+    /// Where its inputs come from.
+    pub inputs: Inputs,
     /// Indices of the actuators it drives.
     pub outputs: Vec<usize>,
     in_buf: Vec<f64>,
@@ -38,13 +102,13 @@ impl Wired {
         &self.out_buf
     }
 
-    /// Wires `brain` to sensors `inputs` and actuators `outputs`.
-    pub fn new(
-        name: String,
-        brain: Box<dyn Brain>,
-        inputs: Vec<usize>,
-        outputs: Vec<usize>,
-    ) -> Wired {
+    /// The inputs its brain read at the last step.
+    pub fn inputs_read(&self) -> &[f64] {
+        &self.in_buf
+    }
+
+    /// Wires `brain` to `inputs` and actuators `outputs`.
+    pub fn new(name: String, brain: Box<dyn Brain>, inputs: Inputs, outputs: Vec<usize>) -> Wired {
         let (ni, no) = (inputs.len(), outputs.len());
         Wired {
             name,
@@ -60,13 +124,17 @@ impl Wired {
 /// A scene's sensors, actuators and controllers.
 #[derive(Default)]
 pub struct NervousSystem {
-    /// Named sensors, in the scene's order.
-    pub sensors: Vec<(String, ScaledSensor)>,
+    /// Named sensors, in the scene's order (a scene's `[[sensor]]`
+    /// entries, a creature's own).
+    pub sensors: Vec<(String, Box<dyn Sensor + Send>)>,
     /// Named actuators, in the scene's order.
     pub actuators: Vec<(String, AnyActuator)>,
     /// The most each actuator's level may change per second (`None`: no
     /// limit), in the order of `actuators`.
     pub rates: Vec<Option<f64>>,
+    /// Each actuator's gate (`None`: it always acts), in the order of
+    /// `actuators`.
+    pub gates: Vec<Option<Gate>>,
     /// Controllers, in the scene's order.
     pub controllers: Vec<Wired>,
     levels: Vec<f64>,
@@ -81,6 +149,30 @@ impl NervousSystem {
     /// The index of the controller called `name`.
     pub fn controller(&self, name: &str) -> Option<usize> {
         self.controllers.iter().position(|c| c.name == name)
+    }
+
+    /// The index of the sensor called `name`.
+    pub fn sensor(&self, name: &str) -> Option<usize> {
+        self.sensors.iter().position(|(n, _)| n == name)
+    }
+
+    /// The index of the actuator called `name`.
+    pub fn actuator(&self, name: &str) -> Option<usize> {
+        self.actuators.iter().position(|(n, _)| n == name)
+    }
+
+    /// Adds an actuator (with its top speed and gate); returns its index.
+    pub fn add_actuator(
+        &mut self,
+        name: String,
+        actuator: AnyActuator,
+        rate: Option<f64>,
+        gate: Option<Gate>,
+    ) -> usize {
+        self.actuators.push((name, actuator));
+        self.rates.push(rate);
+        self.gates.push(gate);
+        self.actuators.len() - 1
     }
 
     /// Every sensor's level now, in the scene's order.
@@ -110,20 +202,31 @@ impl NervousSystem {
         Ok(())
     }
 
-    /// Reads the sensors and runs every controller for the step about to be
-    /// taken.
-    pub fn act(&mut self, world: &mut World, dt: f64) {
-        if self.controllers.is_empty() {
-            return;
-        }
+    fn read_sensors(&mut self, world: &World) {
         self.levels.clear();
         for (_, s) in &self.sensors {
             self.levels.push(s.level(world));
         }
+    }
+
+    /// Reads the sensors and runs every controller for the step about to be
+    /// taken, then applies the gates.
+    pub fn act(&mut self, world: &mut World, dt: f64) {
+        if self.controllers.is_empty() && self.gates.iter().all(Option::is_none) {
+            return;
+        }
+        self.read_sensors(world);
         let t = world.time();
         for c in &mut self.controllers {
-            for (x, &i) in c.in_buf.iter_mut().zip(&c.inputs) {
-                *x = self.levels[i];
+            match &c.inputs {
+                Inputs::Sensors(inputs) => {
+                    for (x, &i) in c.in_buf.iter_mut().zip(inputs) {
+                        *x = self.levels[i];
+                    }
+                }
+                Inputs::Senses(senses) => {
+                    senses.read(world, &self.levels, &self.actuators, &mut c.in_buf)
+                }
             }
             c.brain.think(t, dt, &c.in_buf, &mut c.out_buf);
             for (&o, &l) in c.outputs.iter().zip(&c.out_buf) {
@@ -136,12 +239,14 @@ impl NervousSystem {
                 );
             }
         }
+        self.apply_gates(world);
     }
 
     /// Drives every actuator towards `levels` (scene order) for the step
-    /// about to be taken, each at most its `rate` allows, and runs no
-    /// controller: a program outside the scene is the brain (the Python
-    /// environments). Levels must be finite; they are clamped to [0, 1].
+    /// about to be taken, each at most its `rate` allows, its gate applied,
+    /// and runs no controller: a program outside the scene is the brain
+    /// (the Python environments). Levels must be finite; they are clamped
+    /// to [0, 1].
     pub fn drive(&mut self, world: &mut World, levels: &[f64], dt: f64) -> Result<(), String> {
         if levels.len() != self.actuators.len() {
             return Err(format!(
@@ -165,22 +270,34 @@ impl NervousSystem {
                 dt,
             );
         }
+        if self.gates.iter().any(Option::is_some) {
+            self.read_sensors(world);
+            self.apply_gates(world);
+        }
         Ok(())
+    }
+
+    /// Holds each gated actuator's parameter at zero while its gate is
+    /// closed, at its level's value while open (the sensors as last read).
+    fn apply_gates(&mut self, world: &mut World) {
+        for ((_, a), gate) in self.actuators.iter().zip(&self.gates) {
+            if let Some(g) = gate {
+                a.gate(world, g.open(&self.levels));
+            }
+        }
     }
 }
 
-/// Moves `a` towards `level` (clamped to [0, 1]), at most `rate × dt`.
+/// Moves `a` towards `level` (clamped to [0, 1]), at most `rate × dt`; NaN
+/// leaves it as it is.
 fn slew(a: &mut AnyActuator, rate: Option<f64>, world: &mut World, level: f64, dt: f64) {
+    if level.is_nan() {
+        return;
+    }
     let mut level = unit(level);
     if let Some(rate) = rate {
         let now = a.level();
         level = now + (level - now).clamp(-rate * dt, rate * dt);
     }
     a.set_level(world, level);
-}
-
-impl Actor for NervousSystem {
-    fn act(&mut self, world: &mut World, dt: f64) {
-        NervousSystem::act(self, world, dt);
-    }
 }

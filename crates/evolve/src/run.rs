@@ -1,5 +1,5 @@
 //! An evolution run: independent lanes, each with its own optimiser over one
-//! problem (the roobot's 14 hopping parameters, or a scene's controller),
+//! problem (a scene's `[evolve]` controller: the thesis's roobot is one),
 //! advanced generation by generation.
 //!
 //! A generation asks each lane's optimiser for its population and evaluates
@@ -11,59 +11,42 @@
 //! same bits whatever the number of threads.
 
 use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
-use crate::problem::{Outcome, Problem, RoobotProblem, SceneEvolution};
-use animats_creatures::roobot::evaluate::EvalSettings;
-use animats_creatures::roobot::{HopParams, PARAM_COUNT};
-use animats_scene::evaluate::SceneProblem;
-use animats_scene::params::{format_best, LaneBest};
+use crate::problem::{Outcome, Problem, SceneEvolution};
+use animats_scene::def::LogName;
+use animats_scene::evaluate::{SceneProblem, MAX_LANES};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// What is evolved.
+/// What is evolved: a scene's `[evolve]` controller. The text is kept, so
+/// a resumed run evaluates the scene it started with even if the file has
+/// changed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "lowercase")]
-pub enum ProblemSpec {
-    /// The roobot's hopping gait.
-    Roobot {
-        /// Starting parameters of every lane.
-        start: Vec<f64>,
-        /// Longest evaluation, s.
-        seconds: f64,
-        /// Integration step, s.
-        dt: f64,
-    },
-    /// A scene's `[evolve]` controller. The text is kept, so a resumed run
-    /// evaluates the scene it started with even if the file has changed.
-    Scene {
-        /// The scene file, as named (for messages and relative paths).
-        file: String,
-        /// Its text.
-        text: String,
-    },
+#[serde(tag = "kind", rename = "scene")]
+pub struct ProblemSpec {
+    /// The scene file, as named (for messages and relative paths).
+    pub file: String,
+    /// Its text.
+    pub text: String,
 }
 
 impl ProblemSpec {
-    /// Builds the problem.
-    pub fn build(&self) -> Result<Box<dyn Problem>, String> {
-        match self {
-            ProblemSpec::Roobot { start, seconds, dt } => Ok(Box::new(RoobotProblem {
-                start: start.clone(),
-                settings: EvalSettings {
-                    seconds: *seconds,
-                    dt: *dt,
-                    ..EvalSettings::default()
-                },
-            })),
-            ProblemSpec::Scene { file, text } => Ok(Box::new(SceneEvolution(
-                animats_scene::evaluate::SceneProblem::parse(text, file)
-                    .map_err(|e| e.to_string())?,
-            ))),
+    /// The thesis's evolution of hopping gaits: the built-in
+    /// `scenes/hop_evolver.toml` (what `roobot` names).
+    pub fn thesis() -> ProblemSpec {
+        ProblemSpec {
+            file: animats_scene::HOP_EVOLVER_FILE.into(),
+            text: animats_scene::HOP_EVOLVER.into(),
         }
     }
 
-    /// True for the roobot.
-    pub fn is_roobot(&self) -> bool {
-        matches!(self, ProblemSpec::Roobot { .. })
+    /// Parses and checks the scene.
+    pub fn parse(&self) -> Result<SceneProblem, String> {
+        SceneProblem::parse(&self.text, &self.file).map_err(|e| e.to_string())
+    }
+
+    /// Builds the problem.
+    pub fn build(&self) -> Result<Box<dyn Problem>, String> {
+        Ok(Box::new(SceneEvolution(self.parse()?)))
     }
 }
 
@@ -86,11 +69,76 @@ pub struct Config {
     pub restarts: u32,
     /// What is evolved.
     pub problem: ProblemSpec,
+    /// What `log.csv` holds (the scene's `[evolve] log`).
+    #[serde(default)]
+    pub log: LogMode,
 }
 
+/// What `log.csv` holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LogMode {
+    /// A row per lane per generation.
+    #[default]
+    Generations,
+    /// A row per improvement, with its genes (the thesis's Table 6).
+    Improvements,
+}
+
+/// What a user may choose for a new run; `None` takes the default
+/// ([`Config::new`] says which). The command line and Python both fill it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Choices {
+    /// Lanes (default: the scene's `[evolve] lanes`, else 1).
+    pub lanes: Option<usize>,
+    /// Generations per lane (default 100).
+    pub generations: Option<u64>,
+    /// Seed (default 1).
+    pub seed: Option<u64>,
+    /// Optimiser (default the hill climber).
+    pub optimiser: Option<OptimiserKind>,
+    /// Candidates per generation (default: the optimiser's).
+    pub population: Option<usize>,
+    /// CMA-ES's restarts (default 0; only for CMA-ES).
+    pub restarts: Option<u32>,
+}
+
+/// Generations a run has unless told.
+pub const DEFAULT_GENERATIONS: u64 = 100;
+
 impl Config {
-    /// The thesis's experiment: `lanes` hill-climbing lanes from Appendix
-    /// B's initial parameters, 20 s evaluations at 8 ms.
+    /// A run of `problem` as `choices` say, the rest defaulted; refused
+    /// (naming the field) if the scene or a choice is not valid.
+    pub fn new(problem: ProblemSpec, choices: &Choices) -> Result<Config, String> {
+        let scene = problem.parse()?;
+        let spec = scene.spec();
+        let optimiser = choices.optimiser.unwrap_or(OptimiserKind::HillClimber);
+        if choices.restarts.is_some() && optimiser != OptimiserKind::CmaEs {
+            return Err(format!(
+                "restarts: are for the cma-es optimiser, not {}",
+                optimiser.name()
+            ));
+        }
+        let config = Config {
+            lanes: choices.lanes.or(spec.lanes).unwrap_or(1),
+            generations: choices.generations.unwrap_or(DEFAULT_GENERATIONS),
+            seed: choices.seed.unwrap_or(1),
+            optimiser,
+            population: choices.population,
+            restarts: choices.restarts.unwrap_or(0),
+            log: match spec.log {
+                LogName::Generations => LogMode::Generations,
+                LogName::Improvements => LogMode::Improvements,
+            },
+            problem,
+        };
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// The thesis's experiment (`animats evolve` without a scene): `lanes`
+    /// hill-climbing lanes from Appendix B's initial parameters, 20 s
+    /// evaluations at 8 ms (`scenes/hop_evolver.toml`).
     pub fn thesis(lanes: usize, generations: u64, seed: u64) -> Config {
         Config {
             lanes,
@@ -99,44 +147,20 @@ impl Config {
             optimiser: OptimiserKind::HillClimber,
             population: None,
             restarts: 0,
-            problem: ProblemSpec::Roobot {
-                start: HopParams::INITIAL.0.to_vec(),
-                seconds: 20.0,
-                dt: 0.008,
-            },
+            problem: ProblemSpec::thesis(),
+            log: LogMode::Improvements,
         }
     }
 
     /// Checks the configuration; the error names the field.
     pub fn validate(&self) -> Result<(), String> {
-        if self.lanes == 0 || self.lanes > 1024 {
+        if self.lanes == 0 || self.lanes > MAX_LANES {
             return Err(format!(
-                "lanes: must be between 1 and 1024, got {}",
+                "lanes: must be between 1 and {MAX_LANES}, got {}",
                 self.lanes
             ));
         }
-        if let ProblemSpec::Roobot { start, seconds, dt } = &self.problem {
-            if start.len() != PARAM_COUNT || !start.iter().all(|p| p.is_finite()) {
-                return Err(format!("start: must be {PARAM_COUNT} finite numbers"));
-            }
-            let positive = |x: f64| x > 0.0 && x.is_finite();
-            if !positive(*seconds) || !positive(*dt) {
-                return Err("seconds and dt must be positive".into());
-            }
-        }
         Ok(())
-    }
-
-    /// The roobot's evaluation settings (the thesis's for a scene run).
-    pub fn settings(&self) -> EvalSettings {
-        match &self.problem {
-            ProblemSpec::Roobot { seconds, dt, .. } => EvalSettings {
-                seconds: *seconds,
-                dt: *dt,
-                ..EvalSettings::default()
-            },
-            ProblemSpec::Scene { .. } => EvalSettings::default(),
-        }
     }
 
     /// The optimiser of lane `lane` for `problem`.
@@ -220,8 +244,8 @@ pub struct State {
     pub config: Config,
     /// Each lane.
     pub lanes: Vec<Lane>,
-    /// One row per lane per generation (the roobot's: per improvement), in
-    /// (generation, lane) order.
+    /// One row per lane per generation (or per improvement, as
+    /// [`Config::log`] says), in (generation, lane) order.
     pub log: Vec<LogRow>,
     /// Evaluations done so far.
     pub evaluations: u64,
@@ -249,6 +273,35 @@ impl State {
             log: Vec::new(),
             evaluations: 0,
         })
+    }
+
+    /// Continues this run (read from a checkpoint) as `choices` say: only
+    /// the generations may change, and not to fewer than are done.
+    pub fn resume(&mut self, choices: &Choices) -> Result<(), String> {
+        let c = &self.config;
+        if choices.lanes.is_some_and(|l| l != c.lanes)
+            || choices.seed.is_some_and(|s| s != c.seed)
+            || choices.optimiser.is_some_and(|o| o != c.optimiser)
+            || choices.population.is_some_and(|p| Some(p) != c.population)
+            || choices.restarts.is_some_and(|r| r != c.restarts)
+        {
+            return Err(format!(
+                "a resumed run keeps its scene, optimiser ({}), population, restarts, lanes ({}) and seed ({}); give only the generations",
+                c.optimiser.name(),
+                c.lanes,
+                c.seed
+            ));
+        }
+        if let Some(g) = choices.generations {
+            if g < self.generation() {
+                return Err(format!(
+                    "generations: {g} is fewer than the {} already done",
+                    self.generation()
+                ));
+            }
+            self.config.generations = g;
+        }
+        Ok(())
     }
 
     /// Checks a state read back from a checkpoint is consistent.
@@ -374,66 +427,41 @@ impl State {
 
     fn extend_log(&mut self, mut rows: Vec<LogRow>) {
         self.evaluations = self.lanes.iter().map(|l| l.evaluations).sum();
-        // The roobot's log (Table 6's shape) is its improvements only: a long
-        // run keeps as few rows as before in memory and in its checkpoint.
-        if self.config.problem.is_roobot() {
+        // A log of improvements (Table 6's shape) keeps only those: a long
+        // run keeps few rows in memory and in its checkpoint.
+        if self.config.log == LogMode::Improvements {
             rows.retain(|r| r.improved.is_some());
         }
         rows.sort_by_key(|r| (r.generation, r.lane));
         self.log.extend(rows);
     }
 
-    /// `best.toml`, as `animats evolve` writes it: for the roobot every
-    /// lane's best parameters; for a scene the whole scene with the best
-    /// lane's genome written in. `None` before the first generation.
+    /// `best.toml`, as `animats evolve` writes it: the whole scene with the
+    /// best lane's genome written in. `None` before the first generation.
     pub fn best_toml(&self) -> Result<Option<String>, String> {
-        match &self.config.problem {
-            ProblemSpec::Roobot { .. } => Ok(Some(self.roobot_best())),
-            ProblemSpec::Scene { file, text } => self.scene_best(file, text),
+        match self.best_lane() {
+            Some(lane) => self.lane_toml(lane.lane),
+            None => Ok(None),
         }
     }
 
-    fn roobot_best(&self) -> String {
-        let lanes: Vec<LaneBest> = self
-            .lanes
-            .iter()
-            .filter_map(|l| {
-                let b = l.best.as_ref()?;
-                let mut params = HopParams::INITIAL;
-                params.0.copy_from_slice(&b.genome);
-                Some(LaneBest {
-                    lane: l.lane,
-                    params,
-                    fitness: b.fitness,
-                    time_up: b.time,
-                    distance: b.distance,
-                })
-            })
-            .collect();
-        let comment = format!(
-            "Best roobot hopping parameters of `animats evolve` (seed {}, {} lanes, generation {}).\nLoad the best with `animats hop best.toml`, lane K's with `--lane K`.",
-            self.config.seed,
-            self.config.lanes,
-            self.generation()
-        );
-        format_best(&lanes, &comment)
-    }
-
-    fn scene_best(&self, file: &str, text: &str) -> Result<Option<String>, String> {
-        let Some(lane) = self.best_lane() else {
+    /// Lane `lane`'s best as a whole scene (`lanes/K.toml`); `None` before
+    /// its first generation or for a lane that does not exist.
+    pub fn lane_toml(&self, lane: usize) -> Result<Option<String>, String> {
+        let Some(l) = self.lanes.get(lane) else {
             return Ok(None);
         };
-        let Some(best) = &lane.best else {
+        let Some(best) = &l.best else {
             return Ok(None);
         };
-        let problem = SceneProblem::parse(text, file).map_err(|e| e.to_string())?;
+        let problem = self.config.problem.parse()?;
         let comment = format!(
-            "{file} with the best controller of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nlane {}, fitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate best.toml`; watch it with `animats view best.toml`.",
+            "{} with the best controller of lane {lane} of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate FILE`; watch it with `animats view FILE`.",
+            self.config.problem.file,
             self.config.optimiser.name(),
             self.config.seed,
             self.config.lanes,
             self.generation(),
-            lane.lane,
             best.fitness,
             best.distance,
             best.time,
@@ -442,15 +470,21 @@ impl State {
         problem.best_toml(&best.genome, &comment).map(Some)
     }
 
-    /// `log.csv`. For the roobot, the thesis's Table 6 shape as always: one
-    /// row per improvement with its 14 parameters. For a scene, one row per
-    /// lane per generation. Numbers in their shortest round-trip form.
+    /// `log.csv`: one row per lane per generation, or, for a log of
+    /// improvements, the thesis's Table 6 shape: one row per improvement
+    /// with its genes (`p0`, `p1`...; `time_up` is the time survived).
+    /// Numbers in their shortest round-trip form.
     pub fn log_csv(&self) -> String {
         let mut b = ryu::Buffer::new();
         let mut out = String::new();
-        if self.config.problem.is_roobot() {
+        if self.config.log == LogMode::Improvements {
             out.push_str("lane,generation,fitness,time_up,distance");
-            for i in 0..PARAM_COUNT {
+            let genes = self
+                .lanes
+                .iter()
+                .find_map(|l| l.best.as_ref())
+                .map_or(0, |b| b.genome.len());
+            for i in 0..genes {
                 out.push_str(&format!(",p{i}"));
             }
             out.push('\n');
@@ -581,8 +615,9 @@ fn advance_lanes(
 }
 
 /// Generations the first batch of a run advanced batch by batch takes
-/// (`animats evolve`, `animats bench hopper`).
-pub const FIRST_BATCH: u64 = 10;
+/// (`animats evolve`, `animats bench hopper`): one, since a generation of
+/// a long evaluation can take seconds; [`next_batch`] grows it.
+pub const FIRST_BATCH: u64 = 1;
 
 /// About how long a batch should take, s.
 const BATCH_SECONDS: f64 = 0.25;
@@ -642,13 +677,14 @@ fn record(
     let o = &outcomes[top];
     let f = crate::optimiser::sane(o.fitness);
     let improved = lane.best.as_ref().is_none_or(|b| f > b.fitness);
+    let ended = o.ended.to_string();
     if improved {
         lane.best = Some(Best {
             genome: population[top].clone(),
             fitness: f,
             time: o.time,
             distance: o.distance,
-            ended: o.ended.clone(),
+            ended: ended.clone(),
         });
     }
     Ok(LogRow {
@@ -659,7 +695,7 @@ fn record(
         best_fitness: lane.best.as_ref().map_or(o.fitness, |b| b.fitness),
         time: o.time,
         distance: o.distance,
-        ended: o.ended.clone(),
+        ended,
         improved: improved.then(|| population[top].clone()),
     })
 }

@@ -261,11 +261,12 @@ fn a_run_evaluated_elsewhere_equals_one_advanced_here() {
     let text = include_str!("../../cli/tests/crawler.toml");
     let scene = Config {
         optimiser: animats_evolve::optimiser::OptimiserKind::CmaEs,
-        problem: animats_evolve::run::ProblemSpec::Scene {
+        problem: animats_evolve::run::ProblemSpec {
             file: "crawler.toml".into(),
             text: text.into(),
         },
         generations: 4,
+        log: animats_evolve::LogMode::Generations,
         ..Config::thesis(2, 4, 5)
     };
     let a = run(scene.clone(), 2, 4);
@@ -364,4 +365,95 @@ fn batches_grow_towards_a_quarter_second() {
     assert_eq!(next_batch(1, Duration::from_secs(10)), 1);
     assert_eq!(next_batch(0, Duration::ZERO), 1);
     assert!(next_batch(u64::MAX, Duration::ZERO) >= 1);
+}
+
+#[test]
+fn a_runs_defaults_and_checks_are_the_librarys() {
+    use animats_evolve::optimiser::OptimiserKind;
+    use animats_evolve::{Choices, LogMode, ProblemSpec};
+    // The thesis's scene says its lanes (6) and its log (Table 6's shape);
+    // `Config::thesis` is that scene's run.
+    let thesis = Config::new(ProblemSpec::thesis(), &Choices::default()).unwrap();
+    assert_eq!(thesis, Config::thesis(6, 100, 1));
+    assert_eq!(thesis.log, LogMode::Improvements);
+    // A scene that says nothing: one lane, a row per generation.
+    let crawler = ProblemSpec {
+        file: "crawler.toml".into(),
+        text: include_str!("../../cli/tests/crawler.toml").into(),
+    };
+    let c = Config::new(crawler.clone(), &Choices::default()).unwrap();
+    assert_eq!((c.lanes, c.log), (1, LogMode::Generations));
+    let chosen = Choices {
+        lanes: Some(3),
+        optimiser: Some(OptimiserKind::CmaEs),
+        restarts: Some(2),
+        ..Choices::default()
+    };
+    let c = Config::new(crawler.clone(), &chosen).unwrap();
+    assert_eq!(
+        (c.lanes, c.optimiser, c.restarts),
+        (3, OptimiserKind::CmaEs, 2)
+    );
+    // Refused, naming the field.
+    for (choices, expect) in [
+        (
+            Choices {
+                restarts: Some(1),
+                ..Choices::default()
+            },
+            "restarts",
+        ),
+        (
+            Choices {
+                lanes: Some(0),
+                ..Choices::default()
+            },
+            "lanes",
+        ),
+        (
+            Choices {
+                lanes: Some(5000),
+                ..Choices::default()
+            },
+            "lanes",
+        ),
+    ] {
+        let e = Config::new(crawler.clone(), &choices).unwrap_err();
+        assert!(e.starts_with(expect), "{e}");
+    }
+    let bad = ProblemSpec {
+        file: "bad.toml".into(),
+        text: "[world]\nwings = 2\n".into(),
+    };
+    assert!(Config::new(bad, &Choices::default())
+        .unwrap_err()
+        .contains("bad.toml"));
+
+    // A resumed run takes only new generations, not fewer than done.
+    let mut s = run(Config::thesis(2, 10, 3), 1, 10);
+    let keep = s.clone();
+    for choices in [
+        Choices {
+            seed: Some(4),
+            ..Choices::default()
+        },
+        Choices {
+            lanes: Some(3),
+            ..Choices::default()
+        },
+        Choices {
+            generations: Some(5),
+            ..Choices::default()
+        },
+    ] {
+        assert!(s.resume(&choices).is_err(), "{choices:?}");
+        assert_eq!(s, keep);
+    }
+    s.resume(&Choices {
+        generations: Some(20),
+        seed: Some(3),
+        ..Choices::default()
+    })
+    .unwrap();
+    assert_eq!(s.config.generations, 20);
 }

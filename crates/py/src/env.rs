@@ -1,11 +1,10 @@
-//! `Env` and `VecEnv`: the roobot's or a scene's environment stepped from
-//! Python (the Gymnasium wrappers in `python/animats/gym.py` hold these).
+//! `Env` and `VecEnv`: a scene's environment (the roobot's is the thesis's
+//! scene) stepped from Python (the Gymnasium wrappers in
+//! `python/animats/gym.py` hold these).
 
 use crate::evaluate::problem_spec;
 use crate::{runtime_error, scene_error, value_error};
 use animats_creatures::env::{Env as _, Transition};
-use animats_creatures::roobot::env::RoobotEnv;
-use animats_creatures::roobot::evaluate::EvalSettings;
 use animats_creatures::vec_env::VecEnv as RustVecEnv;
 use animats_evolve::ProblemSpec;
 use animats_scene::env::SceneEnv;
@@ -17,33 +16,22 @@ use std::sync::Mutex;
 
 type Dyn = Box<dyn animats_creatures::env::Env>;
 
-/// How to make one copy.
+/// How to make one copy: the scene, and the episode's length and step when
+/// they are not the scene's.
 #[derive(Clone)]
-enum Recipe {
-    Roobot(Box<EvalSettings>),
-    Scene { file: String, text: String },
+struct Recipe {
+    scene: ProblemSpec,
+    seconds: Option<f64>,
+    dt: Option<f64>,
 }
 
 impl Recipe {
     fn new(what: &Bound<'_, PyAny>, seconds: Option<f64>, dt: Option<f64>) -> PyResult<Recipe> {
-        match problem_spec(what)? {
-            ProblemSpec::Roobot { .. } => {
-                let d = EvalSettings::default();
-                Ok(Recipe::Roobot(Box::new(EvalSettings {
-                    seconds: seconds.unwrap_or(d.seconds),
-                    dt: dt.unwrap_or(d.dt),
-                    ..d
-                })))
-            }
-            ProblemSpec::Scene { file, text } => {
-                if seconds.is_some() || dt.is_some() {
-                    return Err(value_error(
-                        "seconds and dt are the roobot's: a scene's are in its file ([evolve] duration, [world] dt)",
-                    ));
-                }
-                Ok(Recipe::Scene { file, text })
-            }
-        }
+        Ok(Recipe {
+            scene: problem_spec(what)?,
+            seconds,
+            dt,
+        })
     }
 
     fn make(&self, noise: f64) -> PyResult<Dyn> {
@@ -52,12 +40,11 @@ impl Recipe {
                 "noise must be a finite number ≥ 0, got {noise}"
             )));
         }
-        Ok(match self {
-            Recipe::Roobot(s) => Box::new(RoobotEnv::new(**s, noise).map_err(value_error)?),
-            Recipe::Scene { file, text } => {
-                Box::new(SceneEnv::parse(text, file, noise).map_err(scene_error)?)
-            }
-        })
+        let env = SceneEnv::parse(&self.scene.text, &self.scene.file, noise)
+            .map_err(scene_error)?
+            .with_timing(self.seconds, self.dt)
+            .map_err(value_error)?;
+        Ok(Box::new(env))
     }
 }
 
@@ -87,7 +74,8 @@ impl Env {
     /// `scene`: an `animats.Scene`, a path or "roobot". `noise`: each reset
     /// adds to every particle's velocity a uniform random vector of up to
     /// this (m/s per component), drawn from the reset's seed. `seconds` and
-    /// `dt` change the roobot's episode (20 s at 8 ms).
+    /// `dt` change the episode's length (the `[evolve]` duration) and step
+    /// (the scene's; the roobot's: 20 s at 8 ms).
     #[new]
     #[pyo3(signature = (scene, noise = 0.0, seconds = None, dt = None))]
     fn new(

@@ -19,7 +19,7 @@ pub(crate) fn problem_spec(what: &Bound<'_, PyAny>) -> PyResult<ProblemSpec> {
         if !s.is_evolvable() {
             return Err(no_evolve(&s.file));
         }
-        return Ok(ProblemSpec::Scene {
+        return Ok(ProblemSpec {
             file: s.file.clone(),
             text: s.text.clone(),
         });
@@ -30,12 +30,11 @@ pub(crate) fn problem_spec(what: &Bound<'_, PyAny>) -> PyResult<ProblemSpec> {
         )
     })?;
     if path.as_os_str() == "roobot" && !path.exists() {
-        let c = animats_evolve::Config::thesis(1, 1, 0);
-        return Ok(c.problem);
+        return Ok(ProblemSpec::thesis());
     }
     let file = path.display().to_string();
     let text = animats_scene::read(&path).map_err(scene_error)?;
-    Ok(ProblemSpec::Scene { file, text })
+    Ok(ProblemSpec { file, text })
 }
 
 pub(crate) fn build(spec: &ProblemSpec) -> PyResult<Box<dyn Problem>> {
@@ -116,7 +115,7 @@ impl Evaluator {
         Ok(Evaluator {
             problem: build(&spec)?,
             pool: pool(threads)?,
-            roobot: spec.is_roobot(),
+            roobot: spec == ProblemSpec::thesis(),
         })
     }
 
@@ -126,7 +125,7 @@ impl Evaluator {
         self.problem.dim()
     }
 
-    /// True for the roobot.
+    /// True for the roobot (the thesis's scene).
     #[getter]
     fn roobot(&self) -> bool {
         self.roobot
@@ -173,7 +172,7 @@ pub(crate) fn outcome_dict<'py>(py: Python<'py>, o: &[Outcome]) -> PyResult<Boun
     )?;
     d.set_item(
         "ended",
-        o.iter().map(|o| o.ended.clone()).collect::<Vec<_>>(),
+        o.iter().map(|o| o.ended.to_string()).collect::<Vec<_>>(),
     )?;
     Ok(d)
 }

@@ -6,7 +6,9 @@ use crate::evaluate::{build, outcome_dict, outcomes, problem_spec};
 use crate::{on, pool, runtime_error, value_error};
 use animats_evolve::optimiser::{Bounds, Optimiser as _};
 use animats_evolve::run::Generation;
-use animats_evolve::{AnyOptimiser, Config, OptimiserKind, Outcome, ProblemSpec, Setup, State};
+use animats_evolve::{
+    AnyOptimiser, Choices, Config, OptimiserKind, Outcome, ProblemSpec, Setup, State,
+};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -195,26 +197,20 @@ impl Evolution {
     ) -> PyResult<Evolution> {
         let spec = match scene {
             Some(s) => problem_spec(s)?,
-            None => Config::thesis(1, 1, 0).problem,
+            None => ProblemSpec::thesis(),
         };
-        let default_lanes = if spec.is_roobot() { 6 } else { 1 };
-        let kind = kind(optimiser)?;
-        if restarts > 0 && kind != OptimiserKind::CmaEs {
-            return Err(value_error(format!(
-                "restarts are for cma-es, not {}",
-                kind.name()
-            )));
-        }
         if !(1..=100_000_000).contains(&generations) {
             return Err(value_error("generations must be between 1 and 100000000"));
         }
-        let config = Config {
-            optimiser: kind,
+        let choices = Choices {
+            lanes,
+            generations: Some(generations),
+            seed: Some(seed),
+            optimiser: Some(kind(optimiser)?),
             population,
-            restarts,
-            problem: spec,
-            ..Config::thesis(lanes.unwrap_or(default_lanes), generations, seed)
+            restarts: (restarts > 0).then_some(restarts),
         };
+        let config = Config::new(spec, &choices).map_err(value_error)?;
         let problem = build(&config.problem)?;
         let state = State::new(config).map_err(value_error)?;
         Ok(Evolution {
@@ -275,13 +271,15 @@ impl Evolution {
             )));
         }
         let o: Vec<Outcome> = (0..n)
-            .map(|i| Outcome {
-                fitness: fitness[i],
-                time: time[i],
-                distance: distance[i],
-                ended: ended[i].clone(),
+            .map(|i| {
+                Ok(Outcome {
+                    fitness: fitness[i],
+                    time: time[i],
+                    distance: distance[i],
+                    ended: ended[i].parse().map_err(value_error)?,
+                })
             })
-            .collect();
+            .collect::<PyResult<_>>()?;
         self.state.tell(g, &o).map_err(value_error)
     }
 
@@ -361,20 +359,14 @@ impl Evolution {
         d.set_item("optimiser", c.optimiser.name())?;
         d.set_item("population", c.population)?;
         d.set_item("restarts", c.restarts)?;
-        match &c.problem {
-            ProblemSpec::Roobot { .. } => d.set_item("scene", "roobot")?,
-            ProblemSpec::Scene { file, .. } => d.set_item("scene", file)?,
-        }
+        d.set_item("scene", &c.problem.file)?;
         Ok(d)
     }
 
-    /// The problem as text a worker can rebuild: `("roobot", "")` or
-    /// `(file, scene text)`.
+    /// The problem as text a worker can rebuild: `(file, scene text)`.
     fn problem_text(&self) -> (String, String) {
-        match &self.state.config.problem {
-            ProblemSpec::Roobot { .. } => ("roobot".into(), String::new()),
-            ProblemSpec::Scene { file, text } => (file.clone(), text.clone()),
-        }
+        let p = &self.state.config.problem;
+        (p.file.clone(), p.text.clone())
     }
 
     /// `log.csv`, exactly as `animats evolve` writes it.

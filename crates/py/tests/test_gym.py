@@ -15,7 +15,7 @@ def test_roobot_passes_gymnasiums_checker():
     env = gymnasium.make("animats/Roobot-v0")
     check_env(env.unwrapped)
     assert env.observation_space.shape == (4,) and env.action_space.shape == (3,)
-    assert env.unwrapped.action_names == ["leg", "hip", "ankle"]
+    assert env.unwrapped.action_names == ["roobot.leg", "roobot.hip", "roobot.ankle"]
 
 
 def test_scene_passes_gymnasiums_checker(pogo_env):

@@ -207,6 +207,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         kinds: Vec::with_capacity(def.particle.len()),
         handles: Handles::default(),
         actors: Vec::new(),
+        nervous: Default::default(),
+        origins: Vec::new(),
         seed: wd.seed,
         gravity,
     };
@@ -233,6 +235,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         kinds,
         handles,
         actors,
+        mut nervous,
+        mut origins,
         ..
     } = cx;
 
@@ -243,13 +247,22 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .recommended_dt(world.integrator())
             .map_or(most, |r| r.min(most))
     });
-    let nervous = crate::nervous::build(def, src, &names, &handles, &mut world)?;
+    crate::nervous::build(
+        def,
+        src,
+        &names,
+        &handles,
+        &mut world,
+        &mut nervous,
+        &mut origins,
+    )?;
     let evolve = match &def.evolve {
         Some(entry) => Some(crate::evaluate::EvolveSpec::build(
             &at(src, "evolve", entry),
             entry.get_ref(),
             &names,
             &nervous,
+            &origins,
             &world,
             dt,
         )?),

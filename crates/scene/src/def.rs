@@ -461,7 +461,9 @@ pub enum ParamsEntry {
     Inline(Vec<f64>),
 }
 
-/// `[[roobot]]`: a hopping monopod with its FSM controller.
+/// `[[roobot]]`: a hopping monopod with its brain. Its sensors, actuators
+/// and brain join the scene's (`NAME.foot_height`..., `NAME.leg`...,
+/// controller `NAME`).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RoobotEntry {
@@ -473,8 +475,26 @@ pub struct RoobotEntry {
     /// Direction it faces, rad from +x, counter-clockwise seen from above.
     #[serde(default)]
     pub heading: f64,
-    /// Its hopping parameters; default `"evolved"`.
+    /// `hop` (the thesis's FSM), `raibert` or `none`; default `hop`.
+    #[serde(default)]
+    pub brain: RoobotBrainName,
+    /// `hop`: its hopping parameters; default `"evolved"`.
     pub params: Option<ParamsEntry>,
+    /// `raibert`: its 8 gains; default the hand-set ones.
+    pub gains: Option<Vec<f64>>,
+}
+
+/// A roobot's brain, as written in files.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RoobotBrainName {
+    /// The thesis's hopping FSM.
+    #[default]
+    Hop,
+    /// Raibert's three-part controller.
+    Raibert,
+    /// None: a program or a scene's controller drives its actuators.
+    None,
 }
 
 /// `[[food]]`: a fixed particle that jellyfish track.
@@ -637,6 +657,21 @@ pub struct ActuatorEntry {
     /// The most the level may change per second (a muscle's top speed);
     /// default: no limit.
     pub rate: Option<f64>,
+    /// A motor or force that acts only while a sensor's level is above a
+    /// threshold (or at most it); default: always.
+    pub gate: Option<GateEntry>,
+}
+
+/// `gate = { sensor = "...", above = x }` or `{ sensor = "...", at_most = x }`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GateEntry {
+    /// The sensor read, by name.
+    pub sensor: String,
+    /// Open while the level is above this.
+    pub above: Option<f64>,
+    /// Open while the level is at most this.
+    pub at_most: Option<f64>,
 }
 
 fn default_level() -> f64 {
@@ -758,6 +793,58 @@ pub struct EvolveEntry {
     /// The evaluation ends when any of these touches the floor; default none.
     #[serde(default)]
     pub fail_on_touch: Vec<String>,
+    /// m: how close to the floor a sphere's lowest point counts as touching
+    /// it, for `fail_on_touch`; default 0.001.
+    pub touch_tolerance: Option<f64>,
+    /// The evaluation ends when two particles are this far apart or more.
+    #[serde(default)]
+    pub fail_on_stretch: Vec<StretchEntry>,
+    /// How the hill climber mutates: `bounded` (steps in units of each
+    /// gene's bounds) or `relative` (Appendix B's: by a fraction of the
+    /// gene's value, ignoring bounds); default `bounded`.
+    #[serde(default)]
+    pub mutation: MutationName,
+    /// What `log.csv` holds: `generations` (a row per lane per generation)
+    /// or `improvements` (a row per improvement, with its genes: the
+    /// thesis's Table 6); default `generations`.
+    #[serde(default)]
+    pub log: LogName,
+    /// Lanes `animats evolve` runs unless told; default 1.
+    pub lanes: Option<usize>,
+}
+
+/// `fail_on_stretch = [{ a = "...", b = "...", length = 1.0 }]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StretchEntry {
+    /// One particle.
+    pub a: String,
+    /// The other.
+    pub b: String,
+    /// m: the run ends once they are at least this far apart.
+    pub length: f64,
+}
+
+/// `[evolve] mutation`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum MutationName {
+    /// In units of the genes' bounds.
+    #[default]
+    Bounded,
+    /// By a fraction of each gene's value (Appendix B).
+    Relative,
+}
+
+/// `[evolve] log`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum LogName {
+    /// A row per lane per generation.
+    #[default]
+    Generations,
+    /// A row per improvement, with its genes.
+    Improvements,
 }
 
 fn default_eval_duration() -> f64 {

@@ -28,6 +28,8 @@ pub struct SceneEnv {
     steps: u64,
     fitness: f64,
     over: bool,
+    /// The step, when it is not the scene's.
+    dt: Option<f64>,
 }
 
 impl SceneEnv {
@@ -76,9 +78,41 @@ impl SceneEnv {
             steps: 0,
             fitness: 0.0,
             over: false,
+            dt: None,
         };
         env.reset(0).map_err(|e| SceneError::file(file, e))?;
         Ok(env)
+    }
+
+    /// Episodes of `seconds` (instead of the `[evolve]` duration) in steps
+    /// of `dt` (instead of the scene's).
+    pub fn with_timing(
+        mut self,
+        seconds: Option<f64>,
+        dt: Option<f64>,
+    ) -> Result<SceneEnv, String> {
+        let positive = |name: &str, x: f64| {
+            if x > 0.0 && x.is_finite() {
+                Ok(x)
+            } else {
+                Err(format!("{name} must be a positive number, got {x}"))
+            }
+        };
+        if let Some(s) = seconds {
+            self.spec.duration = positive("seconds", s)?;
+        }
+        if let Some(d) = dt {
+            self.dt = Some(positive("dt", d)?);
+        }
+        let steps = self.spec.duration / self.dt.unwrap_or(self.scene.dt);
+        if steps > crate::evaluate::MAX_STEPS {
+            return Err(format!(
+                "an episode of {steps:.3e} steps, more than {:e}",
+                crate::evaluate::MAX_STEPS
+            ));
+        }
+        self.reset(0)?;
+        Ok(self)
     }
 
     /// Reads and parses a scene file.
@@ -131,10 +165,13 @@ impl Env for SceneEnv {
 
     fn reset(&mut self, seed: u64) -> Result<(), String> {
         let mut scene = self.problem.fresh()?;
+        if let Some(dt) = self.dt {
+            scene.dt = dt;
+        }
         perturb(&mut scene.world, seed, self.noise)?;
         self.start = self.spec.centre(&scene.world);
         self.last = self.start;
-        self.over = self.spec.touching(&scene.world).is_some();
+        self.over = self.spec.ending(&scene.world).is_some();
         self.scene = scene;
         self.steps = 0;
         self.fitness = 0.0;
@@ -143,7 +180,7 @@ impl Env for SceneEnv {
 
     fn observe(&self, out: &mut [f64]) {
         for (o, (_, s)) in out.iter_mut().zip(&self.scene.nervous.sensors) {
-            *o = animats_creatures::sensor::Sensor::level(s, &self.scene.world);
+            *o = s.level(&self.scene.world);
         }
     }
 
@@ -166,7 +203,7 @@ impl Env for SceneEnv {
         let fitness = self.score(blew_up);
         let reward = fitness - self.fitness;
         self.fitness = fitness;
-        let terminated = blew_up || self.spec.touching(&self.scene.world).is_some();
+        let terminated = blew_up || self.spec.ending(&self.scene.world).is_some();
         let t = Transition::after(reward, terminated, self.steps, self.max_steps());
         self.over = t.ends();
         Ok(t)

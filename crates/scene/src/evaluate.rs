@@ -1,6 +1,7 @@
 //! A scene's `[evolve]` evaluation: run the scene from its start for
-//! `duration` seconds (or until one of `fail_on_touch` touches the floor, or
-//! the simulation blows up) and score it with the thesis's form (§3.2.1.6):
+//! `duration` seconds (or until one of `fail_on_touch` touches the floor,
+//! two particles of `fail_on_stretch` are too far apart, or the simulation
+//! blows up) and score it with the thesis's form (§3.2.1.6):
 //! `fitness = time_weight × time survived + distance_weight × distance`,
 //! the distance being how far the centre of mass of `particles` moved along
 //! `axis`. A run that blows up keeps the time it survived but no forward
@@ -10,14 +11,16 @@
 //! [`SceneProblem`] evaluates genomes: it parses the scene once, and for
 //! each genome builds the world afresh, writes the genome into the
 //! `[evolve]` controller and runs the evaluation; [`SceneProblem::best_toml`]
-//! writes a genome back into the scene's own text.
+//! writes a genome back into the scene's own text, where the brain's
+//! [`animats_creatures::brain::GenomeKey`]s say.
 
 use crate::build::{At, Names};
-use crate::def::{ControllerEntry, EvolveEntry, SceneDef};
+use crate::def::{EvolveEntry, LogName, MutationName, SceneDef};
 use crate::error::SceneError;
 use crate::source::Source;
 use crate::Scene;
-use animats_creatures::sensors::probe::touches_floor;
+use animats_creatures::brain::GenomeKey;
+use animats_creatures::sensors::probe::TOUCH_TOLERANCE;
 use animats_creatures::NervousSystem;
 use animats_engine::{DVec3, ParticleId, World};
 use std::fmt;
@@ -47,6 +50,32 @@ pub struct EvolveSpec {
     pub time_weight: f64,
     /// The evaluation ends when any of these touches the floor.
     pub fail_on_touch: Vec<(ParticleId, String)>,
+    /// How close to the floor counts as touching it, m.
+    pub touch_tolerance: f64,
+    /// The evaluation ends when these two are at least this far apart, m.
+    pub fail_on_stretch: Vec<Stretch>,
+    /// The table the controller was written in (`controller`, 2), where its
+    /// genes are written back.
+    pub table: (&'static str, usize),
+    /// How the hill climber mutates.
+    pub mutation: MutationName,
+    /// What `log.csv` holds.
+    pub log: LogName,
+    /// Lanes to run unless told.
+    pub lanes: Option<usize>,
+}
+
+/// A `fail_on_stretch` rule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stretch {
+    /// One end.
+    pub a: ParticleId,
+    /// The other.
+    pub b: ParticleId,
+    /// The length that ends the run, m.
+    pub length: f64,
+    /// `a-b`, by their names.
+    pub name: String,
 }
 
 impl EvolveSpec {
@@ -55,6 +84,7 @@ impl EvolveSpec {
         e: &EvolveEntry,
         names: &Names,
         nervous: &NervousSystem,
+        origins: &[(&'static str, usize)],
         world: &World,
         dt: f64,
     ) -> Result<EvolveSpec, SceneError> {
@@ -102,12 +132,45 @@ impl EvolveSpec {
             .iter()
             .map(|n| Ok((names.one(at, "fail_on_touch", n)?, n.clone())))
             .collect::<Result<_, SceneError>>()?;
+        let touch_tolerance = match e.touch_tolerance {
+            None => TOUCH_TOLERANCE,
+            Some(t) => {
+                let t = at.finite("touch_tolerance", t)?;
+                if t < 0.0 {
+                    return Err(at.err("touch_tolerance", format!("must be >= 0, got {t}")));
+                }
+                t
+            }
+        };
+        let fail_on_stretch = e
+            .fail_on_stretch
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let f = |k: &str| format!("fail_on_stretch[{i}].{k}");
+                Ok(Stretch {
+                    a: names.one(at, &f("a"), &s.a)?,
+                    b: names.one(at, &f("b"), &s.b)?,
+                    length: at.positive(&f("length"), s.length)?,
+                    name: format!("{}-{}", s.a, s.b),
+                })
+            })
+            .collect::<Result<_, SceneError>>()?;
         if nervous.controllers[index].brain.genome().is_empty() {
             return Err(at.err(
                 "controller",
                 format!("controller `{}` has no parameters to evolve", e.controller),
             ));
         }
+        let lanes = match e.lanes {
+            Some(l) if !(1..=crate::evaluate::MAX_LANES).contains(&l) => {
+                return Err(at.err(
+                    "lanes",
+                    format!("must be between 1 and {MAX_LANES}, got {l}"),
+                ))
+            }
+            other => other,
+        };
         Ok(EvolveSpec {
             controller: e.controller.clone(),
             index,
@@ -117,11 +180,21 @@ impl EvolveSpec {
             distance_weight: at.finite("distance_weight", e.distance_weight)?,
             time_weight: at.finite("time_weight", e.time_weight)?,
             fail_on_touch,
+            touch_tolerance,
+            fail_on_stretch,
+            table: origins[index],
+            mutation: e.mutation,
+            log: e.log,
+            lanes,
         })
     }
 
-    /// The centre of mass of the particles that count.
+    /// The centre of mass of the particles that count (of one particle:
+    /// its position, exactly).
     pub fn centre(&self, world: &World) -> DVec3 {
+        if let [p] = self.particles[..] {
+            return world.position(p);
+        }
         let (mut sum, mut m) = (DVec3::ZERO, 0.0);
         let mass = &world.particles().mass;
         for p in &self.particles {
@@ -135,14 +208,26 @@ impl EvolveSpec {
         }
     }
 
-    /// The first of `fail_on_touch` touching the floor now.
-    pub fn touching(&self, world: &World) -> Option<&str> {
-        self.fail_on_touch
+    /// The end rule that holds now, if any: the first of `fail_on_touch`
+    /// touching the floor, else the first of `fail_on_stretch` stretched.
+    pub fn ending(&self, world: &World) -> Option<Ended> {
+        let radius = &world.particles().radius;
+        let touch = self
+            .fail_on_touch
             .iter()
-            .find(|(p, _)| touches_floor(world, *p))
-            .map(|(_, n)| n.as_str())
+            .find(|(p, _)| world.position(*p).y - radius[p.index()] <= self.touch_tolerance);
+        if let Some((_, n)) = touch {
+            return Some(Ended::Touch(n.clone()));
+        }
+        self.fail_on_stretch
+            .iter()
+            .find(|s| (world.position(s.a) - world.position(s.b)).length() >= s.length)
+            .map(|s| Ended::Stretch(s.name.clone()))
     }
 }
+
+/// The most lanes a run may have.
+pub const MAX_LANES: usize = 1024;
 
 /// Why an evaluation ended.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -151,6 +236,8 @@ pub enum Ended {
     Timeout,
     /// This particle of `fail_on_touch` touched the floor.
     Touch(String),
+    /// These particles of `fail_on_stretch` (`a-b`) were too far apart.
+    Stretch(String),
     /// The simulation blew up.
     BlowUp,
 }
@@ -160,12 +247,30 @@ impl fmt::Display for Ended {
         match self {
             Ended::Timeout => f.write_str("timeout"),
             Ended::Touch(p) => write!(f, "touch {p}"),
+            Ended::Stretch(p) => write!(f, "stretch {p}"),
             Ended::BlowUp => f.write_str("blow-up"),
         }
     }
 }
 
-/// The outcome of one evaluation.
+impl std::str::FromStr for Ended {
+    type Err = String;
+    /// Reads what [`Ended`]'s `Display` writes.
+    fn from_str(s: &str) -> Result<Ended, String> {
+        match s.split_once(' ') {
+            None if s == "timeout" => Ok(Ended::Timeout),
+            None if s == "blow-up" => Ok(Ended::BlowUp),
+            Some(("touch", p)) if !p.is_empty() => Ok(Ended::Touch(p.to_string())),
+            Some(("stretch", p)) if !p.is_empty() => Ok(Ended::Stretch(p.to_string())),
+            _ => Err(format!(
+                "`{s}` is not an ending: timeout, touch PARTICLE, stretch A-B or blow-up"
+            )),
+        }
+    }
+}
+
+/// The outcome of one evaluation: what every front end reports and every
+/// optimiser is told.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Evaluation {
     /// `time_weight × time + distance_weight × distance`.
@@ -195,8 +300,8 @@ pub fn evaluate_with(
     let mut ended = Ended::Timeout;
     let mut last = start;
     observe(&scene);
-    if let Some(p) = spec.touching(&scene.world) {
-        ended = Ended::Touch(p.to_string());
+    if let Some(end) = spec.ending(&scene.world) {
+        ended = end;
     } else {
         while done < steps {
             if scene.step(dt).is_err() {
@@ -211,8 +316,8 @@ pub fn evaluate_with(
                 break;
             }
             last = c;
-            if let Some(p) = spec.touching(&scene.world) {
-                ended = Ended::Touch(p.to_string());
+            if let Some(end) = spec.ending(&scene.world) {
+                ended = end;
                 break;
             }
         }
@@ -241,9 +346,10 @@ pub struct SceneProblem {
     file: String,
     text: String,
     def: SceneDef,
-    controller: usize,
+    spec: EvolveSpec,
     start: Vec<f64>,
     bounds: Vec<(f64, f64)>,
+    keys: Vec<GenomeKey>,
 }
 
 impl SceneProblem {
@@ -259,16 +365,25 @@ impl SceneProblem {
             )
         })?;
         let brain = &scene.nervous.controllers[spec.index].brain;
-        // Controllers are built in the order written: the same index.
-        let controller = spec.index;
         Ok(SceneProblem {
             file: file.to_string(),
             text: text.to_string(),
             start: brain.genome(),
             bounds: brain.bounds(),
+            keys: brain.genome_keys(),
+            spec: spec.clone(),
             def,
-            controller,
         })
+    }
+
+    /// The scene's `[evolve]` table, resolved.
+    pub fn spec(&self) -> &EvolveSpec {
+        &self.spec
+    }
+
+    /// The scene's text, as given.
+    pub fn text(&self) -> &str {
+        &self.text
     }
 
     /// Reads and parses a scene file.
@@ -323,13 +438,13 @@ impl SceneProblem {
             .text
             .parse()
             .map_err(|e| format!("{}: {e}", self.file))?;
-        let entry = self.def.controller[self.controller].get_ref();
+        let (kind, k) = self.spec.table;
         let table = doc
-            .get_mut("controller")
+            .get_mut(kind)
             .and_then(|c| c.as_array_of_tables_mut())
-            .and_then(|a| a.get_mut(self.controller))
-            .ok_or("the controller table is not where the scene had it")?;
-        write_genome(table, entry, genome)?;
+            .and_then(|a| a.get_mut(k))
+            .ok_or_else(|| format!("{kind}[{k}] is not where the scene had it"))?;
+        write_genome(table, &self.keys, genome)?;
         let mut out = String::new();
         for line in comment.lines() {
             out.push_str("# ");
@@ -341,78 +456,61 @@ impl SceneProblem {
     }
 }
 
-fn array(values: &[f64]) -> toml_edit::Item {
-    let mut a = toml_edit::Array::new();
-    for v in values {
-        a.push(*v);
-    }
-    toml_edit::value(a)
-}
-
-/// Writes `genome` into a controller's table in the layout its kind's
-/// brain documents (`crates/creatures/src/brains/`).
+/// Writes `genome` into a brain's `table`, key by key as the brain's
+/// [`GenomeKey`]s lay it out.
 fn write_genome(
     table: &mut toml_edit::Table,
-    c: &ControllerEntry,
-    g: &[f64],
+    keys: &[GenomeKey],
+    genome: &[f64],
 ) -> Result<(), String> {
-    let n = c.outputs.len();
-    match c.kind.as_str() {
-        "oscillator" if g.len() == 1 + 3 * n => {
-            table["frequency"] = toml_edit::value(g[0]);
-            table["amplitude"] = array(&g[1..1 + n]);
-            table["phase"] = array(&g[1 + n..1 + 2 * n]);
-            table["offset"] = array(&g[1 + 2 * n..]);
-        }
-        "neural" => {
-            table["weights"] = array(g);
-        }
-        "fsm" => {
-            let states = c.state.as_deref().unwrap_or_default();
-            let tables = table
-                .get_mut("state")
-                .and_then(|s| s.as_array_of_tables_mut())
-                .ok_or("the FSM's states are not an array of tables")?;
-            let mut k = 0;
-            let mut take = |count: usize| -> Result<&[f64], String> {
-                let s = g
-                    .get(k..k + count)
-                    .ok_or("the genome is too short for this FSM")?;
-                k += count;
-                Ok(s)
-            };
-            for (i, s) in states.iter().enumerate() {
-                let st = tables.get_mut(i).ok_or("an FSM state is missing")?;
-                st["levels"] = array(take(n)?);
-                if s.rate.is_some() {
-                    st["rate"] = toml_edit::value(take(1)?[0]);
+    let need: usize = keys.iter().map(GenomeKey::genes).sum();
+    if need != genome.len() {
+        return Err(format!(
+            "a genome of {} numbers for a brain whose table holds {need}",
+            genome.len()
+        ));
+    }
+    let mut at = 0;
+    for key in keys {
+        let genes = &genome[at..at + key.genes()];
+        at += key.genes();
+        let value = match key.len {
+            None => toml_edit::value(genes[0]),
+            Some(_) => {
+                let mut a = toml_edit::Array::new();
+                for v in genes {
+                    a.push(*v);
                 }
-                if s.transition.is_empty() {
-                    continue;
-                }
-                let trs = st
-                    .get_mut("transition")
-                    .and_then(|t| t.as_array_of_tables_mut())
-                    .ok_or("an FSM state's transitions are not an array of tables")?;
-                for (j, t) in s.transition.iter().enumerate() {
-                    let tt = trs.get_mut(j).ok_or("an FSM transition is missing")?;
-                    if t.sensor.is_some() {
-                        let key = if t.above.is_some() { "above" } else { "below" };
-                        tt[key] = toml_edit::value(take(1)?[0]);
-                    }
-                    if t.after.is_some() {
-                        tt["after"] = toml_edit::value(take(1)?[0]);
-                    }
-                }
+                toml_edit::value(a)
             }
-        }
-        _ => {
-            return Err(format!(
-                "cannot write a genome of {} numbers into a `{}` controller",
-                g.len(),
-                c.kind
-            ))
-        }
+        };
+        *slot(table, &key.path)? = value;
     }
     Ok(())
+}
+
+/// The item at `path` (`state[1].transition[0].above`) below `table`,
+/// made if its last key is missing.
+fn slot<'t>(
+    table: &'t mut toml_edit::Table,
+    path: &str,
+) -> Result<&'t mut toml_edit::Item, String> {
+    let (parents, last) = match path.rsplit_once('.') {
+        Some((p, l)) => (Some(p), l),
+        None => (None, path),
+    };
+    let mut here = table;
+    for part in parents.into_iter().flat_map(|p| p.split('.')) {
+        let (name, index) = part
+            .strip_suffix(']')
+            .and_then(|p| p.split_once('['))
+            .and_then(|(n, i)| Some((n, i.parse::<usize>().ok()?)))
+            .ok_or_else(|| format!("`{path}`: `{part}` is not a table array's entry"))?;
+        here = here
+            .get_mut(name)
+            .and_then(|t| t.as_array_of_tables_mut())
+            .and_then(|a| a.get_mut(index))
+            .ok_or_else(|| format!("`{path}`: the scene has no `{part}`"))?;
+    }
+    Ok(&mut here[last])
 }

@@ -153,6 +153,15 @@ impl Scene {
     }
 }
 
+/// The thesis's evolution of hopping gaits as a scene
+/// (`scenes/hop_evolver.toml`), built in: what `animats evolve` runs
+/// without a scene, and what `roobot` names on the command line and in
+/// Python.
+pub const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
+
+/// The name [`HOP_EVOLVER`] goes by in messages.
+pub const HOP_EVOLVER_FILE: &str = "scenes/hop_evolver.toml";
+
 /// The largest scene file read, bytes (a scene at the particle limit,
 /// [`build::MAX_PARTICLES`], comes from a few short entries, not megabytes).
 pub const MAX_FILE_BYTES: u64 = 64 << 20;

@@ -12,7 +12,7 @@ use animats_creatures::actuators::{
 };
 use animats_creatures::brain::Brain;
 use animats_creatures::brains::{Condition, Fsm, FsmState, Neural, Oscillator, Transition};
-use animats_creatures::nervous_system::{NervousSystem, Wired};
+use animats_creatures::nervous_system::{Gate, Inputs, NervousSystem, Wired};
 use animats_creatures::sensors::{Probe, ScaledSensor};
 use animats_engine::{AngleJointId, ConstantForceId, DVec3, SpringId, TorqueJointId, World};
 use std::collections::HashMap;
@@ -59,43 +59,73 @@ fn lookup<T: Copy>(
     })
 }
 
-/// Builds every actuator, sensor and controller of the scene.
+/// Builds every actuator, sensor and controller of the scene into `ns`,
+/// which holds what creatures brought; `origins` says, for each controller,
+/// the table it was written in, and gains the scene's own.
 pub(crate) fn build(
     def: &SceneDef,
     src: &Source,
     names: &Names,
     handles: &Handles,
     world: &mut World,
-) -> Result<NervousSystem, SceneError> {
-    let mut ns = NervousSystem::default();
+    ns: &mut NervousSystem,
+    origins: &mut Vec<(&'static str, usize)>,
+) -> Result<(), SceneError> {
+    let mut gated = Vec::new();
     for (k, entry) in def.actuator.iter().enumerate() {
         let at = at(src, format!("actuator[{k}]"), entry);
-        let a = actuator(&at, entry.get_ref(), handles, world)?;
-        if ns.actuators.iter().any(|(n, _)| *n == entry.get_ref().name) {
-            return Err(at.err(
-                "name",
-                format!("duplicate actuator name `{}`", entry.get_ref().name),
-            ));
+        let e = entry.get_ref();
+        let a = actuator(&at, e, handles, world)?;
+        if ns.actuator(&e.name).is_some() {
+            return Err(at.err("name", format!("duplicate actuator name `{}`", e.name)));
         }
-        let rate = match entry.get_ref().rate {
+        let rate = match e.rate {
             Some(r) => Some(at.positive("rate", r)?),
             None => None,
         };
-        ns.actuators.push((entry.get_ref().name.clone(), a));
-        ns.rates.push(rate);
+        if e.gate.is_some() && !a.can_gate() {
+            return Err(at.err(
+                "gate",
+                "only a torque joint's torque or a constant force can be gated (a rest length or angle has no \"off\")",
+            ));
+        }
+        let index = ns.add_actuator(e.name.clone(), a, rate, None);
+        if let Some(g) = &e.gate {
+            gated.push((index, at, g));
+        }
     }
     for (k, entry) in def.sensor.iter().enumerate() {
         let at = at(src, format!("sensor[{k}]"), entry);
         let s = sensor(&at, entry.get_ref(), names)?;
-        if ns.sensors.iter().any(|(n, _)| *n == entry.get_ref().name) {
+        if ns.sensor(&entry.get_ref().name).is_some() {
             return Err(at.err(
                 "name",
                 format!("duplicate sensor name `{}`", entry.get_ref().name),
             ));
         }
-        ns.sensors.push((entry.get_ref().name.clone(), s));
+        ns.sensors.push((entry.get_ref().name.clone(), Box::new(s)));
+    }
+    for (index, at, g) in gated {
+        let sensor = ns
+            .sensor(&g.sensor)
+            .ok_or_else(|| at.err("gate.sensor", format!("no sensor named `{}`", g.sensor)))?;
+        let (threshold, above) = match (g.above, g.at_most) {
+            (Some(x), None) => (at.finite("gate.above", x)?, true),
+            (None, Some(x)) => (at.finite("gate.at_most", x)?, false),
+            _ => return Err(at.err("gate", "give exactly one of `above` and `at_most`")),
+        };
+        ns.gates[index] = Some(Gate {
+            sensor,
+            threshold,
+            above,
+        });
     }
     let mut driven_by: Vec<Option<String>> = vec![None; ns.actuators.len()];
+    for c in &ns.controllers {
+        for &o in &c.outputs {
+            driven_by[o] = Some(c.name.clone());
+        }
+    }
     for (k, entry) in def.controller.iter().enumerate() {
         let c = entry.get_ref();
         let at = at(src, format!("controller[{k}]"), entry);
@@ -107,9 +137,7 @@ pub(crate) fn build(
             .inputs
             .iter()
             .map(|n| {
-                ns.sensors
-                    .iter()
-                    .position(|(s, _)| s == n)
+                ns.sensor(n)
                     .ok_or_else(|| at.err("inputs", format!("no sensor named `{n}`")))
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -119,9 +147,7 @@ pub(crate) fn build(
         let mut outputs = Vec::with_capacity(c.outputs.len());
         for n in &c.outputs {
             let i = ns
-                .actuators
-                .iter()
-                .position(|(a, _)| a == n)
+                .actuator(n)
                 .ok_or_else(|| at.err("outputs", format!("no actuator named `{n}`")))?;
             if let Some(other) = &driven_by[i] {
                 return Err(at.err(
@@ -134,10 +160,15 @@ pub(crate) fn build(
         }
         let levels: Vec<f64> = outputs.iter().map(|&i| ns.actuators[i].1.level()).collect();
         let brain = brain(&at, c, levels)?;
-        ns.controllers
-            .push(Wired::new(c.name.clone(), brain, inputs, outputs));
+        ns.controllers.push(Wired::new(
+            c.name.clone(),
+            brain,
+            Inputs::Sensors(inputs),
+            outputs,
+        ));
+        origins.push(("controller", k));
     }
-    Ok(ns)
+    Ok(())
 }
 
 fn actuator(

@@ -73,7 +73,7 @@ pub struct CreatureState {
     /// Its name.
     pub name: String,
     /// Its controller state.
-    pub state: &'static str,
+    pub state: String,
     /// Its energy, if it has one.
     pub energy: Option<f64>,
     /// Its pulse phase, if it has one.

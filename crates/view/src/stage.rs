@@ -266,17 +266,27 @@ impl Stage for SceneStage {
     }
 
     fn creatures(&self) -> Vec<CreatureState> {
-        self.scene
+        // Brains with states (an FSM's), then creatures acting on their own.
+        let brains = self.scene.nervous.controllers.iter().filter_map(|c| {
+            Some(CreatureState {
+                name: c.name.clone(),
+                state: c.brain.state()?.to_string(),
+                energy: None,
+                phase: None,
+            })
+        });
+        let actors = self
+            .scene
             .actors
             .iter()
             .filter_map(|a| a.status())
             .map(|s| CreatureState {
                 name: s.name,
-                state: s.state,
+                state: s.state.to_string(),
                 energy: s.energy,
                 phase: s.phase,
-            })
-            .collect()
+            });
+        brains.chain(actors).collect()
     }
 
     fn focus(&self) -> Option<[f64; 3]> {

@@ -7,8 +7,8 @@
 //!
 //! - `protocol.rs`: the JSON messages;
 //! - `animats-view` (a crate below this one and the renderer): what is run
-//!   and drawn; `exhibition.rs`: the roobot evolution's exhibition stage;
-//!   `scene_exhibition.rs`: a scene evolution's (its best brain so far);
+//!   and drawn; `exhibition.rs`: an evolution's exhibition stage (its best
+//!   brain so far);
 //! - `runner.rs`: the simulation thread, pacing and commands;
 //! - `server.rs`: routes, the WebSocket, and the bounds on hostile clients;
 //! - `access.rs`: the access token required off the loopback address;
@@ -20,16 +20,14 @@ pub mod access;
 pub mod exhibition;
 pub mod protocol;
 pub mod runner;
-pub mod scene_exhibition;
 pub mod server;
 pub use animats_view::stage;
 
 pub use animats_view::{SceneStage, Stage};
-pub use exhibition::Exhibition;
+pub use exhibition::{BestBrain, Exhibition};
 
 pub use runner::Summary;
 use runner::{Outlets, Runner};
-pub use scene_exhibition::{BestBrain, SceneExhibition};
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Arc;

@@ -1,10 +1,7 @@
 //! What the viewer runs: a scene file's stage (moving the food steers the
 //! jellyfish; the pile's overlay counts its sleeping rocks) and the
-//! exhibition of an evolution's champions.
+//! exhibition of an evolution's best brain.
 
-use animats_creatures::roobot::evaluate::EvalSettings;
-use animats_creatures::roobot::HopParams;
-use animats_viewer::exhibition::{Showcase, LANE_SPACING};
 use animats_viewer::{Exhibition, SceneStage, Stage};
 use std::path::PathBuf;
 
@@ -76,76 +73,75 @@ fn the_food_cannot_be_moved_where_there_is_none() {
 }
 
 #[test]
-fn the_exhibition_shows_each_lane_as_its_fitness_was_measured() {
-    let settings = EvalSettings::default();
-    let showcase = Showcase::new(3);
-    let evolved = animats_scene::params::load("evolved", None).expect("evolved params");
-    showcase.set_best(1, evolved, 2172.09);
-    showcase.set_generation(1000, 1000);
-    let mut show = Exhibition::new(showcase.clone(), settings).expect("exhibition");
+fn the_thesis_exhibition_plays_the_best_gait_as_its_fitness_was_measured() {
+    use animats_scene::evaluate::{evaluate_with, SceneProblem};
+    use animats_viewer::BestBrain;
+    let problem =
+        SceneProblem::parse(animats_scene::HOP_EVOLVER, animats_scene::HOP_EVOLVER_FILE).unwrap();
+    let board = BestBrain::default();
+    let mut show = Exhibition::new(problem.clone(), board.clone()).expect("exhibition");
     let d = show.describe();
-    assert_eq!(d.particles.len(), 15, "three roobots of five masses");
-    assert!(d.floor && d.fluid.is_none());
+    assert_eq!(d.particles.len(), 5, "one roobot of five masses");
+    assert!(d.floor);
+    let dt = show.dt();
 
-    // Lane 1 hops exactly as `evaluate` measured it, shifted sideways.
+    // Until there is a best, the scene's own brain (Appendix B's initial
+    // gait) plays; it falls after 2.616 s and starts again from the start.
+    let mut restarted_at = None;
+    for k in 1..400 {
+        let before = show.time();
+        show.step(dt).unwrap();
+        if show.time() < before {
+            restarted_at = Some(k);
+            break;
+        }
+    }
+    assert_eq!(restarted_at, Some(328), "327 steps up, then a restart");
+
+    // With a best, the next run plays it exactly as `evaluate` measured it.
+    let evolved = animats_scene::params::load("evolved", None).expect("evolved params");
+    board.set_best(&evolved.0, 2172.09, 2);
+    board.set_generation(1000, 1000);
+    show.reset().unwrap();
     let mut reference = Vec::new();
-    animats_creatures::roobot::evaluate::evaluate_with(evolved, &settings, |w, r| {
-        reference.push(w.position(r.body.hip));
+    evaluate_with(problem.scene(&evolved.0).unwrap(), |s| {
+        reference.push(s.world.position(s.particle("roobot.hip").unwrap()));
     })
     .expect("evaluate");
     let mut p = Vec::new();
     for (k, r) in reference.iter().enumerate().take(626).skip(1) {
-        show.step(settings.dt).expect("step");
+        show.step(dt).expect("step");
         if k % 125 == 0 {
             show.positions(&mut p);
-            let hip = &p[15..18];
+            let hip = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])];
             assert!(
-                (f64::from(hip[0]) - r.x).abs() < 1e-5,
+                (hip[0] - r.x).abs() < 1e-5 && (hip[1] - r.y).abs() < 1e-5,
                 "step {k}: {hip:?} vs {r}"
             );
-            assert!((f64::from(hip[1]) - r.y).abs() < 1e-5);
-            assert!((f64::from(hip[2]) - (r.z + LANE_SPACING)).abs() < 1e-5);
         }
     }
-    // 5 s in, the evolved lane leads and the camera follows it.
+    // 5 s in, the camera follows it.
     let focus = show.focus().expect("focus");
-    assert!((focus[0] - f64::from(p[15])).abs() < 1e-5, "{focus:?}");
     assert!(
         focus[0] > 5.0,
-        "the evolved gait covers > 5 m in 5 s, got {}",
-        focus[0]
-    );
-
-    // Lanes without a best show the initial gait, which falls after 2.63 s
-    // (329 steps); the step after a fall starts it again from the origin.
-    let mut initial = Vec::new();
-    animats_creatures::roobot::evaluate::evaluate_with(HopParams::INITIAL, &settings, |w, r| {
-        initial.push(w.position(r.body.hip));
-    })
-    .expect("evaluate");
-    let fell = initial.len() - 1;
-    assert!(fell < 400, "the initial gait falls within 3.2 s");
-    let r = initial[625 - fell - 1];
-    show.positions(&mut p);
-    assert!(
-        (f64::from(p[0]) - r.x).abs() < 1e-5 && (f64::from(p[1]) - r.y).abs() < 1e-5,
-        "lane 0 restarted: {:?} vs {r}",
-        &p[0..3]
+        "the evolved gait covers > 5 m in 5 s: {focus:?}"
     );
     let states = show.creatures();
-    assert_eq!(states.len(), 3);
-    assert!(states[1].name.contains("2172.1"), "{}", states[1].name);
-    assert!(show
-        .note()
-        .expect("note")
-        .contains("generation 1000 of 1000"));
+    assert_eq!(states.len(), 1);
+    assert_eq!(states[0].name, "roobot");
+    assert!(["stance", "leap", "launch", "flight"].contains(&states[0].state.as_str()));
+    let note = show.note().expect("note");
+    assert!(
+        note.contains("generation 1000 of 1000") && note.contains("2172.09 (lane 2)"),
+        "{note}"
+    );
 }
 
 /// `evolve SCENE --view`: the scene plays the best brain so far and, when
 /// a run ends as an evaluation would, starts again with the newest best.
 #[test]
 fn a_scene_exhibition_replays_the_newest_best_brain() {
-    use animats_viewer::{BestBrain, SceneExhibition};
+    use animats_viewer::BestBrain;
     let text = std::fs::read_to_string(
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/walker.toml"),
     )
@@ -153,7 +149,7 @@ fn a_scene_exhibition_replays_the_newest_best_brain() {
     .replace("duration = 10.0\nparticles", "duration = 0.5\nparticles");
     let problem = animats_scene::evaluate::SceneProblem::parse(&text, "walker.toml").unwrap();
     let board = BestBrain::default();
-    let mut show = SceneExhibition::new(problem.clone(), board.clone()).unwrap();
+    let mut show = Exhibition::new(problem.clone(), board.clone()).unwrap();
     assert!(show.note().unwrap().contains("the scene's own brain"));
     let dt = show.dt();
     let mut g = problem.start().to_vec();

@@ -13,7 +13,7 @@ pub use joint_rest_angle::JointRestAngle;
 pub use joint_torque::JointTorque;
 pub use spring_rest_length::SpringRestLength;
 
-use crate::actuator::Actuator;
+use crate::actuator::{Actuated, Actuator};
 use animats_engine::World;
 
 /// An actuator over any of the parameters a scene's `[[actuator]]` can name.
@@ -37,6 +37,39 @@ impl AnyActuator {
             AnyActuator::AngleJoint(a) => a.set_level(world, level),
             AnyActuator::TorqueJoint(a) => a.set_level(world, level),
             AnyActuator::ConstantForce(a) => a.set_level(world, level),
+        }
+    }
+
+    /// Whether a gate can hold it off: a motor's torque and a force's scale
+    /// have a zero that is "off"; a rest length or a rest angle has none.
+    pub fn can_gate(&self) -> bool {
+        matches!(
+            self,
+            AnyActuator::TorqueJoint(_) | AnyActuator::ConstantForce(_)
+        )
+    }
+
+    /// Drives the parameter at its level's value while `open`, at zero
+    /// while closed (only for actuators that [`AnyActuator::can_gate`]).
+    pub fn gate(&self, world: &mut World, open: bool) {
+        match self {
+            AnyActuator::TorqueJoint(a) => {
+                a.target().set(world, if open { a.value() } else { 0.0 })
+            }
+            AnyActuator::ConstantForce(a) => {
+                a.target().set(world, if open { a.value() } else { 0.0 })
+            }
+            AnyActuator::Spring(_) | AnyActuator::AngleJoint(_) => {}
+        }
+    }
+
+    /// The level it started at.
+    pub fn initial_level(&self) -> f64 {
+        match self {
+            AnyActuator::Spring(a) => a.initial_level(),
+            AnyActuator::AngleJoint(a) => a.initial_level(),
+            AnyActuator::TorqueJoint(a) => a.initial_level(),
+            AnyActuator::ConstantForce(a) => a.initial_level(),
         }
     }
 

@@ -14,7 +14,7 @@
 //! in [0, 1], times in [0, max(2 s, 2 × value)], rates in
 //! [0, max(100, 2 × value)] per second.
 
-use crate::brain::{around, check_genome, Brain};
+use crate::brain::{around, check_genome, Brain, GenomeKey};
 
 /// What a transition reads.
 #[derive(Clone, Debug, PartialEq)]
@@ -103,22 +103,37 @@ impl Fsm {
         sensed && t.after.is_none_or(|a| in_state >= a)
     }
 
-    fn genes(&mut self) -> Vec<&mut f64> {
+    /// Every gene in genome order, with its key in the scene file's
+    /// controller table and its bounds (the one place the layout is
+    /// written).
+    fn genes(&mut self) -> Vec<(GenomeKey, &mut f64, (f64, f64))> {
         let mut out = Vec::new();
-        for s in &mut self.states {
-            out.extend(s.levels.iter_mut());
-            if let Some(r) = &mut s.rate {
-                out.push(r);
+        for (i, s) in self.states.iter_mut().enumerate() {
+            let n = s.levels.len();
+            for l in s.levels.iter_mut() {
+                let b = around(*l, 0.0, 1.0);
+                out.push((GenomeKey::array(format!("state[{i}].levels"), n), l, b));
             }
-            for t in &mut s.transitions {
+            if let Some(r) = &mut s.rate {
+                let b = around(*r, 0.0, (2.0 * *r).max(100.0));
+                out.push((GenomeKey::number(format!("state[{i}].rate")), r, b));
+            }
+            for (j, t) in s.transitions.iter_mut().enumerate() {
+                let key = |k: &str| GenomeKey::number(format!("state[{i}].transition[{j}].{k}"));
                 match &mut t.condition {
-                    Condition::Above { threshold, .. } | Condition::Below { threshold, .. } => {
-                        out.push(threshold)
+                    Condition::Above { threshold, .. } => {
+                        let b = around(*threshold, 0.0, 1.0);
+                        out.push((key("above"), threshold, b));
+                    }
+                    Condition::Below { threshold, .. } => {
+                        let b = around(*threshold, 0.0, 1.0);
+                        out.push((key("below"), threshold, b));
                     }
                     Condition::None => {}
                 }
                 if let Some(a) = &mut t.after {
-                    out.push(a);
+                    let b = around(*a, 0.0, (2.0 * *a).max(2.0));
+                    out.push((key("after"), a, b));
                 }
             }
         }
@@ -164,38 +179,31 @@ impl Brain for Fsm {
     }
 
     fn genome(&self) -> Vec<f64> {
-        self.clone().genes().into_iter().map(|g| *g).collect()
+        self.clone().genes().into_iter().map(|g| *g.1).collect()
     }
 
     fn set_genome(&mut self, g: &[f64]) -> Result<(), String> {
         let mut genes = self.genes();
         check_genome("fsm", genes.len(), g)?;
         for (slot, v) in genes.iter_mut().zip(g) {
-            **slot = *v;
+            *slot.1 = *v;
         }
         Ok(())
     }
 
     fn bounds(&self) -> Vec<(f64, f64)> {
-        let mut out = Vec::new();
-        for s in &self.states {
-            out.extend(s.levels.iter().map(|&l| around(l, 0.0, 1.0)));
-            if let Some(r) = s.rate {
-                out.push(around(r, 0.0, (2.0 * r).max(100.0)));
-            }
-            for t in &s.transitions {
-                match t.condition {
-                    Condition::Above { threshold, .. } | Condition::Below { threshold, .. } => {
-                        out.push(around(threshold, 0.0, 1.0))
-                    }
-                    Condition::None => {}
-                }
-                if let Some(a) = t.after {
-                    out.push(around(a, 0.0, (2.0 * a).max(2.0)));
-                }
+        self.clone().genes().into_iter().map(|g| g.2).collect()
+    }
+
+    fn genome_keys(&self) -> Vec<GenomeKey> {
+        let mut keys: Vec<GenomeKey> = Vec::new();
+        for (key, _, _) in self.clone().genes() {
+            // A state's levels are one array: one key for all of them.
+            if keys.last() != Some(&key) {
+                keys.push(key);
             }
         }
-        out
+        keys
     }
 
     fn reset(&mut self) {

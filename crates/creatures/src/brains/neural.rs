@@ -10,7 +10,7 @@
 //! layer its weights row by row (`w_j0, w_j1, ...` for neuron j), then its
 //! biases. Bounds: [−10, 10] each, widened to contain the value given.
 
-use crate::brain::{around, check_genome, Brain};
+use crate::brain::{around, check_genome, Brain, GenomeKey};
 use crate::random::Random;
 use std::f64::consts::TAU;
 
@@ -118,5 +118,9 @@ impl Brain for Neural {
             .iter()
             .map(|&w| around(w, -10.0, 10.0))
             .collect()
+    }
+
+    fn genome_keys(&self) -> Vec<GenomeKey> {
+        vec![GenomeKey::array("weights", self.weights.len())]
     }
 }

@@ -6,7 +6,7 @@
 //! f in [0, 5] Hz, amplitudes and offsets in [0, 1], phases in [−π, π],
 //! each widened to contain the value the scene gives.
 
-use crate::brain::{around, check_genome, Brain};
+use crate::brain::{around, check_genome, Brain, GenomeKey};
 use std::f64::consts::{PI, TAU};
 
 /// Sines at one frequency.
@@ -66,5 +66,15 @@ impl Brain for Oscillator {
         b.extend(self.phase.iter().map(|&p| around(p, -PI, PI)));
         b.extend(self.offset.iter().map(|&o| around(o, 0.0, 1.0)));
         b
+    }
+
+    fn genome_keys(&self) -> Vec<GenomeKey> {
+        let n = self.outputs();
+        vec![
+            GenomeKey::number("frequency"),
+            GenomeKey::array("amplitude", n),
+            GenomeKey::array("phase", n),
+            GenomeKey::array("offset", n),
+        ]
     }
 }

@@ -241,7 +241,7 @@ pub const BRAIN_OUTPUTS: [&str; 3] = ["leg", "hip", "ankle"];
 
 impl crate::brain::Brain for HopFsm {
     fn kind(&self) -> &'static str {
-        "roobot-fsm"
+        "hop"
     }
 
     /// See [`BRAIN_INPUTS`] and [`BRAIN_OUTPUTS`].
@@ -275,7 +275,7 @@ impl crate::brain::Brain for HopFsm {
     }
 
     fn set_genome(&mut self, genome: &[f64]) -> Result<(), String> {
-        crate::brain::check_genome("roobot-fsm", super::PARAM_COUNT, genome)?;
+        crate::brain::check_genome("hop", super::PARAM_COUNT, genome)?;
         self.params.0.copy_from_slice(genome);
         Ok(())
     }
@@ -287,6 +287,11 @@ impl crate::brain::Brain for HopFsm {
             .zip(super::params::BOUNDS)
             .map(|(&p, (lo, hi))| crate::brain::around(p, lo, hi))
             .collect()
+    }
+
+    /// The roobot's `params`.
+    fn genome_keys(&self) -> Vec<crate::brain::GenomeKey> {
+        vec![crate::brain::GenomeKey::array("params", super::PARAM_COUNT)]
     }
 
     fn reset(&mut self) {

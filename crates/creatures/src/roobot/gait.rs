@@ -3,8 +3,7 @@
 //! prints it; docs/ROOBOT.md quotes it (a gait that skated on the floor, or
 //! skipped its stance, shows here).
 
-use super::{HopState, Roobot};
-use animats_engine::{DVec3, World};
+use animats_engine::{DVec3, ParticleId, World};
 
 /// A record of one evaluation's stances and ground contacts, fed one step at
 /// a time by [`GaitLog::observe`].
@@ -20,10 +19,10 @@ pub struct GaitLog {
 }
 
 impl GaitLog {
-    /// Records the state after a step at `world.time()`.
-    pub fn observe(&mut self, world: &World, roobot: &Roobot) {
+    /// Records the state after a step at `world.time()`: where the
+    /// roobot's `foot` is, and whether its brain is in stance.
+    pub fn observe(&mut self, world: &World, foot: ParticleId, in_stance: bool) {
         let t = world.time();
-        let in_stance = roobot.fsm.state() == HopState::Stance;
         match (self.stance_since, in_stance) {
             (None, true) => self.stance_since = Some(t),
             (Some(t0), false) => {
@@ -32,9 +31,10 @@ impl GaitLog {
             }
             _ => {}
         }
-        let foot = world.position(roobot.body.foot);
+        let down = super::foot_down(world, foot);
+        let foot = world.position(foot);
         let flat = DVec3::new(foot.x, 0.0, foot.z);
-        match (self.contact, roobot.foot_down(world)) {
+        match (self.contact, down) {
             (None, true) => self.contact = Some((t, flat)),
             (Some((t0, x0)), false) => {
                 self.contacts.push((t - t0, (flat - x0).length()));

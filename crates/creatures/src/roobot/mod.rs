@@ -1,19 +1,21 @@
 //! The roobot, a hopping monopod (thesis §3.2.1, Appendix B `FSMRobot`).
 //!
 //! - `body.rs`: the masses, springs, joints and motors, and their constants.
-//! - `fsm.rs`: the four-state hopping controller.
-//! - `params.rs`: its 14 parameters; `params_file.rs`: their files (`params/`, `best.toml`).
-//! - `evaluate.rs`: one fitness evaluation, as the thesis's `HopEvolver` runs it.
-//! - `env.rs`: the same evaluation stepped by a program (reinforcement learning).
+//! - `fsm.rs`: the four-state hopping controller, a [`Brain`].
+//! - `raibert.rs`: Raibert's three-part controller, a baseline [`Brain`].
+//! - `params.rs`: the FSM's 14 parameters; `params_file.rs`: their files
+//!   (`params/`).
 //! - `gait.rs`: stance durations and foot slide, for reports.
 //!
-//! Actuators: the leg's rest length, the hip motor (acts only in flight) and
-//! the ankle motor (acts only in stance). Sensors: foot height, leg angle
-//! from the vertical, hip forward speed, time till touchdown.
+//! [`install`] builds one into a world and its nervous system: the body;
+//! its sensors (`NAME.foot_height`, `NAME.leg_angle`, `NAME.hip_speed`,
+//! `NAME.touchdown`); its actuators (`NAME.leg`, the leg's rest length;
+//! `NAME.hip`, the hip motor, gated to act only in flight; `NAME.ankle`,
+//! the ankle motor, gated to act only in stance); and its brain, the
+//! controller `NAME`. Everything else (the floor, the air, how a run is
+//! scored and when it ends) is the scene's, as for every creature.
 
 pub mod body;
-pub mod env;
-pub mod evaluate;
 pub mod fsm;
 pub mod gait;
 pub mod params;
@@ -21,195 +23,184 @@ pub mod params_file;
 pub mod raibert;
 
 use crate::actuator::Actuator;
-use crate::actuators::{JointTorque, SpringRestLength};
+use crate::actuators::{AnyActuator, JointTorque, SpringRestLength};
 use crate::brain::Brain;
-use crate::controller::{Actor, Status};
+use crate::nervous_system::{Gate, Inputs, NervousSystem, Senses, Wired};
 use crate::sensor::Sensor;
 use crate::sensors::{HeightSensor, SpeedSensor, TiltSensor, TouchdownSensor};
-use animats_engine::{DVec3, ModelError, World};
+use animats_engine::{DVec3, ModelError, ParticleId, World};
 pub use body::{Body, BodyConstants};
-pub use fsm::{Command, HopFsm, HopState, Orders, Senses};
+pub use fsm::{Command, HopFsm, HopState, Orders, Senses as HopSenses};
 pub use params::{HopParams, PARAM_COUNT, PARAM_NAMES};
+pub use raibert::Raibert;
 
-/// The roobot's four sensors.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RoobotSensors {
-    /// Foot height, m.
-    pub height: HeightSensor,
-    /// Leg angle from the vertical.
-    pub angle: TiltSensor,
-    /// Hip forward speed, m/s.
-    pub speed: SpeedSensor,
-    /// Time till the foot touches down, s.
-    pub touchdown: TouchdownSensor,
+/// The brain a roobot is built with.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RoobotBrain {
+    /// The thesis's hopping FSM with these parameters.
+    Hop(HopParams),
+    /// Raibert's controller with these gains.
+    Raibert([f64; raibert::GAIN_COUNT]),
+    /// None: its actuators stay where they are put (by a program, or by a
+    /// controller of the scene's).
+    None,
 }
 
-impl RoobotSensors {
-    /// Reads every sense.
-    pub fn read(&self, world: &World) -> Senses {
-        Senses {
-            height: self.height.level(world),
-            angle: self.angle.level(world),
-            speed: self.speed.level(world),
-            touchdown: self.touchdown.level(world),
-            hip_velocity: self.speed.speed(world),
-        }
-    }
-}
+/// Names of the roobot's sensors, after `NAME.`, in the order installed.
+pub const SENSORS: [&str; 4] = ["foot_height", "leg_angle", "hip_speed", "touchdown"];
 
-/// A roobot in a world: body, sensors, actuators and its hopping FSM.
-#[derive(Clone, Debug)]
-pub struct Roobot {
-    /// A name for reports.
-    pub name: String,
-    /// Handles to its parts.
+/// Names of the roobot's actuators, after `NAME.`, in the order installed.
+pub const ACTUATORS: [&str; 3] = ["leg", "hip", "ankle"];
+
+/// Where a roobot's parts are in the world and its nervous system.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Installed {
+    /// Handles to its body.
     pub body: Body,
-    /// Its senses.
-    pub sensors: RoobotSensors,
-    /// The leg's rest length.
-    pub leg: Actuator<SpringRestLength>,
-    /// The hip motor.
-    pub hip: Actuator<JointTorque>,
-    /// The ankle motor.
-    pub ankle: Actuator<JointTorque>,
-    /// The controller.
-    pub fsm: HopFsm,
-    landings: u32,
+    /// Index of its first sensor (the others follow in [`SENSORS`] order).
+    pub sensors: usize,
+    /// Index of its first actuator (the others follow in [`ACTUATORS`] order).
+    pub actuators: usize,
+    /// Index of its controller, if it has a brain.
+    pub controller: Option<usize>,
 }
 
-impl Roobot {
-    /// Builds a roobot standing at `base` facing `heading` (radians from +x),
-    /// controlled by `params`.
-    pub fn build(
-        world: &mut World,
-        name: &str,
-        constants: &BodyConstants,
-        base: DVec3,
-        heading: f64,
-        params: HopParams,
-    ) -> Result<Roobot, ModelError> {
-        let body = body::build(world, constants, base, heading)?;
-        let height = HeightSensor {
-            particle: body.foot,
-        };
-        let sensors = RoobotSensors {
-            height,
-            angle: TiltSensor {
-                base: body.foot,
-                tip: body.hip,
-                forward: body.forward,
-                gain: constants.leg_angle_gain,
-            },
-            speed: SpeedSensor {
-                particle: body.hip,
-                forward: body.forward,
-            },
-            // The thesis's sensor assumes 9.8 m/s² whatever the world's gravity.
-            touchdown: TouchdownSensor { height, g: 9.8 },
-        };
-        let (l0, l1) = constants.leg_range;
-        let leg = Actuator::new(SpringRestLength(body.leg), l0, l1, world);
-        let hip = Actuator::new(
-            JointTorque(body.hip_motor),
-            -constants.hip_torque,
-            constants.hip_torque,
-            world,
-        );
-        let ankle = Actuator::new(
-            JointTorque(body.ankle_motor),
-            -constants.ankle_torque,
-            constants.ankle_torque,
-            world,
-        );
-        Ok(Roobot {
-            name: name.to_string(),
-            body,
-            sensors,
-            leg,
-            hip,
-            ankle,
-            fsm: HopFsm::new(params),
-            landings: 0,
-        })
+/// Builds a roobot called `name` standing at `base` facing `heading`
+/// (radians from +x) into `world`, and its sensors, actuators and brain
+/// into `nervous`. Names are not checked for clashes: the caller does.
+pub fn install(
+    world: &mut World,
+    nervous: &mut NervousSystem,
+    name: &str,
+    constants: &BodyConstants,
+    base: DVec3,
+    heading: f64,
+    brain: RoobotBrain,
+) -> Result<Installed, ModelError> {
+    let body = body::build(world, constants, base, heading)?;
+    let height = HeightSensor {
+        particle: body.foot,
+    };
+    let angle = TiltSensor {
+        base: body.foot,
+        tip: body.hip,
+        forward: body.forward,
+        gain: constants.leg_angle_gain,
+    };
+    let speed = SpeedSensor {
+        particle: body.hip,
+        forward: body.forward,
+    };
+    // The thesis's sensor assumes 9.8 m/s² whatever the world's gravity.
+    let touchdown = TouchdownSensor { height, g: 9.8 };
+    let sensors = nervous.sensors.len();
+    let boxed: [Box<dyn Sensor + Send>; 4] = [
+        Box::new(height),
+        Box::new(angle),
+        Box::new(speed),
+        Box::new(touchdown),
+    ];
+    for (part, s) in SENSORS.iter().zip(boxed) {
+        nervous.sensors.push((format!("{name}.{part}"), s));
     }
 
-    /// True while the foot touches the floor.
-    pub fn foot_down(&self, world: &World) -> bool {
-        self.sensors.height.level(world) <= 0.0
+    let (l0, l1) = constants.leg_range;
+    let leg = Actuator::new(SpringRestLength(body.leg), l0, l1, world);
+    let torque =
+        |motor, max: f64, world: &World| Actuator::new(JointTorque(motor), -max, max, world);
+    let hip = torque(body.hip_motor, constants.hip_torque, world);
+    let ankle = torque(body.ankle_motor, constants.ankle_torque, world);
+    // The hip motor acts only in flight and the ankle motor only in stance
+    // (thesis §3.2.1.2): the one without ground to push against is idle,
+    // whatever level its controller left it at.
+    let foot = sensors; // the foot's height sensor
+    let gates = [
+        None,
+        Some(Gate {
+            sensor: foot,
+            threshold: 0.0,
+            above: true,
+        }),
+        Some(Gate {
+            sensor: foot,
+            threshold: 0.0,
+            above: false,
+        }),
+    ];
+    let actuators = nervous.actuators.len();
+    let parts = [
+        AnyActuator::Spring(leg),
+        AnyActuator::TorqueJoint(hip),
+        AnyActuator::TorqueJoint(ankle),
+    ];
+    for ((part, a), gate) in ACTUATORS.iter().zip(parts).zip(gates) {
+        nervous.add_actuator(format!("{name}.{part}"), a, None, gate);
+    }
+    let outputs = vec![actuators, actuators + 1, actuators + 2];
+
+    let wired: Option<(Box<dyn Brain>, Inputs)> = match brain {
+        RoobotBrain::Hop(params) => Some((
+            Box::new(HopFsm::new(params)),
+            Inputs::Senses(Box::new(FsmSenses {
+                sensors,
+                actuators,
+                speed,
+            })),
+        )),
+        RoobotBrain::Raibert(gains) => Some((
+            Box::new(Raibert::new(gains, constants)),
+            Inputs::Senses(Box::new(raibert::RaibertSenses::new(&body, angle, sensors))),
+        )),
+        RoobotBrain::None => None,
+    };
+    let controller = wired.map(|(brain, inputs)| {
+        nervous
+            .controllers
+            .push(Wired::new(name.to_string(), brain, inputs, outputs));
+        nervous.controllers.len() - 1
+    });
+    Ok(Installed {
+        body,
+        sensors,
+        actuators,
+        controller,
+    })
+}
+
+/// What the hopping FSM reads ([`fsm::BRAIN_INPUTS`]): the four sensors'
+/// levels, the hip's forward velocity (m/s, unclamped, as Appendix B reads
+/// it), then the leg's, hip's and ankle's levels now and at the start.
+struct FsmSenses {
+    /// Index of the foot height sensor (the others follow).
+    sensors: usize,
+    /// Index of the leg actuator (hip and ankle follow).
+    actuators: usize,
+    speed: SpeedSensor,
+}
+
+impl Senses for FsmSenses {
+    fn count(&self) -> usize {
+        fsm::BRAIN_INPUTS.len()
     }
 
-    /// The hip motor acts only in flight and the ankle motor only in stance
-    /// (thesis §3.2.1.2): the one without ground to push against is idle,
-    /// whatever level the controller left it at. `down`: the foot is on the
-    /// floor.
-    pub fn gate_motors(&self, world: &mut World, down: bool) {
-        let motors = &mut world.forces_mut().torque_joints;
-        if down {
-            motors.set_torque(self.body.hip_motor, 0.0);
-            motors.set_torque(self.body.ankle_motor, self.ankle.value());
-        } else {
-            motors.set_torque(self.body.hip_motor, self.hip.value());
-            motors.set_torque(self.body.ankle_motor, 0.0);
+    fn read(
+        &self,
+        world: &World,
+        levels: &[f64],
+        actuators: &[(String, AnyActuator)],
+        out: &mut [f64],
+    ) {
+        out[..4].copy_from_slice(&levels[self.sensors..self.sensors + 4]);
+        out[4] = self.speed.speed(world);
+        let mine = &actuators[self.actuators..self.actuators + 3];
+        for (k, (_, a)) in mine.iter().enumerate() {
+            out[5 + k] = a.level();
+            out[8 + k] = a.initial_level();
         }
-    }
-
-    /// Landings (flight → stance transitions) so far.
-    pub fn landings(&self) -> u32 {
-        self.landings
-    }
-
-    /// True once the hip, or any other part but the foot, touches the floor:
-    /// it has fallen. (Appendix B tests the hip alone; in this body the tail
-    /// and head can prop the hip up, and a roobot lying on its tail must not
-    /// count as upright. See docs/ROOBOT.md.)
-    pub fn fallen(&self, world: &World) -> bool {
-        let b = &self.body;
-        let r = &world.particles().radius;
-        [b.hip, b.head, b.tail1, b.tail2]
-            .iter()
-            .any(|p| world.position(*p).y - r[p.index()] <= 1e-9)
     }
 }
 
-impl Actor for Roobot {
-    fn act(&mut self, world: &mut World, dt: f64) {
-        let senses = self.sensors.read(world);
-        let inputs = [
-            senses.height,
-            senses.angle,
-            senses.speed,
-            senses.touchdown,
-            senses.hip_velocity,
-            self.leg.level(),
-            self.hip.level(),
-            self.ankle.level(),
-            self.leg.initial_level(),
-            self.hip.initial_level(),
-            self.ankle.initial_level(),
-        ];
-        let mut out = [0.0; 3];
-        Brain::think(&mut self.fsm, world.time(), dt, &inputs, &mut out);
-        // NaN: the FSM keeps that actuator as it is.
-        if !out[0].is_nan() {
-            self.leg.set_level(world, out[0]);
-        }
-        for (a, level) in [&mut self.hip, &mut self.ankle].into_iter().zip(&out[1..]) {
-            if !level.is_nan() {
-                a.set_level(world, *level);
-            }
-        }
-        if self.fsm.last_transition() == Some((HopState::Flight, HopState::Stance)) {
-            self.landings += 1;
-        }
-        self.gate_motors(world, senses.height <= 0.0);
-    }
-
-    fn status(&self) -> Option<Status> {
-        Some(Status {
-            name: self.name.clone(),
-            state: self.fsm.state().name(),
-            energy: None,
-            phase: None,
-        })
-    }
+/// True while a roobot's `foot` touches the floor (its height sensor reads 0).
+pub fn foot_down(world: &World, foot: ParticleId) -> bool {
+    HeightSensor { particle: foot }.level(world) <= 0.0
 }

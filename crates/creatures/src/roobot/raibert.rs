@@ -19,9 +19,17 @@
 //!    `τ = −k_a φ − d_a φ̇`, signed gains, so an optimiser may choose the sense.
 //!
 //! Torques become actuator levels as `0.5 + τ / (2 τ_max)`, clamped.
+//!
+//! A [`Brain`] over the roobot's body: its inputs are the roobot's own
+//! senses ([`RaibertSenses`]: raw angles, speeds and the leg's length), its
+//! outputs the leg's, hip's and ankle's levels.
 
-use super::{Body, Roobot};
-use animats_engine::World;
+use super::body::{Body, BodyConstants};
+use crate::actuators::AnyActuator;
+use crate::brain::{around, check_genome, Brain, GenomeKey};
+use crate::nervous_system::Senses;
+use crate::sensors::TiltSensor;
+use animats_engine::{DVec3, ParticleId, World};
 
 /// Number of gains.
 pub const GAIN_COUNT: usize = 8;
@@ -62,6 +70,10 @@ pub const BOUNDS: [(f64, f64); GAIN_COUNT] = [
 pub struct Raibert {
     /// The gains (see [`GAIN_NAMES`]).
     pub gains: [f64; GAIN_COUNT],
+    /// Hip motor torque at levels 0 and 1, N m.
+    hip_torque: f64,
+    /// Ankle motor torque at levels 0 and 1, N m.
+    ankle_torque: f64,
     in_stance: bool,
     thrusting: bool,
     stance_started: f64,
@@ -70,11 +82,23 @@ pub struct Raibert {
     last_pitch: Option<f64>,
 }
 
+/// What Raibert's controller reads, in order ([`RaibertSenses`]).
+pub const INPUTS: [&str; 6] = [
+    "foot height level",
+    "leg angle from the vertical, rad (positive forward)",
+    "body pitch (head above tail), rad",
+    "hip vertical velocity, m/s",
+    "hip forward velocity, m/s",
+    "leg length, m",
+];
+
 impl Raibert {
-    /// A controller with `gains`.
-    pub fn new(gains: [f64; GAIN_COUNT]) -> Raibert {
+    /// A controller with `gains` for a body built with `constants`.
+    pub fn new(gains: [f64; GAIN_COUNT], constants: &BodyConstants) -> Raibert {
         Raibert {
             gains,
+            hip_torque: constants.hip_torque,
+            ankle_torque: constants.ankle_torque,
             in_stance: true,
             thrusting: false,
             stance_started: 0.0,
@@ -89,92 +113,125 @@ impl Raibert {
     pub fn in_stance(&self) -> bool {
         self.in_stance
     }
+}
 
-    fn pitch(world: &World, b: &Body) -> f64 {
-        let v = world.position(b.head) - world.position(b.tail1);
-        libm::atan2(v.y, v.dot(b.forward))
+impl Brain for Raibert {
+    fn kind(&self) -> &'static str {
+        "raibert"
     }
 
-    /// Sets the roobot's actuators for the step of length `dt` about to be
-    /// taken; returns true when a flight ended in a landing.
-    pub fn act(&mut self, world: &mut World, r: &mut Roobot, dt: f64) -> bool {
+    /// Inputs [`INPUTS`]; outputs the leg's, hip's and ankle's levels.
+    fn think(&mut self, t: f64, dt: f64, inputs: &[f64], out: &mut [f64]) {
         let g = self.gains;
-        let b = r.body;
-        let t = world.time();
-        let down = r.foot_down(world);
-        let mut landed = false;
+        let down = inputs[0] <= 0.0;
         if down && !self.in_stance {
             self.in_stance = true;
             self.thrusting = false;
             self.stance_started = t;
-            landed = true;
         } else if !down && self.in_stance {
             self.in_stance = false;
             if t > self.stance_started {
                 self.last_stance = (t - self.stance_started).min(1.0);
             }
         }
-        let angle = r.sensors.angle.angle(world);
+        let angle = inputs[1];
         let rate = self.last_angle.map_or(0.0, |a| (angle - a) / dt);
         self.last_angle = Some(angle);
-        let pitch = Raibert::pitch(world, &b);
+        let pitch = inputs[2];
         let pitch_rate = self.last_pitch.map_or(0.0, |p| (pitch - p) / dt);
         self.last_pitch = Some(pitch);
-        let hip_torque = b.constants.hip_torque;
-        let ankle_torque = b.constants.ankle_torque;
         let level = |tau: f64, max: f64| 0.5 + tau / (2.0 * max);
         if self.in_stance {
             // 1: thrust once the hip stops falling.
-            if world.velocity(b.hip).y >= 0.0 {
+            if inputs[3] >= 0.0 {
                 self.thrusting = true;
             }
-            let leg = g[1] + if self.thrusting { g[0] } else { 0.0 };
-            r.leg.set_level(world, leg);
+            out[0] = g[1] + if self.thrusting { g[0] } else { 0.0 };
             // 3: attitude by the ankle.
             let tau = -g[6] * pitch - g[7] * pitch_rate;
-            r.ankle.set_level(world, level(tau, ankle_torque));
-            r.hip.set_level(world, 0.5);
+            out[2] = level(tau, self.ankle_torque);
+            out[1] = 0.5;
         } else {
-            r.leg.set_level(world, g[1]);
+            out[0] = g[1];
             // 2: foot placement by the hip.
-            let v = world.velocity(b.hip).dot(b.forward);
-            let length = b.leg_length(world).max(1e-3);
+            let v = inputs[4];
+            let length = inputs[5].max(1e-3);
             let ahead = v * self.last_stance / 2.0 + g[2] * (v - g[3]);
             let target = -libm::asin((ahead / length).clamp(-0.9, 0.9));
             let tau = -g[4] * (angle - target) - g[5] * rate;
-            r.hip.set_level(world, level(tau, hip_torque));
-            r.ankle.set_level(world, 0.5);
+            out[1] = level(tau, self.hip_torque);
+            out[2] = 0.5;
         }
-        landed
+    }
+
+    fn state(&self) -> Option<&str> {
+        Some(if self.in_stance { "stance" } else { "flight" })
+    }
+
+    fn genome(&self) -> Vec<f64> {
+        self.gains.to_vec()
+    }
+
+    fn set_genome(&mut self, genome: &[f64]) -> Result<(), String> {
+        check_genome("raibert", GAIN_COUNT, genome)?;
+        self.gains.copy_from_slice(genome);
+        Ok(())
+    }
+
+    fn bounds(&self) -> Vec<(f64, f64)> {
+        self.gains
+            .iter()
+            .zip(BOUNDS)
+            .map(|(&g, (lo, hi))| around(g, lo, hi))
+            .collect()
+    }
+
+    /// The roobot's `gains`.
+    fn genome_keys(&self) -> Vec<GenomeKey> {
+        vec![GenomeKey::array("gains", GAIN_COUNT)]
     }
 }
 
-/// One evaluation of the gains, exactly as the hopping FSM's is run
-/// ([`super::evaluate::evaluate_with`]: the same world, the same end rule,
-/// the same fitness `time upright + 50 × distance`).
-pub fn evaluate(
-    gains: [f64; GAIN_COUNT],
-    settings: &super::evaluate::EvalSettings,
-) -> Result<super::evaluate::Evaluation, animats_engine::ModelError> {
-    evaluate_with(gains, settings, |_, _| {})
+/// The roobot's senses as Raibert's controller reads them ([`INPUTS`]).
+pub struct RaibertSenses {
+    foot_height: usize,
+    angle: TiltSensor,
+    hip: ParticleId,
+    foot: ParticleId,
+    head: ParticleId,
+    tail: ParticleId,
+    forward: DVec3,
 }
 
-/// [`evaluate`], calling `observe` with the world after every step.
-pub fn evaluate_with(
-    gains: [f64; GAIN_COUNT],
-    settings: &super::evaluate::EvalSettings,
-    observe: impl FnMut(&World, &Roobot),
-) -> Result<super::evaluate::Evaluation, animats_engine::ModelError> {
-    let mut controller = Raibert::new(gains);
-    super::evaluate::evaluate_driven(
-        super::HopParams::INITIAL,
-        settings,
-        |world, roobot, dt| {
-            let landed = controller.act(world, roobot, dt);
-            let down = roobot.foot_down(world);
-            roobot.gate_motors(world, down);
-            landed
-        },
-        observe,
-    )
+impl RaibertSenses {
+    /// For `body`, whose leg-angle sensor is `angle` and whose foot height
+    /// sensor has index `foot_height` in the nervous system.
+    pub fn new(body: &Body, angle: TiltSensor, foot_height: usize) -> RaibertSenses {
+        RaibertSenses {
+            foot_height,
+            angle,
+            hip: body.hip,
+            foot: body.foot,
+            head: body.head,
+            tail: body.tail1,
+            forward: body.forward,
+        }
+    }
+}
+
+impl Senses for RaibertSenses {
+    fn count(&self) -> usize {
+        INPUTS.len()
+    }
+
+    fn read(&self, world: &World, levels: &[f64], _: &[(String, AnyActuator)], out: &mut [f64]) {
+        let v = world.position(self.head) - world.position(self.tail);
+        let hip = world.velocity(self.hip);
+        out[0] = levels[self.foot_height];
+        out[1] = self.angle.angle(world);
+        out[2] = libm::atan2(v.y, v.dot(self.forward));
+        out[3] = hip.y;
+        out[4] = hip.dot(self.forward);
+        out[5] = (world.position(self.hip) - world.position(self.foot)).length();
+    }
 }

@@ -29,12 +29,15 @@ pub(crate) use crate::nervous::Handles;
 pub(crate) use crate::source::Source;
 pub(crate) use animats_creatures::jellyfish::{Jellyfish, JellyfishConstants};
 pub(crate) use animats_creatures::quadruped::{Demo, Model, Quadruped, QuadrupedConstants};
-pub(crate) use animats_creatures::roobot::{BodyConstants, Roobot};
+pub(crate) use animats_creatures::roobot::{
+    self as roobot_kit, BodyConstants, HopParams, RoobotBrain,
+};
 pub(crate) use animats_creatures::seaworld::{
     rocks as rock_field, seaweed as seaweed_frond, BubbleColumn, BubbleConstants, Random,
     RocksConstants, SeaweedConstants,
 };
 pub(crate) use animats_creatures::Actor;
+pub(crate) use animats_creatures::NervousSystem;
 pub(crate) use animats_engine::{
     AngleJointDef, Current, DVec3, FloorDef, FluidMedium, NBodyGravity, ParticleDef, ParticleId,
     ReefWater, SpringDef, Targets, TorqueJointDef, World,
@@ -55,8 +58,14 @@ pub(crate) struct Builder<'s> {
     pub kinds: Vec<&'static str>,
     /// Named springs, joints and forces, for actuators.
     pub handles: Handles,
-    /// Creatures and processes that act every step.
+    /// Creatures and processes that act every step beside the nervous system.
     pub actors: Vec<Box<dyn Actor>>,
+    /// Sensors, actuators and brains creatures bring (the scene's own
+    /// `[[sensor]]`, `[[actuator]]` and `[[controller]]` entries follow).
+    pub nervous: NervousSystem,
+    /// For each controller in `nervous`, the table it was written in
+    /// (`roobot`, 0): where evolution writes its genes back.
+    pub origins: Vec<(&'static str, usize)>,
     /// The scene's seed.
     pub seed: u64,
     /// The scene's gravity.
