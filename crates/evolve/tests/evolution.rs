@@ -457,3 +457,29 @@ fn a_runs_defaults_and_checks_are_the_librarys() {
     .unwrap();
     assert_eq!(s.config.generations, 20);
 }
+
+/// FNV-1a of `bytes` (the checkpoint's checksum).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+#[test]
+fn the_thesis_runs_log_is_the_one_users_rely_on() {
+    // `animats evolve --generations 300 --lanes 6 --seed 3` writes this
+    // log.csv (sha256 ada097e748b0d84e...): the roobot's evolution, now the
+    // scene scenes/hop_evolver.toml, scores every genome as the thesis's
+    // own evaluation loop did, bit for bit.
+    let s = run(Config::thesis(6, 300, 3), 2, 50);
+    let log = s.log_csv();
+    assert!(log.starts_with("lane,generation,fitness,time_up,distance,p0,"));
+    assert_eq!(
+        fnv1a(log.as_bytes()),
+        THESIS_LOG_FNV,
+        "{:#018x}",
+        fnv1a(log.as_bytes())
+    );
+}
+
+const THESIS_LOG_FNV: u64 = 0xb221_e0c9_338c_ceb1;
