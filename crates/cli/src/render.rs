@@ -6,8 +6,9 @@ use crate::{positive_f64, Failure};
 use animats_engine::DVec3;
 use animats_render::gif_file::encode_gif;
 use animats_render::video::{encode_mp4, ffmpeg_available};
-use animats_render::{render, Camera, DomeParts, Image, Parts};
-use animats_view::{Describe, SceneStage, Stage};
+use animats_render::{picture, render, Camera, Image};
+use animats_view::{BellShape, Drawing};
+use animats_view::{SceneStage, Stage};
 use rayon::prelude::*;
 use std::path::PathBuf;
 use std::str::FromStr;
@@ -147,53 +148,29 @@ fn frame_times(
     })
 }
 
-/// One instant: where everything is and how far each bell has contracted.
+/// One instant: where everything is and the shape of each bell.
 struct Snapshot {
     t: f64,
     positions: Vec<DVec3>,
-    squeeze: Vec<f64>,
+    bells: Vec<Option<BellShape>>,
 }
 
-fn snapshot(stage: &SceneStage, describe: &Describe) -> Snapshot {
-    let mut p = Vec::new();
-    stage.positions(&mut p);
-    let positions = p
-        .chunks_exact(3)
-        .map(|c| DVec3::new(f64::from(c[0]), f64::from(c[1]), f64::from(c[2])))
-        .collect();
-    let creatures = stage.creatures();
-    let squeeze = describe
-        .domes
-        .iter()
-        .map(|d| {
-            creatures
-                .iter()
-                .find(|c| c.name == d.name)
-                .and_then(|c| c.phase.filter(|_| c.state != "idle"))
-                .map_or(0.0, |phase| phase.sin().max(0.0))
-        })
-        .collect();
+fn snapshot(stage: &SceneStage, drawing: &Drawing) -> Snapshot {
+    let positions = stage.scene().world.state().pos.clone();
+    let bells = drawing.bell_shapes(&positions, &stage.creatures());
     Snapshot {
         t: stage.time(),
         positions,
-        squeeze,
+        bells,
     }
 }
 
-/// Centre of the creatures (or of everything, if there are none).
-fn creatures_centre(describe: &Describe, positions: &[DVec3]) -> DVec3 {
-    let alive = |k: &str| matches!(k, "roobot" | "quadruped" | "dome" | "tentacle");
-    let mut picked: Vec<DVec3> = describe
-        .particles
-        .iter()
-        .zip(positions)
-        .filter(|(p, _)| alive(&p.kind))
-        .map(|(_, x)| *x)
-        .collect();
+/// Centre of the particles `picked` (of everything, if there are none).
+fn centre_of(picked: &[usize], positions: &[DVec3]) -> DVec3 {
     if picked.is_empty() {
-        picked = positions.to_vec();
+        return positions.iter().sum::<DVec3>() / positions.len().max(1) as f64;
     }
-    picked.iter().sum::<DVec3>() / picked.len().max(1) as f64
+    picked.iter().map(|&i| positions[i]).sum::<DVec3>() / picked.len() as f64
 }
 
 /// Runs the command.
@@ -238,29 +215,13 @@ pub fn run(args: Args) -> Result<(), Failure> {
         .map_err(Failure::Input)?;
     crate::warn(&args.scene, stage.warnings());
     let describe = stage.describe();
-    let parts = Parts {
-        kinds: describe.particles.iter().map(|p| p.kind.clone()).collect(),
-        radii: describe.particles.iter().map(|p| p.radius).collect(),
-        springs: describe.springs.clone(),
-        domes: describe
-            .domes
-            .iter()
-            .map(|d| DomeParts {
-                dome: d.particles.clone(),
-                tentacles: d.tentacles.clone(),
-                squeeze: 0.0,
-            })
-            .collect(),
-        floor: describe.floor,
-        water: describe.fluid.is_some_and(|rho| rho > 500.0),
-        cell: if describe.distance < 4.0 { 0.1 } else { 0.5 },
-    };
+    let drawing = &describe.drawing;
 
     let start = Instant::now();
     let dt = stage.dt();
     // Where things are at t = 0, which the framing is for (the first frame
     // drawn may be later: a PNG draws only the last).
-    let at_start = snapshot(&stage, &describe);
+    let at_start = snapshot(&stage, drawing);
     // A world that splits its work over threads enters the pool once for
     // all the frames' steps, not at every step (the same bits).
     let pooled = stage.scene().world.steps_on_pool();
@@ -275,7 +236,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
                     ))
                 })?;
             }
-            snapshots.push(snapshot(&stage, &describe));
+            snapshots.push(snapshot(&stage, drawing));
         }
         Ok(snapshots)
     };
@@ -283,13 +244,18 @@ pub fn run(args: Args) -> Result<(), Failure> {
 
     let base = Camera::framing(DVec3::from_array(describe.target), describe.distance);
     let followed = stage.followed().to_vec();
-    let centre = |positions: &[DVec3]| -> DVec3 {
-        if followed.is_empty() {
-            creatures_centre(&describe, positions)
-        } else {
-            followed.iter().map(|&i| positions[i]).sum::<DVec3>() / followed.len() as f64
-        }
+    // What the camera keeps in view: the followed particles, or else every
+    // creature's.
+    let watched: Vec<usize> = if followed.is_empty() {
+        let creatures = &stage.scene().creatures;
+        creatures
+            .iter()
+            .flat_map(|c| c.particles.iter().copied())
+            .collect()
+    } else {
+        followed.clone()
     };
+    let centre = |positions: &[DVec3]| centre_of(&watched, positions);
     let start_centre = centre(&at_start.positions);
     let camera = |s: &Snapshot| -> Camera {
         let follows = match &args.camera {
@@ -301,7 +267,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
             CameraSpec::Auto | CameraSpec::Follow if follows => {
                 // In whole periods of the floor's checker: the floor looks
                 // the same in every frame, which also keeps GIFs small.
-                let period = 2.0 * parts.cell;
+                let period = 2.0 * drawing.floor.unwrap_or(0.5);
                 let moved = centre(&s.positions) - start_centre;
                 let shift = (DVec3::new(moved.x, 0.0, moved.z) / period).round() * period;
                 Camera {
@@ -325,11 +291,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let frames: Vec<Image> = snapshots
         .par_iter()
         .map(|s| {
-            let mut parts = parts.clone();
-            for (d, q) in parts.domes.iter_mut().zip(&s.squeeze) {
-                d.squeeze = *q;
-            }
-            let mut picture = parts.picture(&s.positions);
+            let mut picture = picture(drawing, &s.positions, &s.bells);
             if !args.no_caption {
                 picture.caption = Some(format!("t = {:.2} s", s.t));
             }

@@ -326,7 +326,7 @@ fn orange_pixels(img: &Image) -> usize {
 }
 
 /// A hopping roobot leaves a fixed framing within two seconds; by default
-/// the camera follows the first walker (or a scene's [evolve] particles, or
+/// the camera follows a scene's one creature (or its [evolve] particles, or
 /// the creature `--follow` names), so the last frame still shows it.
 #[test]
 fn walkers_stay_in_the_picture_by_default() {
@@ -386,7 +386,7 @@ fn walkers_stay_in_the_picture_by_default() {
     assert!(
         text(&o)
             .1
-            .contains("no particle or creature called `south`"),
+            .contains("no creature or particle called `south`"),
         "{}",
         text(&o).1
     );

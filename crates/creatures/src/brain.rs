@@ -13,6 +13,8 @@
 //! "leave that actuator as it is". The scene's controllers always write
 //! every output.
 
+use animats_engine::ModelError;
+
 /// Sensor levels in, actuator levels out.
 pub trait Brain: Send {
     /// The kind's name (`oscillator`, `neural`, `fsm`...).
@@ -111,4 +113,47 @@ pub fn check_genome(kind: &str, expected: usize, genome: &[f64]) -> Result<(), S
 /// `(lo, hi)` widened to contain `x`.
 pub fn around(x: f64, lo: f64, hi: f64) -> (f64, f64) {
     (lo.min(x), hi.max(x))
+}
+
+/// `x` if finite, else an error naming `field`.
+pub fn finite(field: &str, x: f64) -> Result<f64, ModelError> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(ModelError::new(
+            field,
+            format!("must be a finite number, got {x}"),
+        ))
+    }
+}
+
+/// `x` if finite and > 0, else an error naming `field`.
+pub fn positive(field: &str, x: f64) -> Result<f64, ModelError> {
+    if finite(field, x)? > 0.0 {
+        Ok(x)
+    } else {
+        Err(ModelError::new(field, format!("must be > 0, got {x}")))
+    }
+}
+
+/// One finite number per output (`n`), or `default` for each if not given.
+pub fn per_output(
+    field: &str,
+    v: &Option<Vec<f64>>,
+    n: usize,
+    default: f64,
+) -> Result<Vec<f64>, ModelError> {
+    match v {
+        None => Ok(vec![default; n]),
+        Some(v) if v.len() != n => Err(ModelError::new(
+            field,
+            format!("needs one number per output ({n}), got {}", v.len()),
+        )),
+        Some(v) => {
+            for x in v {
+                finite(field, *x)?;
+            }
+            Ok(v.clone())
+        }
+    }
 }

@@ -24,6 +24,6 @@ pub mod video;
 
 pub use camera::Camera;
 pub use image::Image;
-pub use picture::{Bell, DomeParts, Parts, Picture, Rod, Sphere};
+pub use picture::{picture, Bell, Picture, Rod, Sphere};
 pub use plot::{step_plot_png, Plot, Series};
 pub use raster::render;

@@ -1,7 +1,8 @@
-//! What to draw: spheres, rods, jellyfish bells, the floor and the water,
-//! and how each part of a creature or its world is coloured (the same
-//! palette as the live view's page).
+//! What the renderer draws: spheres, rods, jellyfish bells, the floor and
+//! the water, made from the one drawing model (`animats_view::Drawing`)
+//! that the live view's page draws too.
 
+use animats_view::{BellShape, Drawing};
 use glam::DVec3;
 
 /// An RGB colour, components in [0, 1].
@@ -14,12 +15,6 @@ pub fn hex(c: u32) -> Colour {
         f64::from((c >> 8) & 0xff),
         f64::from(c & 0xff),
     ) / 255.0
-}
-
-/// The colour of a particle of kind `kind` (see `animats_scene::Scene::kinds`),
-/// from the palette the live view uses too (`animats_view::palette`).
-pub fn kind_colour(kind: &str) -> Colour {
-    hex(animats_view::palette::colour_of(kind))
 }
 
 /// A solid sphere.
@@ -81,117 +76,53 @@ pub struct Picture {
     pub caption: Option<String>,
 }
 
-/// A jellyfish's dome for [`Parts`]: its dome and tentacle particles, and
-/// how far through a pulse it is (0 relaxed, 1 fully contracted).
-#[derive(Clone, Debug, PartialEq)]
-pub struct DomeParts {
-    /// Indices of the dome masses (three or more).
-    pub dome: Vec<usize>,
-    /// Indices of its tentacle masses (the bell opens towards them).
-    pub tentacles: Vec<usize>,
-    /// Contraction in [0, 1].
-    pub squeeze: f64,
-}
-
-/// A world described for drawing: what each particle is and how big.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Parts {
-    /// Each particle's kind (`roobot`, `dome`, `rock`, ...).
-    pub kinds: Vec<String>,
-    /// Each particle's radius, m.
-    pub radii: Vec<f64>,
-    /// Springs as index pairs.
-    pub springs: Vec<[usize; 2]>,
-    /// Jellyfish domes.
-    pub domes: Vec<DomeParts>,
-    /// Whether there is a floor.
-    pub floor: bool,
-    /// Whether the world is under water.
-    pub water: bool,
-    /// Size of the floor's squares, m.
-    pub cell: f64,
-}
-
-impl Parts {
-    /// The picture of these parts at `positions`.
-    pub fn picture(&self, positions: &[DVec3]) -> Picture {
-        let at = |i: usize| positions.get(i).copied().unwrap_or(DVec3::ZERO);
-        let spheres = self
-            .kinds
-            .iter()
-            .enumerate()
-            .map(|(i, kind)| Sphere {
-                centre: at(i),
-                radius: self.radii.get(i).copied().unwrap_or(0.0).max(0.001),
-                colour: kind_colour(kind),
-                shadow: kind != "bubble",
+/// The picture of `drawing` (`animats_view::Drawing`, the one drawing
+/// model) with the particles at `positions` and its bells shaped as
+/// `bells` says.
+pub fn picture(drawing: &Drawing, positions: &[DVec3], bells: &[Option<BellShape>]) -> Picture {
+    let at = |i: usize| positions.get(i).copied().unwrap_or(DVec3::ZERO);
+    let spheres = drawing
+        .balls
+        .iter()
+        .enumerate()
+        .map(|(i, b)| Sphere {
+            centre: at(i),
+            radius: b.radius,
+            colour: hex(b.colour),
+            shadow: b.shadow,
+        })
+        .collect();
+    let rods = drawing
+        .rods
+        .iter()
+        .map(|r| Rod {
+            a: at(r.a),
+            b: at(r.b),
+            radius: r.radius,
+            colour: hex(r.colour),
+        })
+        .collect();
+    let bells = drawing
+        .bells
+        .iter()
+        .zip(bells)
+        .filter_map(|(plan, shape)| {
+            let s = shape.as_ref()?;
+            Some(Bell {
+                centre: DVec3::from_array(s.centre),
+                axis: DVec3::from_array(s.axis),
+                radius: s.radius,
+                height: s.height,
+                colour: hex(plan.colour),
             })
-            .collect();
-        let rods = self
-            .springs
-            .iter()
-            .map(|&[a, b]| {
-                let r = self
-                    .radii
-                    .get(a)
-                    .copied()
-                    .unwrap_or(0.0)
-                    .min(self.radii.get(b).copied().unwrap_or(0.0));
-                Rod {
-                    a: at(a),
-                    b: at(b),
-                    radius: (0.3 * r).clamp(0.0015, 0.012),
-                    colour: kind_colour(self.kinds.get(a).map_or("", String::as_str)) * 0.8,
-                }
-            })
-            .collect();
-        let bells = self
-            .domes
-            .iter()
-            .filter_map(|d| {
-                let size = d
-                    .dome
-                    .iter()
-                    .map(|&i| self.radii.get(i).copied().unwrap_or(0.0))
-                    .sum::<f64>()
-                    / d.dome.len().max(1) as f64;
-                bell(d, &at, size)
-            })
-            .collect();
-        Picture {
-            spheres,
-            rods,
-            bells,
-            floor: self.floor.then_some(self.cell),
-            water: self.water,
-            caption: None,
-        }
+        })
+        .collect();
+    Picture {
+        spheres,
+        rods,
+        bells,
+        floor: drawing.floor,
+        water: drawing.water,
+        caption: None,
     }
-}
-
-/// The bell over a dome: wrapping the dome masses (of radius `size`),
-/// opening towards the tentacles, narrower and taller as it contracts (as
-/// the live view draws it).
-fn bell(d: &DomeParts, at: &impl Fn(usize) -> DVec3, size: f64) -> Option<Bell> {
-    if d.dome.len() < 3 {
-        return None;
-    }
-    let p: Vec<DVec3> = d.dome.iter().map(|&i| at(i)).collect();
-    let centre = p.iter().sum::<DVec3>() / p.len() as f64;
-    let mut axis = (p[0] - p[1]).cross(p[2] - p[0]).try_normalize()?;
-    if !d.tentacles.is_empty() {
-        let t = d.tentacles.iter().map(|&i| at(i)).sum::<DVec3>() / d.tentacles.len() as f64;
-        if axis.dot(centre - t) < 0.0 {
-            axis = -axis;
-        }
-    }
-    let radius = p.iter().map(|x| x.distance(centre)).sum::<f64>() / p.len() as f64 + size;
-    let s = d.squeeze.clamp(0.0, 1.0);
-    Some(Bell {
-        centre: centre - axis * (0.5 * size),
-        axis,
-        radius: radius * (1.08 - 0.28 * s),
-        height: radius * (0.75 + 0.45 * s),
-        colour: hex(animats_view::palette::colour_of("bell")),
-    })
 }

@@ -4,6 +4,8 @@
 //! SI units, y up, the floor is the plane y = 0. See `docs/SCENES.md` for the
 //! whole format with an example of every entry.
 
+pub use animats_creatures::brains::ControllerEntry;
+pub use animats_creatures::sensors::SensorEntry;
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -64,16 +66,57 @@ pub struct SceneDef {
     pub contacts: Option<Spanned<ContactsEntry>>,
     /// `[[actuator]]` entries: levels in [0, 1] onto a named spring, joint or force.
     #[serde(default)]
-    pub actuator: Vec<Spanned<ActuatorEntry>>,
+    pub actuator: Vec<Spanned<Typed<ActuatorEntry>>>,
     /// `[[sensor]]` entries: readings mapped onto [0, 1].
     #[serde(default)]
-    pub sensor: Vec<Spanned<SensorEntry>>,
+    pub sensor: Vec<Spanned<Typed<SensorEntry>>>,
     /// `[[controller]]` entries: brains from sensors to actuators.
     #[serde(default)]
-    pub controller: Vec<Spanned<ControllerEntry>>,
+    pub controller: Vec<Spanned<Typed<ControllerEntry>>>,
     /// `[evolve]`: the controller evolution tunes and how a run is scored.
     #[serde(default)]
     pub evolve: Option<Spanned<EvolveEntry>>,
+}
+
+/// An entry of a kind chosen by one of its keys (`kind`, or the target of
+/// an actuator), read in two steps: as a table, whose place in the file
+/// is then known, and then as `T`. Read in one step, an error inside the
+/// k-th entry of an array of tables would be reported at the array's
+/// first; the builder reports this one's at its own entry.
+#[derive(Clone, Debug)]
+pub struct Typed<T>(pub Result<T, String>);
+
+impl<'de, T: serde::de::DeserializeOwned> Deserialize<'de> for Typed<T> {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let table = toml::Table::deserialize(d)?;
+        Ok(Typed(
+            toml::Value::Table(table)
+                .try_into::<T>()
+                .map_err(|e| e.message().trim().to_string()),
+        ))
+    }
+}
+
+impl<T> Typed<T> {
+    /// The entry, or what is wrong with it: the key at fault where the
+    /// message names one (`kind` for an unknown kind), and the message.
+    pub fn get(&self) -> Result<&T, (&str, &str)> {
+        self.0.as_ref().map_err(|m| {
+            let named = |prefix: &str| {
+                m.strip_prefix(prefix)
+                    .and_then(|r| r.strip_prefix('`'))
+                    .and_then(|r| r.split('`').next())
+            };
+            let field = if m.starts_with("unknown variant") {
+                "kind"
+            } else {
+                named("unknown field ")
+                    .or_else(|| named("missing field "))
+                    .unwrap_or("")
+            };
+            (field, m.as_str())
+        })
+    }
 }
 
 /// Integration method names as written in files.
@@ -633,26 +676,21 @@ fn default_demo() -> f64 {
 }
 
 /// `[[actuator]]`: a level in [0, 1] mapped linearly onto [min, max] of one
-/// target's parameter (thesis §2.3.2.3).
+/// target's parameter (thesis §2.3.2.3). The target is one of the keys
+/// `spring`, `angle_joint`, `torque_joint` or `constant_force`, checked
+/// while the file is read.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "ActuatorKeys")]
 pub struct ActuatorEntry {
     /// Unique among actuators.
     pub name: String,
-    /// A named spring: its rest length, m.
-    pub spring: Option<String>,
-    /// A named angle joint: its rest angle, rad.
-    pub angle_joint: Option<String>,
-    /// A named torque joint: its torque, N m.
-    pub torque_joint: Option<String>,
-    /// A named constant force: a scale on its force vector.
-    pub constant_force: Option<String>,
+    /// What it drives.
+    pub target: Target,
     /// The value at level 0.
     pub min: f64,
     /// The value at level 1.
     pub max: f64,
     /// The initial level, default 0.5.
-    #[serde(default = "default_level")]
     pub level: f64,
     /// The most the level may change per second (a muscle's top speed);
     /// default: no limit.
@@ -660,6 +698,61 @@ pub struct ActuatorEntry {
     /// A motor or force that acts only while a sensor's level is above a
     /// threshold (or at most it); default: always.
     pub gate: Option<GateEntry>,
+}
+
+/// What an actuator drives, by the name of a spring, joint or force.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// `spring = "..."`: its rest length, m.
+    Spring(String),
+    /// `angle_joint = "..."`: its rest angle, rad.
+    AngleJoint(String),
+    /// `torque_joint = "..."`: its torque, N m.
+    TorqueJoint(String),
+    /// `constant_force = "..."`: a scale on its vector.
+    ConstantForce(String),
+}
+
+/// The keys of `[[actuator]]` as written.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ActuatorKeys {
+    name: String,
+    spring: Option<String>,
+    angle_joint: Option<String>,
+    torque_joint: Option<String>,
+    constant_force: Option<String>,
+    min: f64,
+    max: f64,
+    #[serde(default = "default_level")]
+    level: f64,
+    rate: Option<f64>,
+    gate: Option<GateEntry>,
+}
+
+impl TryFrom<ActuatorKeys> for ActuatorEntry {
+    type Error = String;
+    fn try_from(k: ActuatorKeys) -> Result<ActuatorEntry, String> {
+        let targets = [
+            k.spring.map(Target::Spring),
+            k.angle_joint.map(Target::AngleJoint),
+            k.torque_joint.map(Target::TorqueJoint),
+            k.constant_force.map(Target::ConstantForce),
+        ];
+        let mut given = targets.into_iter().flatten();
+        let (Some(target), None) = (given.next(), given.next()) else {
+            return Err("give exactly one target: `spring`, `angle_joint`, `torque_joint` or `constant_force`".into());
+        };
+        Ok(ActuatorEntry {
+            name: k.name,
+            target,
+            min: k.min,
+            max: k.max,
+            level: k.level,
+            rate: k.rate,
+            gate: k.gate,
+        })
+    }
 }
 
 /// `gate = { sensor = "...", above = x }` or `{ sensor = "...", at_most = x }`.
@@ -676,96 +769,6 @@ pub struct GateEntry {
 
 fn default_level() -> f64 {
     0.5
-}
-
-/// `[[sensor]]`: a reading mapped linearly from [min, max] onto [0, 1].
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SensorEntry {
-    /// Unique among sensors.
-    pub name: String,
-    /// `height`, `speed`, `touch`, `length`, `angle` or `tilt`.
-    pub kind: String,
-    /// The particle of `height`, `speed` and `touch`.
-    pub particle: Option<String>,
-    /// `speed`: the direction, default `[1, 0, 0]`.
-    pub axis: Option<[f64; 3]>,
-    /// `length`, `angle`, `tilt`: the first particle.
-    pub a: Option<String>,
-    /// `length`, `angle`, `tilt`: the second particle.
-    pub b: Option<String>,
-    /// `angle`: the vertex.
-    pub joint: Option<String>,
-    /// The reading at level 0; default 0.
-    pub min: Option<f64>,
-    /// The reading at level 1; default 1 (π for `angle` and `tilt`).
-    pub max: Option<f64>,
-}
-
-/// `[[controller]]`: a brain. Which keys apply depends on `kind`.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ControllerEntry {
-    /// Unique among controllers.
-    pub name: String,
-    /// `oscillator`, `neural` or `fsm`.
-    pub kind: String,
-    /// Sensors read, by name (`neural`, `fsm`).
-    #[serde(default)]
-    pub inputs: Vec<String>,
-    /// Actuators driven, by name.
-    pub outputs: Vec<String>,
-    /// `oscillator`: Hz.
-    pub frequency: Option<f64>,
-    /// `oscillator`: one per output.
-    pub amplitude: Option<Vec<f64>>,
-    /// `oscillator`: rad, one per output.
-    pub phase: Option<Vec<f64>>,
-    /// `oscillator`: one per output.
-    pub offset: Option<Vec<f64>>,
-    /// `neural`: hidden layer sizes, default none.
-    pub hidden: Option<Vec<usize>>,
-    /// `neural`: frequency of the clock inputs, Hz.
-    pub clock: Option<f64>,
-    /// `neural`: every weight and bias, layer by layer.
-    pub weights: Option<Vec<f64>>,
-    /// `neural`: seed of the default random weights, default 1.
-    pub seed: Option<u64>,
-    /// `fsm`: the state it starts in; default the first.
-    pub initial: Option<String>,
-    /// `fsm`: its states.
-    pub state: Option<Vec<StateEntry>>,
-}
-
-/// `[[controller.state]]` of an FSM.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct StateEntry {
-    /// Unique within the controller.
-    pub name: String,
-    /// The level of each output in this state.
-    pub levels: Vec<f64>,
-    /// Level units per second the outputs move towards `levels`; default: at once.
-    pub rate: Option<f64>,
-    /// Ways out, checked in order.
-    #[serde(default)]
-    pub transition: Vec<TransitionEntry>,
-}
-
-/// `[[controller.state.transition]]`.
-#[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TransitionEntry {
-    /// The state it leads to.
-    pub to: String,
-    /// An input sensor whose level is compared.
-    pub sensor: Option<String>,
-    /// Fires when the sensor's level is above this.
-    pub above: Option<f64>,
-    /// Fires when the sensor's level is below this.
-    pub below: Option<f64>,
-    /// Fires only after this long in the state, s.
-    pub after: Option<f64>,
 }
 
 /// `[evolve]`: what `animats evolve SCENE` tunes and how an evaluation

@@ -46,9 +46,11 @@ pub struct Scene {
     pub world: World,
     /// Name of each particle, indexed by [`ParticleId::index`].
     pub names: Vec<String>,
-    /// What each particle is part of, for drawing: `particle`, `food`,
-    /// `roobot`, `dome`, `tentacle`, `seaweed`, `bubble`, `rock`, `quadruped`.
-    pub kinds: Vec<&'static str>,
+    /// What each particle is part of, for drawing.
+    pub kinds: Vec<PartKind>,
+    /// The creatures, as data: their names and particles (what a camera
+    /// follows), and a jellyfish's dome and tentacles (what its bell wraps).
+    pub creatures: Vec<Creature>,
     /// Step, s.
     pub dt: f64,
     /// Largest stable step, s (real-time mode never exceeds it).
@@ -69,6 +71,66 @@ pub struct Scene {
     /// starts inside the floor, a nail given a velocity, a step far past the
     /// stiffest spring's stability limit): front ends print them.
     pub warnings: Vec<String>,
+}
+
+/// What a particle is part of, for drawing (its colour and look).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PartKind {
+    /// A `[[particle]]`.
+    Particle,
+    /// A `[[food]]`.
+    Food,
+    /// A roobot.
+    Roobot,
+    /// A jellyfish's dome mass.
+    Dome,
+    /// A jellyfish's tentacle segment.
+    Tentacle,
+    /// A seaweed frond's segment.
+    Seaweed,
+    /// A bubble.
+    Bubble,
+    /// A rock.
+    Rock,
+    /// A quadruped.
+    Quadruped,
+}
+
+impl PartKind {
+    /// Its name, as the palette and the live view's page know it.
+    pub fn name(self) -> &'static str {
+        match self {
+            PartKind::Particle => "particle",
+            PartKind::Food => "food",
+            PartKind::Roobot => "roobot",
+            PartKind::Dome => "dome",
+            PartKind::Tentacle => "tentacle",
+            PartKind::Seaweed => "seaweed",
+            PartKind::Bubble => "bubble",
+            PartKind::Rock => "rock",
+            PartKind::Quadruped => "quadruped",
+        }
+    }
+}
+
+/// A creature of a scene, as data.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Creature {
+    /// Its name (the prefix of its particles' names).
+    pub name: String,
+    /// Indices of its particles.
+    pub particles: Vec<usize>,
+    /// A jellyfish's bell: its dome masses and its tentacles' masses.
+    pub bell: Option<Bell>,
+}
+
+/// The masses a jellyfish's bell is drawn over.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Bell {
+    /// Indices of the dome masses.
+    pub dome: Vec<usize>,
+    /// Indices of the tentacle masses (the bell opens towards them).
+    pub tentacles: Vec<usize>,
 }
 
 /// The state of a scene at one instant (see [`Scene::snapshot`]).

@@ -181,12 +181,12 @@ fn mistakes_are_refused_naming_the_entry_and_field() {
         (
             "kind = \"length\"",
             "kind = \"smell\"",
-            "sensor[0].kind: unknown sensor kind `smell`",
+            "sensor[0].kind: unknown variant `smell`, expected one of `height`, `touch`, `speed`",
         ),
         (
             "kind = \"height\"\nparticle = \"c\"",
             "kind = \"height\"\nparticle = \"c\"\naxis = [1.0, 0.0, 0.0]",
-            "sensor[3].axis: a `height` sensor has no `axis`",
+            "sensor[3].axis: unknown field `axis`, expected one of `name`, `particle`, `min`, `max`",
         ),
         (
             "min = 1.0\nmax = 2.0",
@@ -206,12 +206,12 @@ fn mistakes_are_refused_naming_the_entry_and_field() {
         (
             "kind = \"oscillator\"",
             "kind = \"brainwave\"",
-            "controller[0].kind: unknown controller kind `brainwave`",
+            "controller[0].kind: unknown variant `brainwave`, expected one of `oscillator`, `neural`, `fsm`",
         ),
         (
             "frequency = 2.0",
             "frequency = 2.0\nhidden = [3]",
-            "controller[0].hidden: an `oscillator` controller has no `hidden`",
+            "controller[0].hidden: unknown field `hidden`, expected one of `name`, `outputs`, `frequency`",
         ),
     ];
     for (from, to, expected) in cases {
@@ -522,5 +522,50 @@ fn the_walker_evolved_among_rocks_outwalks_the_bare_floor_gait_there() {
         let (a, b) = (distance(&evolved), distance(&bare));
         println!("seed {seed:?}: evolved among rocks {a} m, bare-floor gait {b} m");
         assert!(a > 1.03 * b, "seed {seed:?}: {a} m against {b} m");
+    }
+}
+
+#[test]
+fn every_brain_kind_writes_its_genes_back_where_it_reads_them() {
+    // Each kind lays out its own genome (GenomeKey): a genome written into
+    // the scene's text reads back as the same genome, for the scene's
+    // controller kinds and the roobot's brains alike.
+    let pogo = format!(
+        "{}\n[evolve]\ncontroller = \"hop\"\nduration = 1.0\n",
+        include_str!("../../../scenes/pogo.toml")
+    );
+    let neural = PAIR.replacen(
+        "kind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 2.0\namplitude = [0.3]\nphase = [0.5]\noffset = [0.4]",
+        "kind = \"neural\"\ninputs = [\"gap\", \"bend\"]\noutputs = [\"m\"]\nhidden = [3]\nclock = 1.5",
+        1,
+    ) + "\n[evolve]\ncontroller = \"osc\"\nduration = 0.5\n";
+    let raibert = animats_scene::HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
+    let cases = [
+        ("fsm", pogo.as_str()),
+        ("neural", neural.as_str()),
+        ("oscillator", COAST),
+        ("hop", animats_scene::HOP_EVOLVER),
+        ("raibert", raibert.as_str()),
+    ];
+    for (kind, text) in cases {
+        let p = SceneProblem::parse(text, "kinds.toml").unwrap_or_else(|e| panic!("{kind}: {e}"));
+        let scene = p.fresh().unwrap();
+        let brain = &scene.nervous.controllers[scene.evolve.as_ref().unwrap().index].brain;
+        assert_eq!(brain.kind(), kind);
+        let keys: usize = brain.genome_keys().iter().map(|k| k.genes()).sum();
+        assert_eq!(
+            keys,
+            p.start().len(),
+            "{kind}: the keys hold the whole genome"
+        );
+        let g: Vec<f64> = p
+            .start()
+            .iter()
+            .enumerate()
+            .map(|(i, x)| x + 0.001 * (i as f64 + 1.0))
+            .collect();
+        let written = p.best_toml(&g, "").unwrap();
+        let back = SceneProblem::parse(&written, "best.toml").unwrap();
+        assert_eq!(back.start(), g, "{kind}:\n{written}");
     }
 }

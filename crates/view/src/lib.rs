@@ -8,6 +8,8 @@
 //! - `model.rs`: the description of a world to draw (particles and their
 //!   kinds, springs, jellyfish domes, food, the camera's first framing) and a
 //!   creature's state;
+//! - `drawing.rs`: what is drawn (balls, rods, bells, floor, water), decided
+//!   once for the page and the renderer;
 //! - `palette.rs`: the colour of each kind of part, the one source of colour
 //!   (the page receives it from the server with the scene);
 //! - `stage.rs`: a [`Stage`] advances a world and describes it;
@@ -15,9 +17,11 @@
 
 #![warn(missing_docs)]
 
+pub mod drawing;
 pub mod model;
 pub mod palette;
 pub mod stage;
 
+pub use drawing::{Ball, BellPlan, BellShape, Drawing, Look, Rod};
 pub use model::{CreatureState, Describe, Dome, Part};
 pub use stage::{framing, SceneStage, Stage};

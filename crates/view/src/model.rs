@@ -10,8 +10,8 @@ pub struct Part {
     pub name: String,
     /// Its radius, m.
     pub radius: f64,
-    /// What it is part of (see `animats_scene::Scene::kinds`).
-    pub kind: String,
+    /// What it is part of (`animats_scene::PartKind::name`).
+    pub kind: &'static str,
 }
 
 /// A jellyfish's dome, drawn as a pulsing bell over its three dome masses.
@@ -56,6 +56,8 @@ pub struct Describe {
     /// Whether the camera orbits what it follows until the user takes over
     /// (an evolution's exhibition, as the thesis showed it).
     pub orbit: bool,
+    /// What is drawn: the page draws these and computes no shape itself.
+    pub drawing: crate::drawing::Drawing,
 }
 
 /// A caption that stays above a particle in the 3-D view.

@@ -3,7 +3,7 @@
 
 use crate::model::{CreatureState, Describe, Dome, Part};
 use animats_engine::DVec3;
-use animats_scene::Scene;
+use animats_scene::{PartKind, Scene};
 use std::path::PathBuf;
 
 /// Something the viewer can run and draw.
@@ -57,10 +57,10 @@ impl SceneStage {
     }
 
     /// Loads the scene at `path`; the camera frames and follows the
-    /// particle or creature called `follow` (a creature's particles are
-    /// `NAME.part`), or by default the scene's `[evolve]` particles, or the
-    /// first roobot or quadruped; a scene with none of them is framed whole
-    /// and not followed.
+    /// creature or particle called `follow`, or by default the scene's
+    /// `[evolve]` particles, or its creature if it has one (a roobot, a
+    /// quadruped, a jellyfish...); a scene with none, or several, is framed
+    /// whole and not followed.
     pub fn following(path: PathBuf, follow: Option<&str>) -> Result<SceneStage, String> {
         let scene = animats_scene::load(&path).map_err(|e| e.to_string())?;
         let focus = focus_of(&scene, follow).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -94,39 +94,31 @@ impl SceneStage {
     }
 
     fn food(&self) -> Option<usize> {
-        self.scene.kinds.iter().position(|k| *k == "food")
+        self.scene.kinds.iter().position(|k| *k == PartKind::Food)
     }
 }
 
 /// What the camera follows in `scene` (see [`SceneStage::following`]).
 fn focus_of(scene: &Scene, follow: Option<&str>) -> Result<Vec<usize>, String> {
-    let of = |name: &str| -> Vec<usize> {
-        let prefix = format!("{name}.");
-        (0..scene.names.len())
-            .filter(|&i| scene.names[i] == name || scene.names[i].starts_with(&prefix))
-            .collect()
-    };
     if let Some(name) = follow {
-        let found = of(name);
-        if found.is_empty() {
-            return Err(format!(
-                "--follow {name}: no particle or creature called `{name}` (a creature's particles are `{name}.part`)"
-            ));
+        if let Some(c) = scene.creatures.iter().find(|c| c.name == name) {
+            return Ok(c.particles.clone());
         }
-        return Ok(found);
+        return match scene.particle(name) {
+            Some(p) => Ok(vec![p.index()]),
+            None => Err(format!(
+                "--follow {name}: no creature or particle called `{name}`"
+            )),
+        };
     }
     if let Some(spec) = &scene.evolve {
         return Ok(spec.particles.iter().map(|p| p.index()).collect());
     }
-    let walker = (0..scene.kinds.len()).find(|&i| matches!(scene.kinds[i], "roobot" | "quadruped"));
-    Ok(match walker {
-        Some(i) => {
-            let name = &scene.names[i];
-            of(name
-                .rsplit_once('.')
-                .map_or(name.as_str(), |(creature, _)| creature))
-        }
-        None => Vec::new(),
+    // One creature, whatever it is, is followed; among several (a
+    // reef, a race) none is chosen over the others.
+    Ok(match &scene.creatures[..] {
+        [one] => one.particles.clone(),
+        _ => Vec::new(),
     })
 }
 
@@ -158,7 +150,7 @@ impl Stage for SceneStage {
             .map(|i| Part {
                 name: self.scene.names[i].clone(),
                 radius: p.radius[i],
-                kind: self.scene.kinds[i].to_string(),
+                kind: self.scene.kinds[i].name(),
             })
             .collect();
         let springs = w
@@ -170,32 +162,19 @@ impl Stage for SceneStage {
                 [a.index(), b.index()]
             })
             .collect();
-        let mut domes: Vec<Dome> = Vec::new();
-        for (i, k) in self.scene.kinds.iter().enumerate() {
-            if *k == "dome" {
-                let name = self.scene.names[i]
-                    .split(".dome")
-                    .next()
-                    .unwrap_or("")
-                    .to_string();
-                match domes.iter_mut().find(|d| d.name == name) {
-                    Some(d) => d.particles.push(i),
-                    None => domes.push(Dome {
-                        name,
-                        particles: vec![i],
-                        tentacles: Vec::new(),
-                    }),
-                }
-            }
-        }
-        for d in &mut domes {
-            let prefix = format!("{}.tentacle", d.name);
-            d.tentacles = (0..w.len())
-                .filter(|&i| {
-                    self.scene.kinds[i] == "tentacle" && self.scene.names[i].starts_with(&prefix)
+        let domes = self
+            .scene
+            .creatures
+            .iter()
+            .filter_map(|c| {
+                let bell = c.bell.as_ref()?;
+                Some(Dome {
+                    name: c.name.clone(),
+                    particles: bell.dome.clone(),
+                    tentacles: bell.tentacles.clone(),
                 })
-                .collect();
-        }
+            })
+            .collect();
         let floor = w.event::<animats_engine::FloorCollision>().is_some();
         let pos = &w.state().pos;
         let (target, distance) = if self.focus.is_empty() {
@@ -221,6 +200,7 @@ impl Stage for SceneStage {
             palette: crate::palette::PALETTE.into_iter().collect(),
             labels: Vec::new(),
             orbit: false,
+            drawing: crate::drawing::Drawing::of(&self.scene, distance),
         }
     }
 

@@ -14,6 +14,7 @@
 use serde::{Deserialize, Serialize};
 
 pub use animats_view::model::{CreatureState, Describe, Dome, Part};
+pub use animats_view::BellShape;
 
 /// Where everything is now.
 #[derive(Clone, Debug, Serialize)]
@@ -35,7 +36,10 @@ pub struct Frame {
     pub p: Vec<f32>,
     /// Every creature's state.
     pub creatures: Vec<CreatureState>,
-    /// A point the camera may follow (the leading roobot of an evolution).
+    /// Each jellyfish's bell now, in the order of the scene's
+    /// `drawing.bells` (`null` where its dome is degenerate).
+    pub bells: Vec<Option<BellShape>>,
+    /// A point the camera may follow (the creature an evolution shows).
     pub focus: Option<[f64; 3]>,
     /// Why the simulation stopped, if it failed (it is paused until reset).
     pub error: Option<String>,

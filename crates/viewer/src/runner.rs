@@ -60,6 +60,9 @@ pub struct Runner {
     waiting: bool,
     error: Option<String>,
     positions: Vec<f32>,
+    /// What is drawn (from the last scene published): its bells are shaped
+    /// here for every frame.
+    drawing: animats_view::Drawing,
     summary: Summary,
 }
 
@@ -98,7 +101,7 @@ impl Runner {
         display_hz: f64,
         speed: f64,
     ) -> Runner {
-        let runner = Runner {
+        let mut runner = Runner {
             stage,
             commands,
             out,
@@ -109,14 +112,17 @@ impl Runner {
             waiting: true,
             error: None,
             positions: Vec::new(),
+            drawing: Default::default(),
             summary: Summary::default(),
         };
         runner.publish_scene();
         runner
     }
 
-    fn publish_scene(&self) {
-        let json = serde_json::to_string(&self.stage.describe()).unwrap_or_default();
+    fn publish_scene(&mut self) {
+        let describe = self.stage.describe();
+        let json = serde_json::to_string(&describe).unwrap_or_default();
+        self.drawing = describe.drawing;
         self.out.scene.send_replace(json.into());
     }
 
@@ -260,6 +266,17 @@ impl Runner {
 
     fn publish_frame(&mut self, fps: f64, rtf: f64) {
         self.stage.positions(&mut self.positions);
+        let creatures = self.stage.creatures();
+        let bells = if self.drawing.bells.is_empty() {
+            Vec::new()
+        } else {
+            let at: Vec<animats_engine::DVec3> = self
+                .positions
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]].map(f64::from).into())
+                .collect();
+            self.drawing.bell_shapes(&at, &creatures)
+        };
         let frame = Frame {
             kind: "frame",
             t: self.stage.time(),
@@ -268,7 +285,8 @@ impl Runner {
             speed: self.speed,
             paused: self.paused,
             p: std::mem::take(&mut self.positions),
-            creatures: self.stage.creatures(),
+            creatures,
+            bells,
             focus: self.stage.focus(),
             error: self.error.clone(),
             note: self.stage.note(),

@@ -3,9 +3,10 @@
 import * as THREE from 'three';
 import { OrbitControls } from '/vendor/OrbitControls.js';
 
-// Colours by kind of part: the server sends its palette (the renderer's
-// too) with every scene; one grey until then.
-let COLOURS = { particle: 0x888888 };
+// What is drawn comes from the server (the renderer draws the same
+// `drawing`): each ball's radius, colour and look, each rod's radius and
+// colour, each bell's shape every frame, the floor's checker and the water.
+// The page computes no shape of its own.
 const WATER = 0x0d3b5c;
 const AIR = 0xbfd4e6;
 
@@ -78,7 +79,6 @@ function connect() {
     let msg;
     try { msg = JSON.parse(event.data); } catch { return; }
     if (msg.type === 'scene') {
-      if (msg.palette) COLOURS = msg.palette;
       viewer.scene = msg;
       build(msg);
     } else if (msg.type === 'frame') {
@@ -92,12 +92,11 @@ function connect() {
   };
 }
 
-function material(kind) {
-  const colour = COLOURS[kind] ?? COLOURS.particle;
+function material(colour, look) {
   const m = new THREE.MeshStandardMaterial({ color: colour, roughness: 0.6, metalness: 0.05 });
-  if (kind === 'food') m.emissive = new THREE.Color(0x664400);
-  if (kind === 'bubble') { m.transparent = true; m.opacity = 0.55; m.roughness = 0.1; }
-  if (kind === 'dome' || kind === 'tentacle') { m.transparent = true; m.opacity = 0.85; }
+  if (look === 'glow') m.emissive = new THREE.Color(0x664400);
+  if (look === 'clear') { m.transparent = true; m.opacity = 0.55; m.roughness = 0.1; }
+  if (look === 'soft') { m.transparent = true; m.opacity = 0.85; }
   return m;
 }
 
@@ -112,14 +111,15 @@ function build(desc) {
     });
   }
   const group = new THREE.Group();
-  const water = desc.fluid !== null && desc.fluid > 500;
+  const d = desc.drawing;
+  const water = d.water;
   scene.background = new THREE.Color(water ? WATER : AIR);
   scene.fog = water ? new THREE.FogExp2(WATER, 0.18) : new THREE.Fog(AIR, 30, 120);
 
   let floor = null;
-  if (desc.floor) {
-    // A checkerboard of 10 cm (or 50 cm) squares shows scale and motion.
-    const cell = desc.distance < 4 ? 0.1 : 0.5;
+  if (d.floor !== null) {
+    // A checkerboard shows scale and motion.
+    const cell = d.floor;
     const size = cell * 400;
     const [a, b] = water ? [[194, 178, 128], [178, 162, 114]] : [[150, 168, 128], [128, 146, 108]];
     const texels = new Uint8Array([...a, 255, ...b, 255, ...b, 255, ...a, 255]);
@@ -140,48 +140,45 @@ function build(desc) {
     group.add(floor);
   }
 
-  // Spheres, one instanced mesh per kind.
-  const byKind = new Map();
-  desc.particles.forEach((p, i) => {
-    if (!byKind.has(p.kind)) byKind.set(p.kind, []);
-    byKind.get(p.kind).push(i);
+  // Balls, one instanced mesh per colour and look.
+  const groups = new Map();
+  d.balls.forEach((b, i) => {
+    const key = `${b.colour}/${b.look}/${b.shadow}`;
+    if (!groups.has(key)) groups.set(key, { ball: b, indices: [] });
+    groups.get(key).indices.push(i);
   });
   const spheres = [];
-  for (const [kind, indices] of byKind) {
-    const mesh = new THREE.InstancedMesh(sphere, material(kind), indices.length);
+  for (const { ball, indices } of groups.values()) {
+    const mesh = new THREE.InstancedMesh(sphere, material(ball.colour, ball.look), indices.length);
     mesh.frustumCulled = false;
-    mesh.castShadow = kind !== 'bubble';
+    mesh.castShadow = ball.shadow;
     group.add(mesh);
-    spheres.push({ mesh, indices, radii: indices.map((i) => Math.max(desc.particles[i].radius, 0.001)) });
+    spheres.push({ mesh, indices, radii: indices.map((i) => d.balls[i].radius) });
   }
 
-  // Springs as thin cylinders, coloured like their first end.
+  // Springs as thin rods.
   let springs = null;
-  if (desc.springs.length > 0) {
-    const mesh = new THREE.InstancedMesh(rod, new THREE.MeshStandardMaterial({ roughness: 0.7 }), desc.springs.length);
+  if (d.rods.length > 0) {
+    const mesh = new THREE.InstancedMesh(rod, new THREE.MeshStandardMaterial({ roughness: 0.7 }), d.rods.length);
     mesh.frustumCulled = false;
     mesh.castShadow = true;
     const colour = new THREE.Color();
-    const radii = desc.springs.map(([a, b], k) => {
-      colour.setHex(COLOURS[desc.particles[a].kind] ?? COLOURS.particle).multiplyScalar(0.8);
-      mesh.setColorAt(k, colour);
-      const r = Math.min(desc.particles[a].radius, desc.particles[b].radius);
-      return Math.min(Math.max(0.3 * r, 0.0015), 0.012);
-    });
+    d.rods.forEach((r, k) => mesh.setColorAt(k, colour.setHex(r.colour)));
     group.add(mesh);
-    springs = { mesh, radii };
+    springs = { mesh, rods: d.rods };
   }
 
-  // Jellyfish domes: translucent bells over their dome masses.
-  const domes = desc.domes.map((d) => {
+  // Jellyfish: translucent bells over their dome masses, shaped by the
+  // server every frame.
+  const domes = d.bells.map((b) => {
     const mesh = new THREE.Mesh(bell, new THREE.MeshStandardMaterial({
-      color: COLOURS.bell, transparent: true, opacity: 0.45, side: THREE.DoubleSide, roughness: 0.3,
+      color: b.colour, transparent: true, opacity: 0.45, side: THREE.DoubleSide, roughness: 0.3,
       emissive: 0x301020,
     }));
     mesh.frustumCulled = false;
+    mesh.visible = false;
     group.add(mesh);
-    const mass = d.particles.reduce((r, i) => r + desc.particles[i].radius, 0) / Math.max(1, d.particles.length);
-    return { ...d, mesh, mass };
+    return { mesh };
   });
 
   scene.add(group);
@@ -193,7 +190,7 @@ function build(desc) {
     div.className = 'label';
     div.textContent = l.text;
     box.appendChild(div);
-    return { div, particle: l.particle, lift: 3 * desc.particles[l.particle].radius + 0.05 };
+    return { div, particle: l.particle, lift: 3 * desc.drawing.balls[l.particle].radius + 0.05 };
   });
   drawn = { group, spheres, springs, domes, floor, water, labels, size: desc.distance };
 
@@ -238,43 +235,27 @@ function draw(frame) {
     mesh.instanceMatrix.needsUpdate = true;
   }
   if (drawn.springs) {
-    const { mesh, radii } = drawn.springs;
-    viewer.scene.springs.forEach(([a, b], k) => {
-      at(p, a, v);
-      at(p, b, w);
+    const { mesh, rods } = drawn.springs;
+    rods.forEach((r, k) => {
+      at(p, r.a, v);
+      at(p, r.b, w);
       const length = v.distanceTo(w);
       w.sub(v);
       if (length > 1e-9) q.setFromUnitVectors(UP, w.divideScalar(length)); else q.identity();
       v.addScaledVector(w, 0.5 * length);
-      s3.set(radii[k], Math.max(length, 1e-6), radii[k]);
+      s3.set(r.radius, Math.max(length, 1e-6), r.radius);
       mesh.setMatrixAt(k, m4.compose(v, q, s3));
     });
     mesh.instanceMatrix.needsUpdate = true;
   }
-  const states = new Map(frame.creatures.map((c) => [c.name, c]));
-  for (const d of drawn.domes) {
-    const pts = d.particles.map((i) => at(p, i, new THREE.Vector3()));
-    if (pts.length < 3) continue;
-    const c = new THREE.Vector3();
-    pts.forEach((x) => c.add(x));
-    c.divideScalar(pts.length);
-    const n = new THREE.Vector3().subVectors(pts[0], pts[1]).cross(new THREE.Vector3().subVectors(pts[2], pts[0])).normalize();
-    // The bell opens towards the tentacles.
-    if (d.tentacles.length > 0) {
-      const t = new THREE.Vector3();
-      d.tentacles.forEach((i) => t.add(at(p, i, w)));
-      t.divideScalar(d.tentacles.length);
-      if (n.dot(c.clone().sub(t)) < 0) n.negate();
-    }
-    // The bell wraps the dome masses: their ring plus their own radius.
-    const radius = pts.reduce((r, x) => r + x.distanceTo(c), 0) / pts.length + d.mass;
-    const st = states.get(d.name);
-    // Contraction follows the pulse: full at the top of the power stroke.
-    const squeeze = st && st.state !== 'idle' && st.phase != null ? Math.max(0, Math.sin(st.phase)) : 0;
-    d.mesh.position.copy(c).addScaledVector(n, -0.5 * d.mass);
-    d.mesh.quaternion.setFromUnitVectors(UP, n);
-    d.mesh.scale.set(radius * (1.08 - 0.28 * squeeze), radius * (0.75 + 0.45 * squeeze), radius * (1.08 - 0.28 * squeeze));
-  }
+  drawn.domes.forEach((d, k) => {
+    const b = (frame.bells ?? [])[k];
+    d.mesh.visible = !!b;
+    if (!b) return;
+    d.mesh.position.set(...b.centre);
+    d.mesh.quaternion.setFromUnitVectors(UP, v.set(...b.axis));
+    d.mesh.scale.set(b.radius, b.height, b.radius);
+  });
   if (frame.focus && $('follow').checked) {
     const target = new THREE.Vector3(...frame.focus);
     // An evolution's leader changes: ease over; a walker is tracked closely.

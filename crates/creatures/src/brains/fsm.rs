@@ -14,7 +14,184 @@
 //! in [0, 1], times in [0, max(2 s, 2 × value)], rates in
 //! [0, max(100, 2 × value)] per second.
 
-use crate::brain::{around, check_genome, Brain, GenomeKey};
+use crate::brain::{around, check_genome, finite, positive, Brain, GenomeKey};
+use animats_engine::ModelError;
+use serde::Deserialize;
+
+/// `[[controller]] kind = "fsm"`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FsmEntry {
+    /// Unique among controllers.
+    pub name: String,
+    /// Sensors read, by name (transitions compare their levels).
+    #[serde(default)]
+    pub inputs: Vec<String>,
+    /// Actuators driven, by name.
+    pub outputs: Vec<String>,
+    /// The state it starts in; default the first.
+    pub initial: Option<String>,
+    /// Its states, `[[controller.state]]`.
+    #[serde(default)]
+    pub state: Vec<StateEntry>,
+}
+
+/// `[[controller.state]]` of an FSM.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StateEntry {
+    /// Unique within the controller.
+    pub name: String,
+    /// The level of each output in this state.
+    pub levels: Vec<f64>,
+    /// Level units per second the outputs move towards `levels`; default: at once.
+    pub rate: Option<f64>,
+    /// Ways out, checked in order.
+    #[serde(default)]
+    pub transition: Vec<TransitionEntry>,
+}
+
+/// `[[controller.state.transition]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransitionEntry {
+    /// The state it leads to.
+    pub to: String,
+    /// An input sensor whose level is compared.
+    pub sensor: Option<String>,
+    /// Fires when the sensor's level is above this.
+    pub above: Option<f64>,
+    /// Fires when the sensor's level is below this.
+    pub below: Option<f64>,
+    /// Fires only after this long in the state, s.
+    pub after: Option<f64>,
+}
+
+impl FsmEntry {
+    /// The machine it describes; `levels` are its outputs' initial levels.
+    pub fn build(&self, levels: Vec<f64>) -> Result<Fsm, ModelError> {
+        let states = &self.state;
+        if states.is_empty() {
+            return Err(ModelError::new(
+                "state",
+                "an FSM needs at least one [[controller.state]]",
+            ));
+        }
+        let built = states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| self.state(i, s))
+            .collect::<Result<_, _>>()?;
+        let initial = match &self.initial {
+            Some(name) => self.index("initial", name)?,
+            None => 0,
+        };
+        Ok(Fsm::new(built, initial, levels))
+    }
+
+    fn index(&self, field: &str, name: &str) -> Result<usize, ModelError> {
+        self.state
+            .iter()
+            .position(|s| s.name == name)
+            .ok_or_else(|| ModelError::new(field, format!("no state named `{name}`")))
+    }
+
+    fn state(&self, i: usize, s: &StateEntry) -> Result<FsmState, ModelError> {
+        let n = self.outputs.len();
+        let f = |k: &str| format!("state[{i}].{k}");
+        if self.state[..i].iter().any(|o| o.name == s.name) {
+            return Err(ModelError::new(
+                f("name"),
+                format!("duplicate state name `{}`", s.name),
+            ));
+        }
+        if s.levels.len() != n {
+            return Err(ModelError::new(
+                f("levels"),
+                format!("needs one level per output ({n}), got {}", s.levels.len()),
+            ));
+        }
+        if let Some(l) = s.levels.iter().find(|l| !(0.0..=1.0).contains(*l)) {
+            return Err(ModelError::new(
+                f("levels"),
+                format!("levels are in [0, 1], got {l}"),
+            ));
+        }
+        let rate = match s.rate {
+            Some(r) => Some(positive(&f("rate"), r)?),
+            None => None,
+        };
+        let transitions = s
+            .transition
+            .iter()
+            .enumerate()
+            .map(|(j, t)| self.transition(&format!("state[{i}].transition[{j}]."), t))
+            .collect::<Result<_, _>>()?;
+        Ok(FsmState {
+            name: s.name.clone(),
+            levels: s.levels.clone(),
+            rate,
+            transitions,
+        })
+    }
+
+    fn transition(&self, at: &str, t: &TransitionEntry) -> Result<Transition, ModelError> {
+        let g = |k: &str| format!("{at}{k}");
+        let to = self.index(&g("to"), &t.to)?;
+        let input = match &t.sensor {
+            Some(name) => Some(self.inputs.iter().position(|x| x == name).ok_or_else(|| {
+                ModelError::new(
+                    g("sensor"),
+                    format!("`{name}` is not one of this controller's inputs"),
+                )
+            })?),
+            None => None,
+        };
+        let condition = match (input, t.above, t.below) {
+            (Some(input), Some(th), None) => Condition::Above {
+                input,
+                threshold: finite(&g("above"), th)?,
+            },
+            (Some(input), None, Some(th)) => Condition::Below {
+                input,
+                threshold: finite(&g("below"), th)?,
+            },
+            (Some(_), _, _) => {
+                return Err(ModelError::new(
+                    g("sensor"),
+                    "give exactly one of `above` and `below` with a sensor",
+                ))
+            }
+            (None, None, None) => Condition::None,
+            (None, _, _) => {
+                return Err(ModelError::new(
+                    g("sensor"),
+                    "`above` and `below` need a `sensor`",
+                ))
+            }
+        };
+        let after = match t.after {
+            Some(a) if finite(&g("after"), a)? < 0.0 => {
+                return Err(ModelError::new(
+                    g("after"),
+                    format!("must be >= 0, got {a}"),
+                ))
+            }
+            other => other,
+        };
+        if condition == Condition::None && after.is_none() {
+            return Err(ModelError::new(
+                g("after"),
+                "a transition needs a sensor condition, `after`, or both",
+            ));
+        }
+        Ok(Transition {
+            to,
+            condition,
+            after,
+        })
+    }
+}
 
 /// What a transition reads.
 #[derive(Clone, Debug, PartialEq)]

@@ -10,9 +10,85 @@
 //! layer its weights row by row (`w_j0, w_j1, ...` for neuron j), then its
 //! biases. Bounds: [−10, 10] each, widened to contain the value given.
 
-use crate::brain::{around, check_genome, Brain, GenomeKey};
+use crate::brain::{around, check_genome, positive, Brain, GenomeKey};
 use crate::random::Random;
+use animats_engine::ModelError;
+use serde::Deserialize;
 use std::f64::consts::TAU;
+
+/// `[[controller]] kind = "neural"`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeuralEntry {
+    /// Unique among controllers.
+    pub name: String,
+    /// Sensors read, by name.
+    #[serde(default)]
+    pub inputs: Vec<String>,
+    /// Actuators driven, by name.
+    pub outputs: Vec<String>,
+    /// Hidden layer sizes; default none.
+    pub hidden: Option<Vec<usize>>,
+    /// Frequency of the clock inputs, Hz; default no clock.
+    pub clock: Option<f64>,
+    /// Every weight and bias, layer by layer; default random.
+    pub weights: Option<Vec<f64>>,
+    /// Seed of the default random weights; default 1.
+    pub seed: Option<u64>,
+}
+
+/// The most weights and biases a network may have.
+pub const MAX_WEIGHTS: usize = 1_000_000;
+
+impl NeuralEntry {
+    /// The network it describes, its weights given or drawn from `seed`.
+    pub fn build(&self) -> Result<Neural, ModelError> {
+        let hidden = self.hidden.clone().unwrap_or_default();
+        if hidden.iter().any(|h| *h == 0 || *h > 4096) || hidden.len() > 16 {
+            return Err(ModelError::new(
+                "hidden",
+                "up to 16 layers of 1 to 4096 neurons each",
+            ));
+        }
+        let clock = match self.clock {
+            Some(f) => Some(positive("clock", f)?),
+            None => None,
+        };
+        if self.inputs.is_empty() && clock.is_none() {
+            return Err(ModelError::new(
+                "inputs",
+                "a neural controller needs inputs, a clock, or both",
+            ));
+        }
+        // Counted before anything is allocated.
+        let mut sizes = vec![self.inputs.len() + if clock.is_some() { 2 } else { 0 }];
+        sizes.extend(&hidden);
+        sizes.push(self.outputs.len());
+        let count = Neural::weight_count(&sizes);
+        if count > MAX_WEIGHTS {
+            return Err(ModelError::new(
+                "hidden",
+                format!("{count} weights and biases: more than the limit of 1,000,000"),
+            ));
+        }
+        let mut net = Neural::new(self.inputs.len(), &hidden, self.outputs.len(), clock);
+        match &self.weights {
+            Some(w) => net.set_genome(w).map_err(|_| {
+                ModelError::new(
+                    "weights",
+                    format!(
+                        "needs {} finite numbers (layers {:?}: every weight, then the biases, layer by layer), got {}",
+                        net.weights.len(),
+                        net.sizes,
+                        w.len()
+                    ),
+                )
+            })?,
+            None => net.randomise(self.seed.unwrap_or(1)),
+        }
+        Ok(net)
+    }
+}
 
 /// A multilayer perceptron.
 #[derive(Clone, Debug, PartialEq)]

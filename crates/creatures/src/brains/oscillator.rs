@@ -6,8 +6,48 @@
 //! f in [0, 5] Hz, amplitudes and offsets in [0, 1], phases in [−π, π],
 //! each widened to contain the value the scene gives.
 
-use crate::brain::{around, check_genome, Brain, GenomeKey};
+use crate::brain::{around, check_genome, finite, per_output, Brain, GenomeKey};
+use animats_engine::ModelError;
+use serde::Deserialize;
 use std::f64::consts::{PI, TAU};
+
+/// `[[controller]] kind = "oscillator"`: blind, so it takes no `inputs`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillatorEntry {
+    /// Unique among controllers.
+    pub name: String,
+    /// Actuators driven, by name.
+    pub outputs: Vec<String>,
+    /// Hz, >= 0; default 1.
+    pub frequency: Option<f64>,
+    /// One per output; default 0.25.
+    pub amplitude: Option<Vec<f64>>,
+    /// rad, one per output; default 0.
+    pub phase: Option<Vec<f64>>,
+    /// One per output; default 0.5.
+    pub offset: Option<Vec<f64>>,
+}
+
+impl OscillatorEntry {
+    /// The oscillator it describes.
+    pub fn build(&self) -> Result<Oscillator, ModelError> {
+        let n = self.outputs.len();
+        let frequency = finite("frequency", self.frequency.unwrap_or(1.0))?;
+        if frequency < 0.0 {
+            return Err(ModelError::new(
+                "frequency",
+                format!("must be >= 0, got {frequency}"),
+            ));
+        }
+        Ok(Oscillator {
+            frequency,
+            amplitude: per_output("amplitude", &self.amplitude, n, 0.25)?,
+            phase: per_output("phase", &self.phase, n, 0.0)?,
+            offset: per_output("offset", &self.offset, n, 0.5)?,
+        })
+    }
+}
 
 /// Sines at one frequency.
 #[derive(Clone, Debug, PartialEq)]

@@ -11,7 +11,7 @@ pub mod touchdown;
 pub use depth::DepthSensor;
 pub use food::FoodSensor;
 pub use height::HeightSensor;
-pub use probe::{Probe, ScaledSensor};
+pub use probe::{Probe, ScaledSensor, SensorEntry};
 pub use speed::SpeedSensor;
 pub use tilt::TiltSensor;
 pub use touchdown::TouchdownSensor;

@@ -1,8 +1,11 @@
 //! The sensors a scene file declares (`[[sensor]]`): a physical reading
 //! mapped linearly from [min, max] onto [0, 1] and clamped.
 
+use crate::brain::finite;
 use crate::sensor::{unit, Sensor};
-use animats_engine::{DVec3, ParticleId, World};
+use animats_engine::{DVec3, ModelError, ParticleId, World};
+use serde::Deserialize;
+use std::f64::consts::PI;
 
 /// How close to the floor a sphere's lowest point must be to touch it, m.
 /// Resting spheres sit within a micrometre of the plane; a sphere that hits
@@ -80,5 +83,158 @@ pub struct ScaledSensor {
 impl Sensor for ScaledSensor {
     fn level(&self, world: &World) -> f64 {
         unit((self.probe.read(world) - self.min) / (self.max - self.min))
+    }
+}
+
+/// `[[sensor]]`: a reading mapped linearly from [`min`, `max`] onto [0, 1],
+/// of the kind its `kind` key names. Every kind takes `name`, `min`
+/// (default 0) and `max` (default 1; π for `angle` and `tilt`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(tag = "kind", rename_all = "lowercase")]
+pub enum SensorEntry {
+    /// The y of `particle`, m.
+    Height(OneParticle),
+    /// 1 while `particle` touches the floor, else 0.
+    Touch(OneParticle),
+    /// The velocity of `particle` along `axis` (default `[1, 0, 0]`), m/s.
+    Speed(SpeedEntry),
+    /// The distance between `a` and `b`, m.
+    Length(TwoParticles),
+    /// The angle at `joint` between `a` and `b`, rad.
+    Angle(AngleEntry),
+    /// The angle of `a → b` from the vertical, rad.
+    Tilt(TwoParticles),
+}
+
+/// A sensor of one particle.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OneParticle {
+    /// Unique among sensors.
+    pub name: String,
+    /// The particle read.
+    pub particle: String,
+    /// The reading at level 0.
+    pub min: Option<f64>,
+    /// The reading at level 1.
+    pub max: Option<f64>,
+}
+
+/// `kind = "speed"`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpeedEntry {
+    /// Unique among sensors.
+    pub name: String,
+    /// The particle read.
+    pub particle: String,
+    /// The direction; default `[1, 0, 0]`.
+    pub axis: Option<[f64; 3]>,
+    /// The reading at level 0.
+    pub min: Option<f64>,
+    /// The reading at level 1.
+    pub max: Option<f64>,
+}
+
+/// A sensor of two particles.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwoParticles {
+    /// Unique among sensors.
+    pub name: String,
+    /// The first particle.
+    pub a: String,
+    /// The second.
+    pub b: String,
+    /// The reading at level 0.
+    pub min: Option<f64>,
+    /// The reading at level 1.
+    pub max: Option<f64>,
+}
+
+/// `kind = "angle"`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AngleEntry {
+    /// Unique among sensors.
+    pub name: String,
+    /// End of the first arm.
+    pub a: String,
+    /// The vertex.
+    pub joint: String,
+    /// End of the second arm.
+    pub b: String,
+    /// The reading at level 0.
+    pub min: Option<f64>,
+    /// The reading at level 1.
+    pub max: Option<f64>,
+}
+
+impl SensorEntry {
+    /// Its name.
+    pub fn name(&self) -> &str {
+        match self {
+            SensorEntry::Height(e) | SensorEntry::Touch(e) => &e.name,
+            SensorEntry::Speed(e) => &e.name,
+            SensorEntry::Length(e) | SensorEntry::Tilt(e) => &e.name,
+            SensorEntry::Angle(e) => &e.name,
+        }
+    }
+
+    /// The sensor it describes; `particle` resolves a particle's name
+    /// given in `field`.
+    pub fn build(
+        &self,
+        particle: impl Fn(&str, &str) -> Result<ParticleId, ModelError>,
+    ) -> Result<ScaledSensor, ModelError> {
+        let p = |field: &str, name: &String| particle(field, name);
+        let (probe, min, max, full) = match self {
+            SensorEntry::Height(e) => (
+                Probe::Height(p("particle", &e.particle)?),
+                e.min,
+                e.max,
+                1.0,
+            ),
+            SensorEntry::Touch(e) => (Probe::Touch(p("particle", &e.particle)?), e.min, e.max, 1.0),
+            SensorEntry::Speed(e) => {
+                let axis = e.axis.unwrap_or([1.0, 0.0, 0.0]);
+                if !axis.iter().all(|x| x.is_finite()) {
+                    return Err(ModelError::new(
+                        "axis",
+                        format!("must be finite, got {axis:?}"),
+                    ));
+                }
+                let axis = DVec3::from_array(axis);
+                if axis.length() == 0.0 {
+                    return Err(ModelError::new("axis", "must not be zero"));
+                }
+                let probe = Probe::Speed(p("particle", &e.particle)?, axis.normalize());
+                (probe, e.min, e.max, 1.0)
+            }
+            SensorEntry::Length(e) => (
+                Probe::Length(p("a", &e.a)?, p("b", &e.b)?),
+                e.min,
+                e.max,
+                1.0,
+            ),
+            SensorEntry::Angle(e) => {
+                let probe = Probe::Angle {
+                    a: p("a", &e.a)?,
+                    joint: p("joint", &e.joint)?,
+                    b: p("b", &e.b)?,
+                };
+                (probe, e.min, e.max, PI)
+            }
+            SensorEntry::Tilt(e) => (Probe::Tilt(p("a", &e.a)?, p("b", &e.b)?), e.min, e.max, PI),
+        };
+        let min = finite("min", min.unwrap_or(0.0))?;
+        let max = finite("max", max.unwrap_or(full))?;
+        if min == max {
+            return Err(ModelError::new(
+                "max",
+                format!("must differ from min ({min})"),
+            ));
+        }
+        Ok(ScaledSensor { probe, min, max })
     }
 }

@@ -28,7 +28,7 @@ impl Build for BubbleColumnEntry {
         )
         .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.bubbles).map(|i| format!("{name}.{i}")).collect();
-        cx.add(at, first, &parts, |_| "bubble")?;
+        cx.add(at, first, &parts, |_| PartKind::Bubble)?;
         cx.actors.push(Box::new(column));
 
         Ok(())

@@ -28,7 +28,7 @@ impl Build for FoodEntry {
             .map_err(|e| at.model(e))?;
         cx.names.ids.insert(f.name.clone(), id);
         cx.list.push(f.name.clone());
-        cx.kinds.push("food");
+        cx.kinds.push(PartKind::Food);
 
         Ok(())
     }

@@ -40,11 +40,16 @@ impl Build for JellyfishEntry {
         let domes = constants.tentacles;
         cx.add(at, first, &parts, |i| {
             if i < domes {
-                "dome"
+                PartKind::Dome
             } else {
-                "tentacle"
+                PartKind::Tentacle
             }
         })?;
+        let bell = crate::Bell {
+            dome: (first..first + domes).collect(),
+            tentacles: (first + domes..first + parts.len()).collect(),
+        };
+        cx.creature(&name, first, parts.len(), Some(bell));
         cx.actors.push(Box::new(jelly));
 
         Ok(())

@@ -27,6 +27,7 @@ pub(crate) use crate::def::*;
 pub(crate) use crate::error::SceneError;
 pub(crate) use crate::nervous::Handles;
 pub(crate) use crate::source::Source;
+pub(crate) use crate::PartKind;
 pub(crate) use animats_creatures::jellyfish::{Jellyfish, JellyfishConstants};
 pub(crate) use animats_creatures::quadruped::{Demo, Model, Quadruped, QuadrupedConstants};
 pub(crate) use animats_creatures::roobot::{
@@ -55,7 +56,9 @@ pub(crate) struct Builder<'s> {
     /// Each particle's name, by index.
     pub list: Vec<String>,
     /// What each particle is part of, by index.
-    pub kinds: Vec<&'static str>,
+    pub kinds: Vec<crate::PartKind>,
+    /// The creatures built so far.
+    pub creatures: Vec<crate::Creature>,
     /// Named springs, joints and forces, for actuators.
     pub handles: Handles,
     /// Creatures and processes that act every step beside the nervous system.
@@ -73,14 +76,14 @@ pub(crate) struct Builder<'s> {
 }
 
 impl Builder<'_> {
-    /// Names the particles a creature just added (`first` onwards), of the
+    /// Names the particles an entry just added (`first` onwards), of the
     /// kinds `kind` gives by position.
     pub fn add(
         &mut self,
         at: &At,
         first: usize,
         parts: &[String],
-        kind: impl Fn(usize) -> &'static str,
+        kind: impl Fn(usize) -> crate::PartKind,
     ) -> Result<(), SceneError> {
         for (i, full) in parts.iter().enumerate() {
             self.kinds.push(kind(i));
@@ -93,6 +96,17 @@ impl Builder<'_> {
             self.list.push(full.clone());
         }
         Ok(())
+    }
+}
+
+impl Builder<'_> {
+    /// Records the creature `name` whose particles are `first..first + count`.
+    pub fn creature(&mut self, name: &str, first: usize, count: usize, bell: Option<crate::Bell>) {
+        self.creatures.push(crate::Creature {
+            name: name.to_string(),
+            particles: (first..first + count).collect(),
+            bell,
+        });
     }
 }
 

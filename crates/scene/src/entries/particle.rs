@@ -30,7 +30,7 @@ impl Build for ParticleEntry {
         let id = cx.world.add_particle(pdef).map_err(|e| at.model(e))?;
         cx.names.ids.insert(p.name.clone(), id);
         cx.list.push(p.name.clone());
-        cx.kinds.push("particle");
+        cx.kinds.push(PartKind::Particle);
 
         Ok(())
     }

@@ -60,7 +60,8 @@ impl Build for QuadrupedEntry {
             }
             parts.push(format!("{name}.foot{i}"));
         }
-        cx.add(at, first, &parts, |_| "quadruped")?;
+        cx.add(at, first, &parts, |_| PartKind::Quadruped)?;
+        cx.creature(&name, first, parts.len(), None);
         cx.actors.push(Box::new(quad));
 
         Ok(())

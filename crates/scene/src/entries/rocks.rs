@@ -24,7 +24,7 @@ impl Build for RocksEntry {
         )
         .map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..c.count).map(|i| format!("{name}{i}")).collect();
-        cx.add(at, first, &parts, |_| "rock")?;
+        cx.add(at, first, &parts, |_| PartKind::Rock)?;
 
         Ok(())
     }

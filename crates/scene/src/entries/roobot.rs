@@ -76,7 +76,8 @@ impl Build for RoobotEntry {
             .iter()
             .map(|p| format!("{name}.{p}"))
             .collect();
-        cx.add(at, first, &parts, |_| "roobot")?;
+        cx.add(at, first, &parts, |_| PartKind::Roobot)?;
+        cx.creature(&name, first, parts.len(), None);
         Ok(())
     }
 }

@@ -21,7 +21,7 @@ impl Build for SeaweedEntry {
         let first = cx.world.len();
         seaweed_frond::build(&mut cx.world, &c, position).map_err(|e| at.model(e))?;
         let parts: Vec<String> = (0..=c.segments).map(|i| format!("{name}.{i}")).collect();
-        cx.add(at, first, &parts, |_| "seaweed")?;
+        cx.add(at, first, &parts, |_| PartKind::Seaweed)?;
 
         Ok(())
     }

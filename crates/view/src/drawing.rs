@@ -1,0 +1,221 @@
+//! What is drawn, decided once for both pictures: each particle's ball,
+//! each spring's rod, each jellyfish's bell, the floor's checker and
+//! whether the world is under water. The live view's page draws what the
+//! server sends it ([`Drawing`] with the scene, [`BellShape`]s with every
+//! frame) and the software renderer what it is given; neither computes a
+//! shape of its own.
+
+use crate::model::CreatureState;
+use animats_engine::DVec3;
+use animats_scene::{PartKind, Scene};
+use serde::Serialize;
+
+/// How a ball's surface looks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Look {
+    /// Opaque.
+    Solid,
+    /// Opaque and glowing (food).
+    Glow,
+    /// See-through and glossy (a bubble).
+    Clear,
+    /// A little see-through (a jellyfish's flesh).
+    Soft,
+}
+
+/// A particle, drawn as a ball.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Ball {
+    /// m (at least 1 mm, so that it shows).
+    pub radius: f64,
+    /// 0xRRGGBB.
+    pub colour: u32,
+    /// Its surface.
+    pub look: Look,
+    /// Whether it casts a shadow.
+    pub shadow: bool,
+}
+
+/// A spring, drawn as a rod between its ends.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Rod {
+    /// One end (a particle's index).
+    pub a: usize,
+    /// The other.
+    pub b: usize,
+    /// m: 0.3 of the thinner end's radius, within [1.5 mm, 12 mm].
+    pub radius: f64,
+    /// 0xRRGGBB: its first end's colour, darkened.
+    pub colour: u32,
+}
+
+/// A jellyfish's bell: which masses it wraps.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BellPlan {
+    /// The jellyfish (its state carries the pulse's phase).
+    pub name: String,
+    /// Indices of the dome masses.
+    pub dome: Vec<usize>,
+    /// Indices of the tentacle masses (the bell opens towards them).
+    pub tentacles: Vec<usize>,
+    /// The dome masses' mean radius, m.
+    pub size: f64,
+    /// 0xRRGGBB.
+    pub colour: u32,
+}
+
+/// A bell now: a half-ellipsoid whose rim is a circle of `radius` around
+/// `centre` square to `axis`, its crown `height` along the axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct BellShape {
+    /// Centre of the rim, m.
+    pub centre: [f64; 3],
+    /// Unit vector from the rim to the crown.
+    pub axis: [f64; 3],
+    /// Rim radius, m.
+    pub radius: f64,
+    /// Crown height, m.
+    pub height: f64,
+}
+
+/// Everything that is drawn, but for where it is.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Drawing {
+    /// One per particle, by index.
+    pub balls: Vec<Ball>,
+    /// One per spring.
+    pub rods: Vec<Rod>,
+    /// One per jellyfish.
+    pub bells: Vec<BellPlan>,
+    /// The floor's checker square, m, if there is a floor.
+    pub floor: Option<f64>,
+    /// Under water (tinted and fogged), not in air.
+    pub water: bool,
+}
+
+/// Fluids denser than this are water to the eye, kg/m³.
+const WATER_DENSITY: f64 = 500.0;
+
+/// 0xRRGGBB times `f` per channel.
+fn dim(c: u32, f: f64) -> u32 {
+    let ch = |shift: u32| ((f64::from((c >> shift) & 0xff) * f).round() as u32).min(255) << shift;
+    ch(16) | ch(8) | ch(0)
+}
+
+impl Drawing {
+    /// The drawing of `scene`, framed from `distance` m (a far camera
+    /// gets a coarser checker).
+    pub fn of(scene: &Scene, distance: f64) -> Drawing {
+        let w = &scene.world;
+        let radius = &w.particles().radius;
+        let colour = |i: usize| crate::palette::colour_of(scene.kinds[i].name());
+        let balls = (0..w.len())
+            .map(|i| {
+                let kind = scene.kinds[i];
+                Ball {
+                    radius: radius[i].max(0.001),
+                    colour: colour(i),
+                    look: match kind {
+                        PartKind::Food => Look::Glow,
+                        PartKind::Bubble => Look::Clear,
+                        PartKind::Dome | PartKind::Tentacle => Look::Soft,
+                        _ => Look::Solid,
+                    },
+                    shadow: kind != PartKind::Bubble,
+                }
+            })
+            .collect();
+        let rods = w
+            .forces()
+            .springs
+            .iter()
+            .map(|s| {
+                let (a, b) = s.ends();
+                let (a, b) = (a.index(), b.index());
+                Rod {
+                    a,
+                    b,
+                    radius: (0.3 * radius[a].min(radius[b])).clamp(0.0015, 0.012),
+                    colour: dim(colour(a), 0.8),
+                }
+            })
+            .collect();
+        let bells = scene
+            .creatures
+            .iter()
+            .filter_map(|c| {
+                let bell = c.bell.as_ref()?;
+                let size = bell.dome.iter().map(|&i| radius[i]).sum::<f64>()
+                    / bell.dome.len().max(1) as f64;
+                Some(BellPlan {
+                    name: c.name.clone(),
+                    dome: bell.dome.clone(),
+                    tentacles: bell.tentacles.clone(),
+                    size,
+                    colour: crate::palette::colour_of("bell"),
+                })
+            })
+            .collect();
+        let floor = w.event::<animats_engine::FloorCollision>().is_some();
+        Drawing {
+            balls,
+            rods,
+            bells,
+            floor: floor.then_some(if distance < 4.0 { 0.1 } else { 0.5 }),
+            water: w
+                .forces()
+                .fluids()
+                .first()
+                .is_some_and(|f| f.density > WATER_DENSITY),
+        }
+    }
+
+    /// Every bell's shape with the particles at `positions` and the
+    /// creatures in `states` (`None` for a bell whose dome is degenerate).
+    pub fn bell_shapes(
+        &self,
+        positions: &[DVec3],
+        states: &[CreatureState],
+    ) -> Vec<Option<BellShape>> {
+        self.bells
+            .iter()
+            .map(|b| {
+                // Contraction follows the pulse: full at the top of the power
+                // stroke, none while idle.
+                let squeeze = states
+                    .iter()
+                    .find(|c| c.name == b.name)
+                    .and_then(|c| c.phase.filter(|_| c.state != "idle"))
+                    .map_or(0.0, |phase| phase.sin().max(0.0));
+                bell_shape(b, positions, squeeze)
+            })
+            .collect()
+    }
+}
+
+/// The bell over a dome: wrapping the dome masses, opening towards the
+/// tentacles, narrower and taller as it contracts (`squeeze` in [0, 1]).
+fn bell_shape(b: &BellPlan, positions: &[DVec3], squeeze: f64) -> Option<BellShape> {
+    let at = |i: usize| positions.get(i).copied().unwrap_or(DVec3::ZERO);
+    if b.dome.len() < 3 {
+        return None;
+    }
+    let p: Vec<DVec3> = b.dome.iter().map(|&i| at(i)).collect();
+    let centre = p.iter().sum::<DVec3>() / p.len() as f64;
+    let mut axis = (p[0] - p[1]).cross(p[2] - p[0]).try_normalize()?;
+    if !b.tentacles.is_empty() {
+        let t = b.tentacles.iter().map(|&i| at(i)).sum::<DVec3>() / b.tentacles.len() as f64;
+        if axis.dot(centre - t) < 0.0 {
+            axis = -axis;
+        }
+    }
+    let radius = p.iter().map(|x| x.distance(centre)).sum::<f64>() / p.len() as f64 + b.size;
+    let s = squeeze.clamp(0.0, 1.0);
+    Some(BellShape {
+        centre: (centre - axis * (0.5 * b.size)).to_array(),
+        axis: axis.to_array(),
+        radius: radius * (1.08 - 0.28 * s),
+        height: radius * (0.75 + 0.45 * s),
+    })
+}
