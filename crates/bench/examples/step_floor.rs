@@ -44,9 +44,6 @@ impl DiscreteEvent for Never {
         EventState::None
     }
     fn handle(&mut self, _: f64, _: &mut [DVec3], _: &mut [DVec3], _: &Properties) {}
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 fn world(event: bool) -> World {

@@ -3,8 +3,8 @@
 //! structure-of-arrays loop they are compared with.
 
 use animats_engine::{
-    DVec3, DiscreteEvent, EventContext, EventState, IntegratorKind, ParticleDef, ParticleId,
-    Properties, SpringDef, TrialPiece, World,
+    ByPieces, DVec3, DiscreteEvent, EventContext, EventState, IntegratorKind, ParticleDef,
+    ParticleId, Properties, SpringDef, TrialPiece, World,
 };
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -151,6 +151,20 @@ impl DiscreteEvent for WorkloadFloor {
             .unwrap_or(EventState::None)
     }
 
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        self.handle_piece(t, 0, pos, vel, p);
+    }
+
+    fn name(&self) -> &str {
+        "workload floor"
+    }
+
+    fn by_pieces(&self) -> Option<&dyn ByPieces> {
+        Some(self)
+    }
+}
+
+impl ByPieces for WorkloadFloor {
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
         Some(
             if below(&ctx.pos[range.clone()], &ctx.particles.inv_mass[range]) {
@@ -196,18 +210,6 @@ impl DiscreteEvent for WorkloadFloor {
                 x.y = 0.0;
             }
         }
-    }
-
-    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
-        self.handle_piece(t, 0, pos, vel, p);
-    }
-
-    fn name(&self) -> &str {
-        "workload floor"
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 

@@ -85,87 +85,15 @@ pub struct TrialPiece<'a> {
     pub particles: &'a Properties,
 }
 
-/// A discrete event: detected after a trial step, handled by changing the state.
-/// Events are `Clone` (derive it), so that a world can be cloned whole, and
-/// `Sync`, so that the threads of a large world can ask
-/// [`check_piece`](Self::check_piece) at once.
-pub trait DiscreteEvent: Send + Sync + CloneEvent {
+/// A discrete event: detected after a trial step, handled by changing the
+/// state. An event implements [`check`](Self::check) and
+/// [`handle`](Self::handle) (and derives `Clone`, so that a world can be
+/// cloned whole); the rest has defaults. An event that concerns each
+/// particle on its own (a floor, a wall) may also let a large world check
+/// and handle it piece by piece on many threads: see [`ByPieces`].
+pub trait DiscreteEvent: Send + Sync + CloneEvent + AsAny {
     /// Inspects the trial state. May remember what it found for `handle`.
     fn check(&mut self, ctx: &EventContext) -> EventState;
-
-    /// [`check`](Self::check) for the particles `range` alone, without
-    /// keeping records, for an event that concerns each particle on its own
-    /// (a floor, a wall); `None`, the default, for the others (events that
-    /// look at pairs, or must keep records in `check`).
-    ///
-    /// A large world on many threads asks each thread about the piece of
-    /// particles it has just integrated, still in its cache (one thread
-    /// reading every particle would pull half the world across cores). The
-    /// event's state is then the worst of its pieces', and `check` is not
-    /// called. An answer must be the state `check` would give if these were
-    /// the only particles.
-    fn check_piece(&self, _ctx: &EventContext, _range: Range<usize>) -> Option<EventState> {
-        None
-    }
-
-    /// True if [`handle_piece`](Self::handle_piece) can stand in for
-    /// [`handle`](Self::handle) (after `check_piece`); false, the default,
-    /// makes a world that found this event occurring call `check` and
-    /// `handle` on one thread.
-    fn handles_pieces(&self) -> bool {
-        false
-    }
-
-    /// [`handle`](Self::handle) for the particles `first..first + pos.len()`
-    /// alone (`pos` and `vel` are theirs; `particles` is the whole world's),
-    /// for events whose [`handles_pieces`](Self::handles_pieces) is true.
-    /// Called for every piece of a trial in which some piece was
-    /// `Occurring` (or `Missed`, once the step cannot be split further), so
-    /// it must leave a piece in which nothing happened as it is.
-    fn handle_piece(
-        &self,
-        _t: f64,
-        _first: usize,
-        _pos: &mut [DVec3],
-        _vel: &mut [DVec3],
-        _particles: &Properties,
-    ) {
-    }
-
-    /// True if [`settle_piece`](Self::settle_piece) stands in for `check`
-    /// and `handle` altogether: then, with the integrators that write a
-    /// trial by pieces (symplectic Euler, RK4), the thread that has just
-    /// written a piece of the trial checks and handles it at once, while it
-    /// is in its cache, and a large world on many threads needs no pass of
-    /// its own for this event (cloth-128 on two threads: docs/PERFORMANCE.md).
-    /// A world uses it only when every one of its events settles pieces.
-    /// False, the default.
-    fn settles_pieces(&self) -> bool {
-        false
-    }
-
-    /// Checks one piece of a trial as [`check`](Self::check) would if these
-    /// were the only particles, handles it in place as
-    /// [`handle`](Self::handle) would if the piece is `Occurring` (or
-    /// `Missed` while `piece.finest`), and returns the state it found. A
-    /// piece in which nothing happens must be left as it is; a missed piece
-    /// of a trial that is not the finest may be left or handled (the world
-    /// throws that trial away). The events of a world settle each piece in
-    /// the order they were added, each seeing the piece as the ones before
-    /// left it. Called only when [`settles_pieces`](Self::settles_pieces)
-    /// is true, from many threads at once: records of what it did must wait
-    /// behind a lock until [`settled`](Self::settled) says whether the
-    /// world keeps the trial.
-    fn settle_piece(&self, _piece: &mut TrialPiece) -> EventState {
-        EventState::None
-    }
-
-    /// Called on one thread after every trial whose pieces were settled:
-    /// `kept` when the world keeps the trial, false when it throws it away
-    /// (an event missed in some piece, or a blow-up). An event that keeps
-    /// records of what it settled gathers them here, or drops them (the
-    /// floor's bounces). Nothing, the default.
-    fn settled(&mut self, _kept: bool) {}
 
     /// Handles the event found by the last `check` (called only after
     /// `Occurring`, or after `Missed` once the step cannot be split further).
@@ -190,15 +118,106 @@ pub trait DiscreteEvent: Send + Sync + CloneEvent {
         "event"
     }
 
-    /// Lets a caller that knows the concrete type read its records back
-    /// (e.g. the floor's collisions of the last step).
-    fn as_any(&self) -> &dyn std::any::Any;
-
-    /// [`as_any`](Self::as_any), mutably, for an event whose state the
-    /// world restores from a snapshot (sphere contact's sleep); `None`, the
-    /// default, for the others.
-    fn as_any_mut(&mut self) -> Option<&mut dyn std::any::Any> {
+    /// The hooks that let a large world check and handle this event piece
+    /// by piece; `None`, the default, for events that look at pairs or
+    /// must keep records in `check`.
+    fn by_pieces(&self) -> Option<&dyn ByPieces> {
         None
+    }
+
+    /// [`by_pieces`](Self::by_pieces), mutably (for [`ByPieces::settled`]).
+    fn by_pieces_mut(&mut self) -> Option<&mut dyn ByPieces> {
+        None
+    }
+}
+
+/// How an event that concerns each particle on its own is checked and
+/// handled by the threads of a large world, each on the piece of particles
+/// it has just integrated, still in its cache (one thread reading every
+/// particle would pull half the world across cores). Every hook has a
+/// default that declines, so an event implements the ones it can.
+pub trait ByPieces: Send + Sync {
+    /// [`check`](DiscreteEvent::check) for the particles `range` alone,
+    /// without keeping records; `None`, the default, if it cannot. The
+    /// event's state is then the worst of its pieces', and `check` is not
+    /// called. An answer must be the state `check` would give if these were
+    /// the only particles.
+    fn check_piece(&self, _ctx: &EventContext, _range: Range<usize>) -> Option<EventState> {
+        None
+    }
+
+    /// True if [`handle_piece`](Self::handle_piece) can stand in for
+    /// [`handle`](DiscreteEvent::handle) (after `check_piece`); false, the
+    /// default, makes a world that found this event occurring call `check`
+    /// and `handle` on one thread.
+    fn handles_pieces(&self) -> bool {
+        false
+    }
+
+    /// `handle` for the particles `first..first + pos.len()` alone (`pos`
+    /// and `vel` are theirs; `particles` is the whole world's). Called for
+    /// every piece of a trial in which some piece was `Occurring` (or
+    /// `Missed`, once the step cannot be split further), so it must leave a
+    /// piece in which nothing happened as it is.
+    fn handle_piece(
+        &self,
+        _t: f64,
+        _first: usize,
+        _pos: &mut [DVec3],
+        _vel: &mut [DVec3],
+        _particles: &Properties,
+    ) {
+    }
+
+    /// True if [`settle_piece`](Self::settle_piece) stands in for `check`
+    /// and `handle` altogether: then, with the integrators that write a
+    /// trial by pieces (symplectic Euler, RK4), the thread that has just
+    /// written a piece of the trial checks and handles it at once, and a
+    /// large world on many threads needs no pass of its own for this event
+    /// (cloth-128 on two threads: docs/PERFORMANCE.md). A world uses it
+    /// only when every one of its events settles pieces. False, the default.
+    fn settles_pieces(&self) -> bool {
+        false
+    }
+
+    /// Checks one piece of a trial as `check` would if these were the only
+    /// particles, handles it in place as `handle` would if the piece is
+    /// `Occurring` (or `Missed` while `piece.finest`), and returns the state
+    /// it found. A piece in which nothing happens must be left as it is; a
+    /// missed piece of a trial that is not the finest may be left or
+    /// handled (the world throws that trial away). The events of a world
+    /// settle each piece in the order they were added, each seeing the
+    /// piece as the ones before left it. Called from many threads at once:
+    /// records of what it did must wait behind a lock until
+    /// [`settled`](Self::settled) says whether the world keeps the trial.
+    fn settle_piece(&self, _piece: &mut TrialPiece) -> EventState {
+        EventState::None
+    }
+
+    /// Called on one thread after every trial whose pieces were settled:
+    /// `kept` when the world keeps the trial, false when it throws it away
+    /// (an event missed in some piece, or a blow-up). An event that keeps
+    /// records of what it settled gathers them here, or drops them (the
+    /// floor's bounces). Nothing, the default.
+    fn settled(&mut self, _kept: bool) {}
+}
+
+/// Lets a caller that knows an event's concrete type read it back (the
+/// floor's collisions of the last step: [`World::event`](crate::World::event)),
+/// or restore it from a snapshot; implemented for every event.
+pub trait AsAny {
+    /// The event as [`std::any::Any`].
+    fn as_any(&self) -> &dyn std::any::Any;
+    /// The event as [`std::any::Any`], mutably.
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
+}
+
+impl<T: DiscreteEvent + 'static> AsAny for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
     }
 }
 

@@ -45,7 +45,7 @@ pub mod snapshot;
 pub mod world;
 
 pub use error::{ModelError, SimError};
-pub use event::{DiscreteEvent, EventContext, EventState, TrialPiece};
+pub use event::{AsAny, ByPieces, DiscreteEvent, EventContext, EventState, TrialPiece};
 pub use events::floor_collision::{Collision, FloorCollision};
 pub use events::plane_constraint::PlaneConstraint;
 pub use events::sphere_contact::{Impact, SleepState, SphereContact, SphereContactDef};

@@ -66,9 +66,6 @@ impl DiscreteEvent for AlwaysMissed {
         }
     }
     fn handle(&mut self, _t: f64, _p: &mut [DVec3], _v: &mut [DVec3], _q: &Properties) {}
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 #[test]

@@ -246,9 +246,6 @@ impl DiscreteEvent for Wall {
             vel[i].x = -vel[i].x.abs();
         }
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 #[test]

@@ -88,9 +88,6 @@ impl animats_engine::DiscreteEvent for Never {
     }
     fn handle(&mut self, _: f64, _: &mut [DVec3], _: &mut [DVec3], _: &animats_engine::Properties) {
     }
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// A push that changes with the time and the velocity, so that a step

@@ -4,9 +4,9 @@
 //! state's hash is pinned, so a change of the numerics shows up here first.
 
 use animats_engine::{
-    DVec3, DiscreteEvent, EventContext, EventState, FloorCollision, FloorDef, IntegratorKind,
-    NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SphereContactDef, SpringDef,
-    Targets, TrialPiece, World,
+    ByPieces, DVec3, DiscreteEvent, EventContext, EventState, FloorCollision, FloorDef,
+    IntegratorKind, NBodyGravity, ParticleDef, ParticleId, Properties, SimError, SphereContactDef,
+    SpringDef, Targets, TrialPiece, World,
 };
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -278,6 +278,18 @@ impl DiscreteEvent for Clamp {
         self.state(deepest)
     }
 
+    fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
+        for &i in &self.below {
+            self.bounce(&mut pos[i], &mut vel[i], p.restitution[i]);
+        }
+    }
+
+    fn by_pieces(&self) -> Option<&dyn ByPieces> {
+        Some(self)
+    }
+}
+
+impl ByPieces for Clamp {
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
         let deepest = range
             .filter(|&i| self.below(ctx.pos[i], ctx.particles.inv_mass[i]))
@@ -313,12 +325,6 @@ impl DiscreteEvent for Clamp {
         state
     }
 
-    fn handle(&mut self, _t: f64, pos: &mut [DVec3], vel: &mut [DVec3], p: &Properties) {
-        for &i in &self.below {
-            self.bounce(&mut pos[i], &mut vel[i], p.restitution[i]);
-        }
-    }
-
     fn handle_piece(
         &self,
         _t: f64,
@@ -333,10 +339,6 @@ impl DiscreteEvent for Clamp {
                 self.bounce(x, v, p.restitution[first + i]);
             }
         }
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 

@@ -33,7 +33,7 @@
 //! speed it would have at the plane.
 
 use crate::error::ModelError;
-use crate::event::{DiscreteEvent, EventContext, EventState, TrialPiece};
+use crate::event::{ByPieces, DiscreteEvent, EventContext, EventState, TrialPiece};
 use crate::force::Targets;
 use crate::particle::{non_negative, ParticleId, Properties};
 use glam::DVec3;
@@ -268,6 +268,49 @@ impl DiscreteEvent for FloorCollision {
         self.state((!self.hits.is_empty()).then_some(deepest))
     }
 
+    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
+        for k in 0..self.hits.len() {
+            let hit = self.hits[k];
+            let i = hit.index as usize;
+            let shift = self.shift * hit.accel * self.step;
+            if let Some(c) = self.resolve(
+                hit,
+                self.step,
+                shift,
+                t,
+                &mut pos[i],
+                &mut vel[i],
+                particles,
+            ) {
+                self.collisions.push(c);
+            }
+        }
+    }
+
+    fn begin_step(&mut self) {
+        self.collisions.clear();
+    }
+
+    fn is_passive(&self) -> bool {
+        true // an impact never adds energy (module documentation)
+    }
+
+    fn name(&self) -> &str {
+        "floor collision"
+    }
+
+    fn by_pieces(&self) -> Option<&dyn ByPieces> {
+        Some(self)
+    }
+
+    fn by_pieces_mut(&mut self) -> Option<&mut dyn ByPieces> {
+        Some(self)
+    }
+}
+
+/// Each sphere meets the floor on its own: a large world checks, handles
+/// and settles it piece by piece.
+impl ByPieces for FloorCollision {
     fn check_piece(&self, ctx: &EventContext, range: Range<usize>) -> Option<EventState> {
         if self.targets != Targets::All {
             return None;
@@ -325,40 +368,5 @@ impl DiscreteEvent for FloorCollision {
         } else {
             pending.clear();
         }
-    }
-
-    fn handle(&mut self, t: f64, pos: &mut [DVec3], vel: &mut [DVec3], particles: &Properties) {
-        for k in 0..self.hits.len() {
-            let hit = self.hits[k];
-            let i = hit.index as usize;
-            let shift = self.shift * hit.accel * self.step;
-            if let Some(c) = self.resolve(
-                hit,
-                self.step,
-                shift,
-                t,
-                &mut pos[i],
-                &mut vel[i],
-                particles,
-            ) {
-                self.collisions.push(c);
-            }
-        }
-    }
-
-    fn begin_step(&mut self) {
-        self.collisions.clear();
-    }
-
-    fn is_passive(&self) -> bool {
-        true // an impact never adds energy (module documentation)
-    }
-
-    fn name(&self) -> &str {
-        "floor collision"
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }

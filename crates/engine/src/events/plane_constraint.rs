@@ -71,8 +71,4 @@ impl DiscreteEvent for PlaneConstraint {
     fn name(&self) -> &str {
         "plane constraint"
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }

@@ -323,12 +323,4 @@ impl DiscreteEvent for SphereContact {
     fn name(&self) -> &str {
         "sphere contact"
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-
-    fn as_any_mut(&mut self) -> Option<&mut dyn std::any::Any> {
-        Some(self)
-    }
 }
