@@ -196,10 +196,127 @@ fn start(args: &Args) -> Result<(PathBuf, State), Failure> {
     Ok((dir, state))
 }
 
+/// The live view of the run, if asked for: the board the run publishes
+/// its best to, and the server's thread.
+type Viewing = (
+    BestBrain,
+    std::thread::JoinHandle<Result<animats_viewer::Summary, String>>,
+);
+
+fn watch(args: &Args, state: &State, stop: &Arc<AtomicBool>) -> Result<Option<Viewing>, Failure> {
+    if !args.view {
+        return Ok(None);
+    }
+    let problem = state.config.problem.parse().map_err(input)?;
+    let board = BestBrain::default();
+    let stage = Exhibition::new(problem, board.clone()).map_err(Failure::Other)?;
+    publish(&board, state);
+    let server = args.serving.bind(1.0)?;
+    let stop = stop.clone();
+    let thread = std::thread::spawn(move || server.serve(Box::new(stage), stop));
+    Ok(Some((board, thread)))
+}
+
+/// Progress on stderr: a bar on a terminal, a line every few seconds in a
+/// log file.
+struct Progress {
+    bar: ProgressBar,
+    lines: bool,
+    last_line: Instant,
+    start: Instant,
+    evals_at_start: u64,
+}
+
+impl Progress {
+    fn new(state: &State) -> Progress {
+        let lines = !std::io::stderr().is_terminal();
+        let bar = if lines {
+            ProgressBar::hidden()
+        } else {
+            ProgressBar::new(state.config.generations)
+        };
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:32}] {pos}/{len} generations  {msg}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> "),
+        );
+        bar.set_position(state.generation());
+        Progress {
+            bar,
+            lines,
+            last_line: Instant::now(),
+            start: Instant::now(),
+            evals_at_start: state.evaluations,
+        }
+    }
+
+    fn show(&mut self, state: &State) {
+        let rate = (state.evaluations - self.evals_at_start) as f64
+            / self.start.elapsed().as_secs_f64().max(1e-9);
+        self.bar.set_position(state.generation());
+        let message = format!(
+            "{rate:.0} evals/s, best fitness {:.1}",
+            state.best_fitness().unwrap_or(f64::NAN)
+        );
+        if self.lines && (self.last_line.elapsed().as_secs_f64() >= PROGRESS_EVERY || state.done())
+        {
+            eprintln!(
+                "generation {} of {}: {} evaluations, {message}",
+                state.generation(),
+                state.config.generations,
+                state.evaluations
+            );
+            self.last_line = Instant::now();
+        }
+        self.bar.set_message(message);
+    }
+}
+
+/// Advances the run to its end (or to Ctrl-C: then true), batch by batch,
+/// showing progress, publishing to the view and saving checkpoints.
+fn evolve(
+    args: &Args,
+    dir: &Path,
+    state: &mut State,
+    pool: &rayon::ThreadPool,
+    stop: &AtomicBool,
+    board: Option<&BestBrain>,
+) -> Result<bool, Failure> {
+    // Built once for the whole run (a scene is parsed and checked here).
+    let problem = state.config.problem.build().map_err(input)?;
+    let mut progress = Progress::new(state);
+    let mut last_save = Instant::now();
+    // Generations each lane advances between progress updates and Ctrl-C
+    // checks: one at first, then as many as take about a quarter of a
+    // second.
+    let mut batch = animats_evolve::FIRST_BATCH;
+    while !state.done() {
+        if stop.load(Ordering::SeqCst) {
+            progress.bar.finish_and_clear();
+            return Ok(true);
+        }
+        let begun = Instant::now();
+        pool.install(|| state.advance_with(problem.as_ref(), batch))
+            .map_err(Failure::Other)?;
+        batch = animats_evolve::next_batch(batch, begun.elapsed());
+        if let Some(board) = board {
+            publish(board, state);
+        }
+        progress.show(state);
+        if last_save.elapsed().as_secs_f64() >= args.checkpoint_every {
+            save(dir, state, false)?;
+            last_save = Instant::now();
+        }
+    }
+    progress.bar.finish_and_clear();
+    Ok(false)
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
     let (dir, mut state) = start(&args)?;
-
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |t| t as usize,
@@ -215,87 +332,18 @@ pub fn run(args: Args) -> Result<(), Failure> {
         // last checkpoint still stands.
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
-    let viewing = if args.view {
-        let problem = state.config.problem.parse().map_err(input)?;
-        let board = BestBrain::default();
-        let stage = Exhibition::new(problem, board.clone()).map_err(Failure::Other)?;
-        publish(&board, &state);
-        let server = args.serving.bind(1.0)?;
-        let stop = stop.clone();
-        let thread = std::thread::spawn(move || server.serve(Box::new(stage), stop));
-        Some((board, thread))
-    } else {
-        None
-    };
-
-    // Built once for the whole run (a scene is parsed and checked here).
-    let problem = state.config.problem.build().map_err(input)?;
-    let total = state.config.generations;
-    // A terminal gets a bar; a log file a line every few seconds.
-    let lines = !std::io::stderr().is_terminal();
-    let mut last_line = Instant::now();
-    let bar = if lines {
-        ProgressBar::hidden()
-    } else {
-        ProgressBar::new(total)
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:32}] {pos}/{len} generations  {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    bar.set_position(state.generation());
-    let start = Instant::now();
-    let evals_at_start = state.evaluations;
-    let mut last_save = Instant::now();
-    let mut interrupted = false;
-    // Generations each lane advances between progress updates and Ctrl-C
-    // checks: one at first, then as many as take about a quarter of a
-    // second.
-    let mut batch = animats_evolve::FIRST_BATCH;
-    while !state.done() {
-        if stop.load(Ordering::SeqCst) {
-            interrupted = true;
-            break;
-        }
-        let begun = Instant::now();
-        pool.install(|| state.advance_with(problem.as_ref(), batch))
-            .map_err(Failure::Other)?;
-        batch = animats_evolve::next_batch(batch, begun.elapsed());
-        let rate =
-            (state.evaluations - evals_at_start) as f64 / start.elapsed().as_secs_f64().max(1e-9);
-        if let Some((board, _)) = &viewing {
-            publish(board, &state);
-        }
-        bar.set_position(state.generation());
-        let message = format!(
-            "{rate:.0} evals/s, best fitness {:.1}",
-            state.best_fitness().unwrap_or(f64::NAN)
-        );
-        if lines && (last_line.elapsed().as_secs_f64() >= PROGRESS_EVERY || state.done()) {
-            eprintln!(
-                "generation {} of {total}: {} evaluations, {message}",
-                state.generation(),
-                state.evaluations
-            );
-            last_line = Instant::now();
-        }
-        bar.set_message(message);
-        if last_save.elapsed().as_secs_f64() >= args.checkpoint_every {
-            save(&dir, &state, false)?;
-            last_save = Instant::now();
-        }
-    }
-    bar.finish_and_clear();
+    let viewing = watch(&args, &state, &stop)?;
+    let (start, evals_at_start) = (Instant::now(), state.evaluations);
+    let board = viewing.as_ref().map(|(b, _)| b);
+    let interrupted = evolve(&args, &dir, &mut state, &pool, &stop, board)?;
     save(&dir, &state, true)?;
     let wall = start.elapsed().as_secs_f64();
     let evals = state.evaluations - evals_at_start;
-
     println!(
         "{} lanes, generation {} of {}, seed {}: {evals} evaluations in {wall:.2} s ({:.0}/s, {threads} threads)",
         state.config.lanes,
         state.generation(),
-        total,
+        state.config.generations,
         state.config.seed,
         evals as f64 / wall.max(1e-9)
     );

@@ -7,7 +7,7 @@ use animats_engine::DVec3;
 use animats_render::gif_file::encode_gif;
 use animats_render::video::{encode_mp4, ffmpeg_available};
 use animats_render::{picture, render, Camera, Image};
-use animats_view::{BellShape, Drawing};
+use animats_view::{BellShape, Describe, Drawing};
 use animats_view::{SceneStage, Stage};
 use rayon::prelude::*;
 use std::path::PathBuf;
@@ -18,8 +18,8 @@ use std::time::Instant;
 #[derive(Clone, Debug, PartialEq)]
 pub enum CameraSpec {
     /// The live view's starting framing, moved along with what the scene
-    /// follows (its `[evolve]` particles, `--follow NAME`, or its first
-    /// walker), fixed when it follows nothing.
+    /// follows (its `[evolve]` particles, `--follow NAME`, or its one
+    /// creature), fixed when it follows nothing.
     Auto,
     /// That framing, moved along with what the scene follows, or else with
     /// the centre of its creatures (in whole checker periods of the floor).
@@ -85,15 +85,14 @@ pub struct Args {
     #[arg(long, default_value_t = 25.0, value_parser = positive_f64)]
     fps: f64,
     /// Camera: `auto` (the live view's framing, following the scene's
-    /// `[evolve]` particles, `--follow NAME` or its first walker, in steps
+    /// `[evolve]` particles, `--follow NAME` or its one creature, in steps
     /// of two floor squares so the floor stands still), `follow` (the same,
     /// or the centre of all creatures when the scene follows nothing),
     /// `fixed` (the opening framing, still) or `EYE:TARGET` as
     /// `x,y,z:x,y,z`, metres.
     #[arg(long, default_value = "auto")]
     camera: CameraSpec,
-    /// The particle or creature (`NAME` for `NAME.part`) the camera frames
-    /// and follows.
+    /// The creature or particle the camera frames and follows.
     #[arg(long)]
     follow: Option<String>,
     /// Vertical field of view, degrees.
@@ -173,8 +172,9 @@ fn centre_of(picked: &[usize], positions: &[DVec3]) -> DVec3 {
     picked.iter().map(|&i| positions[i]).sum::<DVec3>() / picked.len() as f64
 }
 
-/// Runs the command.
-pub fn run(args: Args) -> Result<(), Failure> {
+/// What the output's name asks for; refused (before any work) if it
+/// cannot be written.
+fn format_of(args: &Args) -> Result<Format, Failure> {
     let ext = args
         .out
         .extension()
@@ -209,25 +209,23 @@ pub fn run(args: Args) -> Result<(), Failure> {
             )));
         }
     }
-    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
+    Ok(format)
+}
 
-    let mut stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
-        .map_err(Failure::Input)?;
-    crate::warn(&args.scene, stage.warnings());
-    let describe = stage.describe();
-    let drawing = &describe.drawing;
-
-    let start = Instant::now();
+/// Runs the scene to each of `times`, taking a snapshot at each.
+fn shoot(
+    args: &Args,
+    stage: &mut SceneStage,
+    drawing: &Drawing,
+    times: &[f64],
+) -> Result<Vec<Snapshot>, Failure> {
     let dt = stage.dt();
-    // Where things are at t = 0, which the framing is for (the first frame
-    // drawn may be later: a PNG draws only the last).
-    let at_start = snapshot(&stage, drawing);
     // A world that splits its work over threads enters the pool once for
     // all the frames' steps, not at every step (the same bits).
     let pooled = stage.scene().world.steps_on_pool();
     let run = || -> Result<Vec<Snapshot>, Failure> {
         let mut snapshots = Vec::with_capacity(times.len());
-        for &t in &times {
+        for &t in times {
             while stage.time() < t - 0.5 * dt {
                 stage.step(dt).map_err(|e| {
                     Failure::Blowup(format!(
@@ -236,40 +234,63 @@ pub fn run(args: Args) -> Result<(), Failure> {
                     ))
                 })?;
             }
-            snapshots.push(snapshot(&stage, drawing));
+            snapshots.push(snapshot(stage, drawing));
         }
         Ok(snapshots)
     };
-    let snapshots = animats_engine::on_pool_if(pooled, run)?;
+    animats_engine::on_pool_if(pooled, run)
+}
 
-    let base = Camera::framing(DVec3::from_array(describe.target), describe.distance);
-    let followed = stage.followed().to_vec();
-    // What the camera keeps in view: the followed particles, or else every
-    // creature's.
-    let watched: Vec<usize> = if followed.is_empty() {
-        let creatures = &stage.scene().creatures;
-        creatures
-            .iter()
-            .flat_map(|c| c.particles.iter().copied())
-            .collect()
-    } else {
-        followed.clone()
-    };
-    let centre = |positions: &[DVec3]| centre_of(&watched, positions);
-    let start_centre = centre(&at_start.positions);
-    let camera = |s: &Snapshot| -> Camera {
-        let follows = match &args.camera {
-            CameraSpec::Auto => !followed.is_empty(),
-            CameraSpec::Follow => true,
-            _ => false,
+/// The camera of each frame: the opening framing (`base`), moved with what
+/// is `watched` (from where it was at the start) as `--camera` says.
+struct Cameras {
+    base: Camera,
+    spec: CameraSpec,
+    follows: bool,
+    watched: Vec<usize>,
+    start: DVec3,
+    period: f64,
+    fov: f64,
+}
+
+impl Cameras {
+    fn new(args: &Args, stage: &SceneStage, describe: &Describe, at_start: &Snapshot) -> Cameras {
+        let followed = stage.followed().to_vec();
+        // What the camera keeps in view: the followed particles, or else
+        // every creature's.
+        let watched: Vec<usize> = if followed.is_empty() {
+            let creatures = &stage.scene().creatures;
+            creatures
+                .iter()
+                .flat_map(|c| c.particles.iter().copied())
+                .collect()
+        } else {
+            followed.clone()
         };
-        let c = match &args.camera {
-            CameraSpec::Auto | CameraSpec::Follow if follows => {
-                // In whole periods of the floor's checker: the floor looks
-                // the same in every frame, which also keeps GIFs small.
-                let period = 2.0 * drawing.floor.unwrap_or(0.5);
-                let moved = centre(&s.positions) - start_centre;
-                let shift = (DVec3::new(moved.x, 0.0, moved.z) / period).round() * period;
+        let start = centre_of(&watched, &at_start.positions);
+        Cameras {
+            base: Camera::framing(DVec3::from_array(describe.target), describe.distance),
+            follows: match &args.camera {
+                CameraSpec::Auto => !followed.is_empty(),
+                CameraSpec::Follow => true,
+                _ => false,
+            },
+            spec: args.camera.clone(),
+            watched,
+            start,
+            // In whole periods of the floor's checker: the floor looks the
+            // same in every frame, which also keeps GIFs small.
+            period: 2.0 * describe.drawing.floor.unwrap_or(0.5),
+            fov: args.fov,
+        }
+    }
+
+    fn of(&self, s: &Snapshot) -> Camera {
+        let base = self.base;
+        let c = match &self.spec {
+            CameraSpec::Auto | CameraSpec::Follow if self.follows => {
+                let moved = centre_of(&self.watched, &s.positions) - self.start;
+                let shift = (DVec3::new(moved.x, 0.0, moved.z) / self.period).round() * self.period;
                 Camera {
                     eye: base.eye + shift,
                     target: base.target + shift,
@@ -284,21 +305,14 @@ pub fn run(args: Args) -> Result<(), Failure> {
             _ => base,
         };
         Camera {
-            fov_y: args.fov,
+            fov_y: self.fov,
             ..c
         }
-    };
-    let frames: Vec<Image> = snapshots
-        .par_iter()
-        .map(|s| {
-            let mut picture = picture(drawing, &s.positions, &s.bells);
-            if !args.no_caption {
-                picture.caption = Some(format!("t = {:.2} s", s.t));
-            }
-            render(&picture, &camera(s), args.width, args.height)
-        })
-        .collect();
+    }
+}
 
+/// Writes `frames` as the output asks, whole or not at all.
+fn write(args: &Args, format: Format, frames: &[Image]) -> Result<(), Failure> {
     let bytes = match (format, args.sheet) {
         (Format::Png, None) => frames
             .last()
@@ -308,7 +322,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         (Format::Png, Some(n)) => {
             let columns = f64::from(n).sqrt().ceil() as u32;
             Some(
-                Image::sheet(&frames, columns)
+                Image::sheet(frames, columns)
                     .png()
                     .map_err(Failure::Other)?,
             )
@@ -316,25 +330,52 @@ pub fn run(args: Args) -> Result<(), Failure> {
         (Format::Gif, _) => {
             // GIF delays are in hundredths of a second.
             let delay = (100.0 / args.fps).round().clamp(2.0, 65535.0) as u16;
-            Some(encode_gif(&frames, delay).map_err(Failure::Other)?)
+            Some(encode_gif(frames, delay).map_err(Failure::Other)?)
         }
         (Format::Mp4, _) => None,
     };
     match bytes {
         // Through a temporary file: no partial picture under the final name.
-        Some(b) => animats_files::write_atomically(&args.out, &b).map_err(Failure::Other)?,
+        Some(b) => animats_files::write_atomically(&args.out, &b).map_err(Failure::Other),
         None => {
             let partial = args.out.with_extension("mp4.partial");
-            let encoded = encode_mp4(&frames, args.fps, &partial);
+            let encoded = encode_mp4(frames, args.fps, &partial);
             if let Err(e) = encoded {
                 let _ = std::fs::remove_file(&partial);
                 return Err(Failure::Other(e));
             }
-            std::fs::rename(&partial, &args.out).map_err(|e| {
-                Failure::Other(format!("{}: cannot write: {e}", args.out.display()))
-            })?;
+            std::fs::rename(&partial, &args.out)
+                .map_err(|e| Failure::Other(format!("{}: cannot write: {e}", args.out.display())))
         }
     }
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<(), Failure> {
+    let format = format_of(&args)?;
+    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
+    let mut stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
+        .map_err(Failure::Input)?;
+    crate::warn(&args.scene, stage.warnings());
+    let describe = stage.describe();
+    let drawing = &describe.drawing;
+    let start = Instant::now();
+    // Where things are at t = 0, which the framing is for (the first frame
+    // drawn may be later: a PNG draws only the last).
+    let at_start = snapshot(&stage, drawing);
+    let snapshots = shoot(&args, &mut stage, drawing, &times)?;
+    let cameras = Cameras::new(&args, &stage, &describe, &at_start);
+    let frames: Vec<Image> = snapshots
+        .par_iter()
+        .map(|s| {
+            let mut picture = picture(drawing, &s.positions, &s.bells);
+            if !args.no_caption {
+                picture.caption = Some(format!("t = {:.2} s", s.t));
+            }
+            render(&picture, &cameras.of(s), args.width, args.height)
+        })
+        .collect();
+    write(&args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
     println!(
         "{}: {} frame{} of {}x{} rendered in {:.2} s, to t = {:.2} s; wrote {} ({size} bytes)",

@@ -3,6 +3,7 @@
 use crate::output::Trajectory;
 use crate::{positive_f64, Failure};
 use animats_engine::{IntegratorKind, SimError};
+use animats_scene::Scene;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -74,6 +75,40 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if args.realtime {
         return realtime(args);
     }
+    let (mut scene, dt, steps) = prepare(&args)?;
+    let limit = scene.world.step_limit(scene.world.integrator());
+    let mut trajectory = match &args.output {
+        Some(path) => Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?),
+        None => None,
+    };
+    let conservative = scene.world.is_conservative();
+    let e0 = scene.world.energy().total();
+    let start = Instant::now();
+    let iterations = run_steps(&args, &mut scene, dt, steps, &mut trajectory)?;
+    let wall = start.elapsed().as_secs_f64();
+    report(&args, &scene, dt, steps, limit, iterations, wall);
+    if conservative {
+        let e1 = scene.world.energy().total();
+        let rel = if e0 != 0.0 {
+            (e1 - e0) / e0.abs()
+        } else {
+            e1 - e0
+        };
+        println!("energy: E0 = {e0:.12e} J, E = {e1:.12e} J, drift {rel:+.3e} (relative)");
+    } else {
+        println!("energy: not reported (the scene has dissipative or driven forces or events)");
+    }
+    if let Some(t) = trajectory {
+        let frames = t.frames();
+        let path = t.finish().map_err(Failure::Other)?;
+        println!("wrote {frames} recorded steps to {}", path.display());
+    }
+    Ok(())
+}
+
+/// The scene with the command line's integrator, its step and its number
+/// of steps, checked.
+fn prepare(args: &Args) -> Result<(Scene, f64, u64), Failure> {
     let mut scene = animats_scene::load(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     crate::warn(&args.scene, &scene.warnings);
     let dt = args.dt.unwrap_or(scene.dt);
@@ -83,7 +118,6 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     // The scene's own step was checked when it loaded; a step or an
     // integrator from the command line is checked here.
-    let limit = scene.world.step_limit(scene.world.integrator());
     if args.dt.is_some() || args.integrator.is_some() {
         let warning = animats_scene::build::step_warning(&scene.world, &scene.names, dt);
         crate::warn(&args.scene, warning.as_slice());
@@ -99,19 +133,20 @@ pub fn run(args: Args) -> Result<(), Failure> {
             "{steps:.1e} steps is too many (at most 1e12): raise --dt or lower --duration"
         )));
     }
-    let steps = steps as u64;
+    Ok((scene, dt, steps as u64))
+}
 
-    let mut trajectory = match &args.output {
-        Some(path) => Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?),
-        None => None,
-    };
-    let conservative = scene.world.is_conservative();
-    let e0 = scene.world.energy().total();
-    let write_err = |m: String| Failure::Other(m);
-
-    let start = Instant::now();
+/// Takes `steps` steps of `dt`, recording every `--every`-th; returns the
+/// implicit integrator's conjugate-gradient iterations in all.
+fn run_steps(
+    args: &Args,
+    scene: &mut Scene,
+    dt: f64,
+    steps: u64,
+    trajectory: &mut Option<Trajectory>,
+) -> Result<u64, Failure> {
     if let Some(t) = trajectory.as_mut() {
-        t.record_scene(&scene, 0).map_err(write_err)?;
+        t.record_scene(scene, 0).map_err(Failure::Other)?;
     }
     // A world that splits its work over threads enters the pool once for
     // the whole run instead of at every step (the same bits).
@@ -123,21 +158,30 @@ pub fn run(args: Args) -> Result<(), Failure> {
             iterations += scene.world.last_step().solver_iterations as u64;
             if let Err(e) = stepped {
                 let step = format!("step {step} of {steps}");
-                return Err(blowup(&args, &scene, &e, &step, trajectory.take()));
+                return Err(blowup(args, scene, &e, &step, trajectory.take()));
             }
             if let Some(t) = trajectory.as_mut() {
                 if step % args.every == 0 || step == steps {
-                    t.record_scene(&scene, step).map_err(write_err)?;
+                    t.record_scene(scene, step).map_err(Failure::Other)?;
                 }
             }
         }
         Ok(iterations)
     };
-    let iterations = animats_engine::on_pool_if(pooled, run)?;
-    let wall = start.elapsed().as_secs_f64();
+    animats_engine::on_pool_if(pooled, run)
+}
 
+/// Prints the run's summary (but for its energy).
+fn report(
+    args: &Args,
+    scene: &Scene,
+    dt: f64,
+    steps: u64,
+    limit: Option<animats_engine::StepLimit>,
+    iterations: u64,
+    wall: f64,
+) {
     let world = &scene.world;
-    let stats = world.stats();
     println!(
         "{}: {} particles, {} springs, {} angle joints, {} torque joints",
         args.scene.display(),
@@ -179,7 +223,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
             );
         }
     }
-    println!("backtracks: {}", stats.backtracks);
+    println!("backtracks: {}", world.stats().backtracks);
     if let Some(c) = world.event::<animats_engine::SphereContact>() {
         let asleep = if c.def().sleep_speed > 0.0 {
             format!(", {} spheres asleep", c.sleeping())
@@ -195,23 +239,6 @@ pub fn run(args: Args) -> Result<(), Failure> {
         "wall time: {wall:.4} s ({:.1} simulated s per wall s)",
         world.time() / wall.max(1e-9)
     );
-    if conservative {
-        let e1 = world.energy().total();
-        let rel = if e0 != 0.0 {
-            (e1 - e0) / e0.abs()
-        } else {
-            e1 - e0
-        };
-        println!("energy: E0 = {e0:.12e} J, E = {e1:.12e} J, drift {rel:+.3e} (relative)");
-    } else {
-        println!("energy: not reported (the scene has dissipative or driven forces or events)");
-    }
-    if let Some(t) = trajectory {
-        let frames = t.frames();
-        let path = t.finish().map_err(write_err)?;
-        println!("wrote {frames} recorded steps to {}", path.display());
-    }
-    Ok(())
 }
 
 /// The thesis's SeaWorld loop (§5.3, Appendix B): frames at a steady rate;
