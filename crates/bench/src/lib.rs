@@ -686,6 +686,38 @@ fn threads(n: usize) -> rayon::ThreadPool {
     animats_engine::pin::pinned_pool(n).expect("a thread pool")
 }
 
+/// Two threads, two independent all-pairs worlds, one per thread (the
+/// throughput an evolution loop sees), against two hand-written loops.
+fn allpairs_two_copies(runs: usize, steps: usize) -> (Timing, Timing) {
+    use allpairs::*;
+    let (pa, pb) = (threads(1), threads(1));
+    let on = |p: &rayon::ThreadPool, w: &mut animats_engine::World| {
+        in_pool(p, || {
+            for _ in 0..steps {
+                w.step(DT).expect("all-pairs stays finite");
+            }
+        })
+    };
+    let (two, two_base, _, _) = measure_pair(
+        runs,
+        || (engine_world(), engine_world()),
+        |(a, b)| {
+            std::thread::scope(|s| {
+                s.spawn(|| on(&pa, a));
+                s.spawn(|| on(&pb, b));
+            })
+        },
+        || (Baseline::new(), Baseline::new()),
+        |(a, b)| {
+            std::thread::scope(|s| {
+                s.spawn(|| (0..steps).for_each(|_| a.step()));
+                s.spawn(|| (0..steps).for_each(|_| b.step()));
+            })
+        },
+    );
+    (two, two_base)
+}
+
 fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
     use allpairs::*;
     let steps = if quick { 20 } else { STEPS };
@@ -761,26 +793,7 @@ fn run_allpairs(quick: bool, runs: usize) -> Vec<Row> {
             Check::target("speed-up over 1 thread", speedup, 1.8),
         ],
     );
-    // Two threads: two independent copies, one per thread (the throughput an
-    // evolution loop sees); the work of both counts.
-    let (pa, pb) = (threads(1), threads(1));
-    let (two, two_base, _, _) = measure_pair(
-        runs,
-        || (engine_world(), engine_world()),
-        |(a, b)| {
-            std::thread::scope(|s| {
-                s.spawn(|| on(&pa, a));
-                s.spawn(|| on(&pb, b));
-            })
-        },
-        || (Baseline::new(), Baseline::new()),
-        |(a, b)| {
-            std::thread::scope(|s| {
-                s.spawn(|| (0..steps).for_each(|_| a.step()));
-                s.spawn(|| (0..steps).for_each(|_| b.step()));
-            })
-        },
-    );
+    let (two, two_base) = allpairs_two_copies(runs, steps);
     let double = row(
         "symplectic, 2 threads x 1 copy each",
         two,

@@ -163,31 +163,11 @@ fn one(args: &[String]) {
     }
 }
 
-fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) == Some("one") {
-        return one(&args[1..]);
-    }
-    let seeds: u64 = args.first().and_then(|s| s.parse().ok()).unwrap_or(20);
-    let budget: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(6000);
-    let plot = args.get(2).cloned();
+/// Prints the Markdown table of `runs` (one per job) and returns each
+/// controller and optimiser's median best fitness curve, for the plot.
+fn table(runs: &[Run], jobs: &[(Controller, OptimiserKind, u64)], budget: usize) -> Vec<Series> {
     let kinds = OptimiserKind::ALL;
     let controllers = [Controller::Fsm, Controller::Raibert];
-    let jobs: Vec<(Controller, OptimiserKind, u64)> = controllers
-        .iter()
-        .flat_map(|c| kinds.iter().map(move |k| (*c, *k)))
-        .flat_map(|(c, k)| (1..=seeds).map(move |s| (c, k, s)))
-        .collect();
-    let start = std::time::Instant::now();
-    let runs: Vec<Run> = jobs
-        .par_iter()
-        .map(|&(c, k, s)| run(c, k, s, budget))
-        .collect();
-    eprintln!(
-        "{} runs of {budget} evaluations in {:.1} s",
-        runs.len(),
-        start.elapsed().as_secs_f64()
-    );
     let early = 600.min(budget);
     println!("| controller | optimiser | evaluations to the first 20 s hop: median [Q1–Q3] (runs that found one) | best fitness at {early}: median [Q1–Q3] | at {budget}: median [Q1–Q3] | the best at 2 ms: runs upright 20 s, their median distance |");
     println!("|---|---|---|---|---|---|");
@@ -198,7 +178,7 @@ fn main() {
     {
         let mine: Vec<&Run> = runs
             .iter()
-            .zip(&jobs)
+            .zip(jobs)
             .filter(|(_, j)| j.0 == controller && j.1 == kind)
             .map(|(r, _)| r)
             .collect();
@@ -266,6 +246,35 @@ fn main() {
             points,
         });
     }
+    series
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("one") {
+        return one(&args[1..]);
+    }
+    let seeds: u64 = args.first().and_then(|s| s.parse().ok()).unwrap_or(20);
+    let budget: usize = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(6000);
+    let plot = args.get(2).cloned();
+    let kinds = OptimiserKind::ALL;
+    let controllers = [Controller::Fsm, Controller::Raibert];
+    let jobs: Vec<(Controller, OptimiserKind, u64)> = controllers
+        .iter()
+        .flat_map(|c| kinds.iter().map(move |k| (*c, *k)))
+        .flat_map(|(c, k)| (1..=seeds).map(move |s| (c, k, s)))
+        .collect();
+    let start = std::time::Instant::now();
+    let runs: Vec<Run> = jobs
+        .par_iter()
+        .map(|&(c, k, s)| run(c, k, s, budget))
+        .collect();
+    eprintln!(
+        "{} runs of {budget} evaluations in {:.1} s",
+        runs.len(),
+        start.elapsed().as_secs_f64()
+    );
+    let series = table(&runs, &jobs, budget);
     if let Some(path) = plot {
         let png = step_plot_png(&Plot {
             title: format!("The roobot: median best fitness over {seeds} seeds, one lane each"),

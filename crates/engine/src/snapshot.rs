@@ -117,6 +117,15 @@ impl World {
     /// or one built the same way. Checks everything before changing anything:
     /// on an error the world is as it was.
     pub fn restore(&mut self, s: &Snapshot) -> Result<(), ModelError> {
+        self.check_snapshot(s)?;
+        // Everything checked: apply.
+        self.apply_snapshot(s);
+        Ok(())
+    }
+
+    /// Whether `s` fits this world: the same particles, forces and sleep,
+    /// every value usable; the error names the field.
+    fn check_snapshot(&self, s: &Snapshot) -> Result<(), ModelError> {
         let n = self.len();
         let f = &self.forces;
         for (field, got, want) in [
@@ -188,8 +197,12 @@ impl World {
             }
             sleep.check(n)?;
         }
+        Ok(())
+    }
 
-        // Everything checked: apply.
+    /// Puts a checked snapshot's values in place.
+    fn apply_snapshot(&mut self, s: &Snapshot) {
+        let n = self.len();
         if let Some(contact) = self.event_mut::<SphereContact>() {
             contact.restore_sleep(s.sleep.as_ref());
         }
@@ -233,6 +246,5 @@ impl World {
         if let (Some(g), Some(gravity)) = (s.gravity, &mut f.gravity) {
             gravity.g = DVec3::from_array(g);
         }
-        Ok(())
     }
 }

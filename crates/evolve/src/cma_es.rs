@@ -273,40 +273,11 @@ impl CmaEs {
     }
 }
 
-impl Optimiser for CmaEs {
-    fn ask(&mut self) -> Vec<Vec<f64>> {
-        let n = self.n;
-        let generation = self.generation + 1;
-        let mut rng = Random::for_evaluation(self.seed, self.lane, generation);
-        let mut out = Vec::with_capacity(self.lambda);
-        self.pending.clear();
-        for _ in 0..self.lambda {
-            let z: Vec<f64> = (0..n).map(|_| gaussian(&mut rng)).collect();
-            let y: Vec<f64> = (0..n)
-                .map(|i| {
-                    let mut s = 0.0;
-                    for (j, zj) in z.iter().enumerate() {
-                        s += self.b[i * n + j] * self.d[j] * zj;
-                    }
-                    self.mean[i] + self.sigma * s
-                })
-                .collect();
-            out.push(self.to_genome(&y));
-            self.pending.push(y);
-        }
-        out
-    }
-
-    fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
-        check_told(self.pending.len(), fitness.len())?;
-        let n = self.n;
-        let lambda = self.lambda;
-        for (y, f) in self.pending.iter().zip(fitness) {
-            let g = self.to_genome(y);
-            self.best.offer(&g, *f);
-        }
-        // Values to minimise: −fitness (−∞ fitness → +∞, ranked last),
-        // plus the bound penalty.
+impl CmaEs {
+    /// The values to minimise of the pending candidates told `fitness`
+    /// (−fitness, −∞ fitness → +∞, ranked last, plus the bound penalty),
+    /// and the candidates in their order, best first (the first of equals).
+    fn rank(&self, fitness: &[f64]) -> (Vec<f64>, Vec<usize>) {
         let mut values: Vec<f64> = fitness.iter().map(|f| -sane(*f)).collect();
         if self.bounds.is_some() {
             let mut finite: Vec<f64> = values.iter().copied().filter(|v| v.is_finite()).collect();
@@ -323,23 +294,32 @@ impl Optimiser for CmaEs {
                 *v += gamma * self.outside(y);
             }
         }
-        let mut order: Vec<usize> = (0..lambda).collect();
+        let mut order: Vec<usize> = (0..self.lambda).collect();
         order.sort_by(|&a, &b| values[a].total_cmp(&values[b]).then(a.cmp(&b)));
-        self.counteval += lambda as u64;
+        (values, order)
+    }
 
+    /// Moves the mean to the weighted recombination of the best (positive
+    /// weights only); returns the old mean and the step `y_w`.
+    fn move_mean(&mut self, order: &[usize]) -> (Vec<f64>, Vec<f64>) {
+        let n = self.n;
         let old = self.mean.clone();
         let mut mean = vec![0.0; n];
-        // The mean moves by the positive weights only.
-        for (w, &k) in self.weights.iter().zip(&order).filter(|(w, _)| **w > 0.0) {
+        for (w, &k) in self.weights.iter().zip(order).filter(|(w, _)| **w > 0.0) {
             for (m, y) in mean.iter_mut().zip(&self.pending[k]) {
                 *m += w * y;
             }
         }
         self.mean = mean;
-        let yw: Vec<f64> = (0..n)
+        let yw = (0..n)
             .map(|i| (self.mean[i] - old[i]) / self.sigma)
             .collect();
+        (old, yw)
+    }
 
+    /// The evolution paths after step `yw`; returns |p_σ|² and h_σ (1 or 0).
+    fn update_paths(&mut self, yw: &[f64]) -> (f64, f64) {
+        let n = self.n;
         // C^{-1/2} y_w = B D^{-1} Bᵀ y_w
         let mut bt = vec![0.0; n];
         for (j, v) in bt.iter_mut().enumerate() {
@@ -358,14 +338,21 @@ impl Optimiser for CmaEs {
             self.ps[i] = (1.0 - self.cs) * self.ps[i] + ks * s;
         }
         let ps2: f64 = self.ps.iter().map(|v| v * v).sum();
-        let gens = self.counteval as f64 / lambda as f64;
+        let gens = self.counteval as f64 / self.lambda as f64;
         let hsig = ps2 / n as f64 / (1.0 - (1.0 - self.cs).powf(2.0 * gens))
             < 2.0 + 4.0 / (n as f64 + 1.0);
         let hsig = if hsig { 1.0 } else { 0.0 };
         let kc = (self.cc * (2.0 - self.cc) * self.mueff).sqrt();
-        for (p, y) in self.pc.iter_mut().zip(&yw) {
+        for (p, y) in self.pc.iter_mut().zip(yw) {
             *p = (1.0 - self.cc) * *p + hsig * kc * y;
         }
+        (ps2, hsig)
+    }
+
+    /// The covariance's rank-one and rank-μ update, the candidates in
+    /// `order` stepping from the `old` mean.
+    fn update_covariance(&mut self, order: &[usize], old: &[f64], hsig: f64) {
+        let n = self.n;
         let (c1, cmu) = (self.c1, self.cmu);
         let c1a = c1 * (1.0 - (1.0 - hsig * hsig) * self.cc * (2.0 - self.cc));
         let steps: Vec<Vec<f64>> = order
@@ -373,7 +360,7 @@ impl Optimiser for CmaEs {
             .map(|&k| {
                 self.pending[k]
                     .iter()
-                    .zip(&old)
+                    .zip(old)
                     .map(|(y, m)| (y - m) / self.sigma)
                     .collect()
             })
@@ -414,8 +401,47 @@ impl Optimiser for CmaEs {
                 self.c[j * n + i] = v;
             }
         }
+    }
+}
+
+impl Optimiser for CmaEs {
+    fn ask(&mut self) -> Vec<Vec<f64>> {
+        let n = self.n;
+        let generation = self.generation + 1;
+        let mut rng = Random::for_evaluation(self.seed, self.lane, generation);
+        let mut out = Vec::with_capacity(self.lambda);
+        self.pending.clear();
+        for _ in 0..self.lambda {
+            let z: Vec<f64> = (0..n).map(|_| gaussian(&mut rng)).collect();
+            let y: Vec<f64> = (0..n)
+                .map(|i| {
+                    let mut s = 0.0;
+                    for (j, zj) in z.iter().enumerate() {
+                        s += self.b[i * n + j] * self.d[j] * zj;
+                    }
+                    self.mean[i] + self.sigma * s
+                })
+                .collect();
+            out.push(self.to_genome(&y));
+            self.pending.push(y);
+        }
+        out
+    }
+
+    fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
+        check_told(self.pending.len(), fitness.len())?;
+        for (y, f) in self.pending.iter().zip(fitness) {
+            let g = self.to_genome(y);
+            self.best.offer(&g, *f);
+        }
+        let (values, order) = self.rank(fitness);
+        self.counteval += self.lambda as u64;
+        let (old, yw) = self.move_mean(&order);
+        let (ps2, hsig) = self.update_paths(&yw);
+        self.update_covariance(&order, &old, hsig);
         self.sigma *= libm::exp((self.cs / self.damps) * (ps2.sqrt() / self.chi_n - 1.0));
-        if (self.counteval - self.eigeneval) as f64 > lambda as f64 / (c1 + cmu) / n as f64 / 10.0 {
+        let (n, lambda) = (self.n as f64, self.lambda as f64);
+        if (self.counteval - self.eigeneval) as f64 > lambda / (self.c1 + self.cmu) / n / 10.0 {
             self.eigeneval = self.counteval;
             self.refresh_eigen();
         }

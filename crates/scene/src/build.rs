@@ -150,11 +150,20 @@ pub(crate) fn check_name(at: &At, name: &str) -> Result<(), SceneError> {
     }
 }
 
-/// Builds the world a scene describes.
-pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
-    let mut world = World::new();
+/// The `[world]` table, checked.
+struct WorldTable {
+    gravity: DVec3,
+    /// `None`: `"auto"`.
+    dt: Option<f64>,
+    duration: f64,
+    max_dt: Option<f64>,
+    seed: u64,
+}
 
-    // [world]
+/// An empty world set up as the `[world]` table says (integrator, solver,
+/// gravity), and the table's run settings.
+fn world_table(def: &SceneDef, src: &Source) -> Result<(World, WorldTable), SceneError> {
+    let mut world = World::new();
     let wd = def
         .world
         .as_ref()
@@ -168,12 +177,19 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             offset: 0,
         },
     };
-    let gravity = wat.vec3("gravity", wd.gravity)?;
-    let given_dt = match wd.dt {
-        crate::def::StepDef::Seconds(d) => Some(wat.positive("dt", d)?),
-        crate::def::StepDef::Auto => None,
+    let table = WorldTable {
+        gravity: wat.vec3("gravity", wd.gravity)?,
+        dt: match wd.dt {
+            crate::def::StepDef::Seconds(d) => Some(wat.positive("dt", d)?),
+            crate::def::StepDef::Auto => None,
+        },
+        duration: wat.positive("duration", wd.duration)?,
+        max_dt: match wd.max_dt {
+            Some(m) => Some(wat.positive("max_dt", m)?),
+            None => None,
+        },
+        seed: wd.seed,
     };
-    let duration = wat.positive("duration", wd.duration)?;
     world.set_integrator(wd.integrator.into());
     let mut solver = world.solver();
     if let Some(tol) = wd.implicit_tolerance {
@@ -189,14 +205,39 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         };
         wat.err(field, e.reason)
     })?;
-    if gravity != DVec3::ZERO {
+    if table.gravity != DVec3::ZERO {
         world
-            .set_gravity_force(Some(Gravity::new(gravity)))
+            .set_gravity_force(Some(Gravity::new(table.gravity)))
             .map_err(|e| wat.model(e))?;
     }
+    Ok((world, table))
+}
 
-    // Every entry builds itself (`entries/`), in this order: particles and
-    // food first, so that everything else can name them.
+/// Every entry builds itself (`entries/`), in this order: particles and
+/// food first, so that everything else can name them; creatures after the
+/// forces.
+fn entries(def: &SceneDef, cx: &mut Builder) -> Result<(), SceneError> {
+    each(&def.particle, "particle", cx)?;
+    each(&def.food, "food", cx)?;
+    one(&def.floor, "floor", cx)?;
+    one(&def.fluid, "fluid", cx)?;
+    each(&def.spring, "spring", cx)?;
+    each(&def.angle_joint, "angle_joint", cx)?;
+    each(&def.torque_joint, "torque_joint", cx)?;
+    each(&def.constant_force, "constant_force", cx)?;
+    each(&def.nbody, "nbody", cx)?;
+    each(&def.roobot, "roobot", cx)?;
+    each(&def.jellyfish, "jellyfish", cx)?;
+    each(&def.seaweed, "seaweed", cx)?;
+    each(&def.bubble_column, "bubble_column", cx)?;
+    each(&def.rocks, "rocks", cx)?;
+    each(&def.quadruped, "quadruped", cx)?;
+    one(&def.contacts, "contacts", cx)
+}
+
+/// Builds the world a scene describes.
+pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
+    let (world, table) = world_table(def, src)?;
     let mut cx = Builder {
         src,
         world,
@@ -210,25 +251,10 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         actors: Vec::new(),
         nervous: Default::default(),
         origins: Vec::new(),
-        seed: wd.seed,
-        gravity,
+        seed: table.seed,
+        gravity: table.gravity,
     };
-    each(&def.particle, "particle", &mut cx)?;
-    each(&def.food, "food", &mut cx)?;
-    one(&def.floor, "floor", &mut cx)?;
-    one(&def.fluid, "fluid", &mut cx)?;
-    each(&def.spring, "spring", &mut cx)?;
-    each(&def.angle_joint, "angle_joint", &mut cx)?;
-    each(&def.torque_joint, "torque_joint", &mut cx)?;
-    each(&def.constant_force, "constant_force", &mut cx)?;
-    each(&def.nbody, "nbody", &mut cx)?;
-    each(&def.roobot, "roobot", &mut cx)?;
-    each(&def.jellyfish, "jellyfish", &mut cx)?;
-    each(&def.seaweed, "seaweed", &mut cx)?;
-    each(&def.bubble_column, "bubble_column", &mut cx)?;
-    each(&def.rocks, "rocks", &mut cx)?;
-    each(&def.quadruped, "quadruped", &mut cx)?;
-    one(&def.contacts, "contacts", &mut cx)?;
+    entries(def, &mut cx)?;
     let Builder {
         mut world,
         names,
@@ -241,9 +267,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         mut origins,
         ..
     } = cx;
-
     // `dt = "auto"`: the recommended step now the springs are known.
-    let dt = given_dt.unwrap_or_else(|| {
+    let dt = table.dt.unwrap_or_else(|| {
         let most = crate::def::DEFAULT_DT;
         world
             .recommended_dt(world.integrator())
@@ -270,11 +295,6 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         )?),
         None => None,
     };
-
-    let max_dt = match wd.max_dt {
-        Some(m) => wat.positive("max_dt", m)?,
-        None => dt,
-    };
     let guard =
         animats_engine::DivergenceGuard::new(&world, !actors.is_empty() || !nervous.is_empty());
     let warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
@@ -286,8 +306,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         kinds,
         creatures,
         dt,
-        max_dt,
-        duration,
+        max_dt: table.max_dt.unwrap_or(dt),
+        duration: table.duration,
         actors,
         nervous,
         evolve,

@@ -65,6 +65,13 @@ pub struct EvolveSpec {
     pub lanes: Option<usize>,
 }
 
+/// An `[evolve]` table's end rules, resolved.
+struct EndRules {
+    fail_on_touch: Vec<(ParticleId, String)>,
+    touch_tolerance: f64,
+    fail_on_stretch: Vec<Stretch>,
+}
+
 /// A `fail_on_stretch` rule.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Stretch {
@@ -94,22 +101,7 @@ impl EvolveSpec {
                 format!("no controller named `{}`", e.controller),
             )
         })?;
-        let duration = at.positive("duration", e.duration)?;
-        if duration > MAX_DURATION {
-            return Err(at.err(
-                "duration",
-                format!("must be at most {MAX_DURATION} s (a simulated day), got {duration}"),
-            ));
-        }
-        if duration / dt > MAX_STEPS {
-            return Err(at.err(
-                "duration",
-                format!(
-                    "{duration} s at dt = {dt} s is {:.3e} steps, more than {MAX_STEPS:e}: raise dt or shorten the evaluation",
-                    duration / dt
-                ),
-            ));
-        }
+        let duration = Self::duration(at, e, dt)?;
         let particles = match &e.particles {
             None => world.particle_ids().collect(),
             Some(list) if list.is_empty() => {
@@ -127,35 +119,11 @@ impl EvolveSpec {
         if axis.length() == 0.0 {
             return Err(at.err("axis", "must not be zero"));
         }
-        let fail_on_touch = e
-            .fail_on_touch
-            .iter()
-            .map(|n| Ok((names.one(at, "fail_on_touch", n)?, n.clone())))
-            .collect::<Result<_, SceneError>>()?;
-        let touch_tolerance = match e.touch_tolerance {
-            None => TOUCH_TOLERANCE,
-            Some(t) => {
-                let t = at.finite("touch_tolerance", t)?;
-                if t < 0.0 {
-                    return Err(at.err("touch_tolerance", format!("must be >= 0, got {t}")));
-                }
-                t
-            }
-        };
-        let fail_on_stretch = e
-            .fail_on_stretch
-            .iter()
-            .enumerate()
-            .map(|(i, s)| {
-                let f = |k: &str| format!("fail_on_stretch[{i}].{k}");
-                Ok(Stretch {
-                    a: names.one(at, &f("a"), &s.a)?,
-                    b: names.one(at, &f("b"), &s.b)?,
-                    length: at.positive(&f("length"), s.length)?,
-                    name: format!("{}-{}", s.a, s.b),
-                })
-            })
-            .collect::<Result<_, SceneError>>()?;
+        let EndRules {
+            fail_on_touch,
+            touch_tolerance,
+            fail_on_stretch,
+        } = Self::end_rules(at, e, names)?;
         if nervous.controllers[index].brain.genome().is_empty() {
             return Err(at.err(
                 "controller",
@@ -186,6 +154,66 @@ impl EvolveSpec {
             mutation: e.mutation,
             log: e.log,
             lanes,
+        })
+    }
+
+    /// `duration`, checked against a day and against the steps it takes.
+    fn duration(at: &At, e: &EvolveEntry, dt: f64) -> Result<f64, SceneError> {
+        let duration = at.positive("duration", e.duration)?;
+        if duration > MAX_DURATION {
+            return Err(at.err(
+                "duration",
+                format!("must be at most {MAX_DURATION} s (a simulated day), got {duration}"),
+            ));
+        }
+        if duration / dt > MAX_STEPS {
+            return Err(at.err(
+                "duration",
+                format!(
+                    "{duration} s at dt = {dt} s is {:.3e} steps, more than {MAX_STEPS:e}: raise dt or shorten the evaluation",
+                    duration / dt
+                ),
+            ));
+        }
+        Ok(duration)
+    }
+
+    /// The end rules: `fail_on_touch` (with `touch_tolerance`) and
+    /// `fail_on_stretch`, resolved.
+    fn end_rules(at: &At, e: &EvolveEntry, names: &Names) -> Result<EndRules, SceneError> {
+        let fail_on_touch = e
+            .fail_on_touch
+            .iter()
+            .map(|n| Ok((names.one(at, "fail_on_touch", n)?, n.clone())))
+            .collect::<Result<_, SceneError>>()?;
+        let touch_tolerance = match e.touch_tolerance {
+            None => TOUCH_TOLERANCE,
+            Some(t) => {
+                let t = at.finite("touch_tolerance", t)?;
+                if t < 0.0 {
+                    return Err(at.err("touch_tolerance", format!("must be >= 0, got {t}")));
+                }
+                t
+            }
+        };
+        let fail_on_stretch = e
+            .fail_on_stretch
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                let f = |k: &str| format!("fail_on_stretch[{i}].{k}");
+                Ok(Stretch {
+                    a: names.one(at, &f("a"), &s.a)?,
+                    b: names.one(at, &f("b"), &s.b)?,
+                    length: at.positive(&f("length"), s.length)?,
+                    name: format!("{}-{}", s.a, s.b),
+                })
+            })
+            .collect::<Result<_, SceneError>>()?;
+        Ok(EndRules {
+            fail_on_touch,
+            touch_tolerance,
+            fail_on_stretch,
         })
     }
 

@@ -72,6 +72,45 @@ pub(crate) fn build(
     ns: &mut NervousSystem,
     origins: &mut Vec<(&'static str, usize)>,
 ) -> Result<(), SceneError> {
+    let gated = actuators(def, src, handles, world, ns)?;
+    for (k, entry) in def.sensor.iter().enumerate() {
+        let at = at(src, format!("sensor[{k}]"), entry);
+        let e = entry.get_ref().get().map_err(|(f, m)| at.err(f, m))?;
+        let s = sensor(&at, e, names)?;
+        if ns.sensor(e.name()).is_some() {
+            return Err(at.err("name", format!("duplicate sensor name `{}`", e.name())));
+        }
+        ns.sensors.push((e.name().to_string(), Box::new(s)));
+    }
+    // Gates name sensors: resolved once the sensors are known.
+    for (index, at, g) in gated {
+        let sensor = ns
+            .sensor(&g.sensor)
+            .ok_or_else(|| at.err("gate.sensor", format!("no sensor named `{}`", g.sensor)))?;
+        let (threshold, above) = match (g.above, g.at_most) {
+            (Some(x), None) => (at.finite("gate.above", x)?, true),
+            (None, Some(x)) => (at.finite("gate.at_most", x)?, false),
+            _ => return Err(at.err("gate", "give exactly one of `above` and `at_most`")),
+        };
+        ns.gates[index] = Some(Gate {
+            sensor,
+            threshold,
+            above,
+        });
+    }
+    controllers(def, src, ns, origins)
+}
+
+/// The scene's `[[actuator]]` entries, into `ns`; returns those with a
+/// gate (its index, where it was written, the gate), to resolve once the
+/// sensors are known.
+fn actuators<'d, 's>(
+    def: &'d SceneDef,
+    src: &'s Source<'s>,
+    handles: &Handles,
+    world: &mut World,
+    ns: &mut NervousSystem,
+) -> Result<Vec<(usize, At<'s>, &'d GateEntry)>, SceneError> {
     let mut gated = Vec::new();
     for (k, entry) in def.actuator.iter().enumerate() {
         let at = at(src, format!("actuator[{k}]"), entry);
@@ -95,30 +134,16 @@ pub(crate) fn build(
             gated.push((index, at, g));
         }
     }
-    for (k, entry) in def.sensor.iter().enumerate() {
-        let at = at(src, format!("sensor[{k}]"), entry);
-        let e = entry.get_ref().get().map_err(|(f, m)| at.err(f, m))?;
-        let s = sensor(&at, e, names)?;
-        if ns.sensor(e.name()).is_some() {
-            return Err(at.err("name", format!("duplicate sensor name `{}`", e.name())));
-        }
-        ns.sensors.push((e.name().to_string(), Box::new(s)));
-    }
-    for (index, at, g) in gated {
-        let sensor = ns
-            .sensor(&g.sensor)
-            .ok_or_else(|| at.err("gate.sensor", format!("no sensor named `{}`", g.sensor)))?;
-        let (threshold, above) = match (g.above, g.at_most) {
-            (Some(x), None) => (at.finite("gate.above", x)?, true),
-            (None, Some(x)) => (at.finite("gate.at_most", x)?, false),
-            _ => return Err(at.err("gate", "give exactly one of `above` and `at_most`")),
-        };
-        ns.gates[index] = Some(Gate {
-            sensor,
-            threshold,
-            above,
-        });
-    }
+    Ok(gated)
+}
+
+/// The scene's `[[controller]]` entries, wired into `ns`.
+fn controllers(
+    def: &SceneDef,
+    src: &Source,
+    ns: &mut NervousSystem,
+    origins: &mut Vec<(&'static str, usize)>,
+) -> Result<(), SceneError> {
     let mut driven_by: Vec<Option<String>> = vec![None; ns.actuators.len()];
     for c in &ns.controllers {
         for &o in &c.outputs {

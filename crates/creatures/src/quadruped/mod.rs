@@ -184,103 +184,20 @@ impl Quadruped {
                 ))?;
             }
         }
-        // Neighbours of corner i: (front–back, left–right).
-        let neighbours = |i: usize| match i {
-            0 => (3, 1),
-            1 => (2, 0),
-            2 => (1, 3),
-            _ => (0, 2),
-        };
-        let foot_def = |x: DVec3| {
-            ParticleDef::new(c.foot_mass)
-                .with_radius(0.02)
-                .at(x)
-                .with_friction(1.0, 0.8)
-                .with_restitution(0.1)
-        };
         let mut legs = Vec::with_capacity(4);
         for (i, o) in offsets.iter().enumerate() {
             let out = DVec3::new(o.x, 0.0, o.z).normalize();
-            let top = world.position(corners[i]);
-            let (fb, lr) = neighbours(i);
-            let joint = |a, j, b| AngleJointDef::new(a, j, b, c.joint.0, c.joint.1);
-            let leg = match model {
-                Model::TwoSegment => {
-                    let knee_at = top + out * 0.1 + DVec3::Y * 0.1;
-                    let foot_at = DVec3::new(knee_at.x, 0.02, knee_at.z) + out * 0.1;
-                    let knee = world.add_particle(foot_def(knee_at).with_radius(0.02))?;
-                    let foot = world.add_particle(foot_def(foot_at))?;
-                    world.add_spring(SpringDef::new(
-                        corners[i],
-                        knee,
-                        c.leg_spring.0,
-                        c.leg_spring.1,
-                    ))?;
-                    let spring = world.add_spring(SpringDef::new(
-                        knee,
-                        foot,
-                        c.leg_spring.0,
-                        c.leg_spring.1,
-                    ))?;
-                    // The 2-DOF hip: the upper segment held against both edges.
-                    world.add_angle_joint(joint(knee, corners[i], corners[fb]))?;
-                    world.add_angle_joint(joint(knee, corners[i], corners[lr]))?;
-                    // The knee.
-                    world.add_angle_joint(joint(corners[i], knee, foot))?;
-                    Leg {
-                        corner: corners[i],
-                        knee: Some(knee),
-                        foot,
-                        spring,
-                        swing: None,
-                        supports: None,
-                    }
-                }
-                Model::AngleJointed | Model::Sprung => {
-                    let foot_at = DVec3::new(top.x, 0.02, top.z) + out * c.splay;
-                    let foot = world.add_particle(foot_def(foot_at))?;
-                    let spring = world.add_spring(SpringDef::new(
-                        corners[i],
-                        foot,
-                        c.leg_spring.0,
-                        c.leg_spring.1,
-                    ))?;
-                    let (swing, supports) = if model == Model::AngleJointed {
-                        world.add_angle_joint(joint(foot, corners[i], corners[fb]))?;
-                        world.add_angle_joint(joint(foot, corners[i], corners[lr]))?;
-                        let motor = |axis| TorqueJointDef {
-                            end: foot,
-                            joint: corners[i],
-                            axis,
-                            torque: 0.0,
-                        };
-                        (
-                            Some((
-                                world.add_torque_joint(motor(side))?,
-                                world.add_torque_joint(motor(f))?,
-                            )),
-                            None,
-                        )
-                    } else {
-                        let s = |n: usize| {
-                            SpringDef::new(foot, corners[n], c.leg_spring.0, c.leg_spring.1)
-                        };
-                        (
-                            None,
-                            Some((world.add_spring(s(fb))?, world.add_spring(s(lr))?)),
-                        )
-                    };
-                    Leg {
-                        corner: corners[i],
-                        knee: None,
-                        foot,
-                        spring,
-                        swing,
-                        supports,
-                    }
-                }
+            let at = LegAt {
+                corners,
+                i,
+                out,
+                forward: f,
+                side,
             };
-            legs.push(leg);
+            legs.push(match model {
+                Model::TwoSegment => at.two_segments(world, c)?,
+                Model::AngleJointed | Model::Sprung => at.one_segment(world, c, model)?,
+            });
         }
         Ok(Quadruped {
             name: name.to_string(),
@@ -338,6 +255,116 @@ impl Quadruped {
             springs.set_rest_length(to_side, side);
         }
         self.forward * distance
+    }
+}
+
+/// Where leg `i` of a quadruped hangs: its corner among `corners`, the
+/// horizontal direction `out` from the torso's centre, and the body's
+/// forward and right-hand directions.
+struct LegAt {
+    corners: [ParticleId; 4],
+    i: usize,
+    out: DVec3,
+    forward: DVec3,
+    side: DVec3,
+}
+
+impl LegAt {
+    /// The corners next to this one: (front–back, left–right).
+    fn neighbours(&self) -> (ParticleId, ParticleId) {
+        let (fb, lr) = match self.i {
+            0 => (3, 1),
+            1 => (2, 0),
+            2 => (1, 3),
+            _ => (0, 2),
+        };
+        (self.corners[fb], self.corners[lr])
+    }
+
+    fn foot(c: &QuadrupedConstants, x: DVec3) -> ParticleDef {
+        ParticleDef::new(c.foot_mass)
+            .with_radius(0.02)
+            .at(x)
+            .with_friction(1.0, 0.8)
+            .with_restitution(0.1)
+    }
+
+    fn joint(c: &QuadrupedConstants, a: ParticleId, j: ParticleId, b: ParticleId) -> AngleJointDef {
+        AngleJointDef::new(a, j, b, c.joint.0, c.joint.1)
+    }
+
+    /// Model 1's leg: a knee between hip and foot, the upper segment held
+    /// against both torso edges by angle joints (a 2-DOF hip).
+    fn two_segments(&self, world: &mut World, c: &QuadrupedConstants) -> Result<Leg, ModelError> {
+        let corner = self.corners[self.i];
+        let (fb, lr) = self.neighbours();
+        let top = world.position(corner);
+        let knee_at = top + self.out * 0.1 + DVec3::Y * 0.1;
+        let foot_at = DVec3::new(knee_at.x, 0.02, knee_at.z) + self.out * 0.1;
+        let knee = world.add_particle(Self::foot(c, knee_at).with_radius(0.02))?;
+        let foot = world.add_particle(Self::foot(c, foot_at))?;
+        world.add_spring(SpringDef::new(corner, knee, c.leg_spring.0, c.leg_spring.1))?;
+        let spring =
+            world.add_spring(SpringDef::new(knee, foot, c.leg_spring.0, c.leg_spring.1))?;
+        // The 2-DOF hip: the upper segment held against both edges.
+        world.add_angle_joint(Self::joint(c, knee, corner, fb))?;
+        world.add_angle_joint(Self::joint(c, knee, corner, lr))?;
+        // The knee.
+        world.add_angle_joint(Self::joint(c, corner, knee, foot))?;
+        Ok(Leg {
+            corner,
+            knee: Some(knee),
+            foot,
+            spring,
+            swing: None,
+            supports: None,
+        })
+    }
+
+    /// Models 2 and 3's leg: one sprung segment, swung by two motors held
+    /// by angle joints (model 2) or held by two more springs (model 3).
+    fn one_segment(
+        &self,
+        world: &mut World,
+        c: &QuadrupedConstants,
+        model: Model,
+    ) -> Result<Leg, ModelError> {
+        let corner = self.corners[self.i];
+        let (fb, lr) = self.neighbours();
+        let top = world.position(corner);
+        let foot_at = DVec3::new(top.x, 0.02, top.z) + self.out * c.splay;
+        let foot = world.add_particle(Self::foot(c, foot_at))?;
+        let spring =
+            world.add_spring(SpringDef::new(corner, foot, c.leg_spring.0, c.leg_spring.1))?;
+        let (swing, supports) = if model == Model::AngleJointed {
+            world.add_angle_joint(Self::joint(c, foot, corner, fb))?;
+            world.add_angle_joint(Self::joint(c, foot, corner, lr))?;
+            let motor = |axis| TorqueJointDef {
+                end: foot,
+                joint: corner,
+                axis,
+                torque: 0.0,
+            };
+            let swing = (
+                world.add_torque_joint(motor(self.side))?,
+                world.add_torque_joint(motor(self.forward))?,
+            );
+            (Some(swing), None)
+        } else {
+            let s = |n: ParticleId| SpringDef::new(foot, n, c.leg_spring.0, c.leg_spring.1);
+            (
+                None,
+                Some((world.add_spring(s(fb))?, world.add_spring(s(lr))?)),
+            )
+        };
+        Ok(Leg {
+            corner,
+            knee: None,
+            foot,
+            spring,
+            swing,
+            supports,
+        })
     }
 }
 

@@ -66,6 +66,50 @@ pub(super) struct Parallel {
     runs: Vec<Range<usize>>,
 }
 
+/// The particles that springs of other tasks add to (`touched` and not
+/// `owned` by one task), and their springs grouped by particle in spring
+/// order: particle `shared[k]`'s are `ends[start[k]..start[k + 1]]`, each
+/// `spring << 1 | which end`.
+fn shared_springs(
+    springs: Slice,
+    touched: &[bool],
+    owned: &[bool],
+) -> (Vec<u32>, Vec<u32>, Vec<u32>) {
+    let particles = touched.len();
+    let mut slot = vec![u32::MAX; particles];
+    let shared: Vec<u32> = (0..particles)
+        .filter(|&p| touched[p] && !owned[p])
+        .map(|p| p as u32)
+        .collect();
+    for (k, &p) in shared.iter().enumerate() {
+        slot[p as usize] = k as u32;
+    }
+    let mut start = vec![0u32; shared.len() + 1];
+    for &[a, b] in springs.ends {
+        for end in [a, b] {
+            let k = slot[end as usize];
+            if k != u32::MAX {
+                start[k as usize + 1] += 1;
+            }
+        }
+    }
+    for k in 0..shared.len() {
+        start[k + 1] += start[k];
+    }
+    let mut next = start.clone();
+    let mut ends = vec![0u32; start[shared.len()] as usize];
+    for (i, &[a, b]) in springs.ends.iter().enumerate() {
+        for (end, second) in [(a, 0), (b, 1)] {
+            let k = slot[end as usize];
+            if k != u32::MAX {
+                ends[next[k as usize] as usize] = (i as u32) << 1 | second;
+                next[k as usize] += 1;
+            }
+        }
+    }
+    (shared, start, ends)
+}
+
 impl Parallel {
     /// Makes the tables (again only when springs were added, the world grew
     /// or the number of threads changed: a spring's ends never change).
@@ -83,27 +127,7 @@ impl Parallel {
                 owned[end] &= end / per_piece == i / per_range;
             }
         }
-        // The shared particles' springs, grouped by particle in spring order.
-        let mut slot = vec![u32::MAX; particles];
-        let shared: Vec<u32> = (0..particles)
-            .filter(|&p| touched[p] && !owned[p])
-            .map(|p| p as u32)
-            .collect();
-        for (k, &p) in shared.iter().enumerate() {
-            slot[p as usize] = k as u32;
-        }
-        let mut start = vec![0u32; shared.len() + 1];
-        for &[a, b] in springs.ends {
-            for end in [a, b] {
-                let k = slot[end as usize];
-                if k != u32::MAX {
-                    start[k as usize + 1] += 1;
-                }
-            }
-        }
-        for k in 0..shared.len() {
-            start[k + 1] += start[k];
-        }
+        let (shared, start, ends) = shared_springs(springs, &touched, &owned);
         let code: Vec<u8> = springs
             .ends
             .iter()
@@ -123,17 +147,6 @@ impl Parallel {
         for (t, range) in code.chunks(per_range).enumerate() {
             for (k, block) in range.chunks(BLOCK).enumerate() {
                 whole[t * per_block + k] = block.iter().all(|&c| c == 3);
-            }
-        }
-        let mut next = start.clone();
-        let mut ends = vec![0u32; start[shared.len()] as usize];
-        for (i, &[a, b]) in springs.ends.iter().enumerate() {
-            for (end, second) in [(a, 0), (b, 1)] {
-                let k = slot[end as usize];
-                if k != u32::MAX {
-                    ends[next[k as usize] as usize] = (i as u32) << 1 | second;
-                    next[k as usize] += 1;
-                }
             }
         }
         let stages = (0..threads)
