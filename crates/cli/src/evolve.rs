@@ -21,8 +21,8 @@ pub struct Args {
     /// A scene file with an `[evolve]` table; without one, the thesis's
     /// roobot (scenes/hop_evolver.toml, built in).
     scene: Option<PathBuf>,
-    /// hill-climber (the thesis's), ga or cma-es.
-    #[arg(long, value_parser = OptimiserKind::parse)]
+    /// The optimiser of every lane (default: the thesis's hill climber).
+    #[arg(long, value_parser = optimiser_names())]
     optimiser: Option<OptimiserKind>,
     /// Candidates per generation per lane (default: hill-climber 1, ga 32,
     /// cma-es 4 + 3 ln n).
@@ -63,6 +63,13 @@ pub struct Args {
     view: bool,
     #[command(flatten)]
     serving: crate::view::Serving,
+}
+
+/// `--optimiser`: one of [`OptimiserKind::ALL`], listed in `--help`.
+fn optimiser_names() -> impl clap::builder::TypedValueParser<Value = OptimiserKind> {
+    use clap::builder::TypedValueParser;
+    let names: Vec<&'static str> = OptimiserKind::ALL.iter().map(|k| k.name()).collect();
+    clap::builder::PossibleValuesParser::new(names).try_map(|s| OptimiserKind::parse(&s))
 }
 
 const CHECKPOINT: &str = "checkpoint.json";

@@ -122,5 +122,10 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
     assert_eq!(o.status.code(), Some(2));
     let o = animats(&["evolve", CRAWLER, "--optimiser", "annealing"]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o).1.contains("unknown optimiser `annealing`"));
+    let err = text(&o).1;
+    assert!(
+        err.contains("invalid value 'annealing' for '--optimiser")
+            && err.contains("[possible values: hill-climber, ga, cma-es]"),
+        "{err}"
+    );
 }

@@ -17,12 +17,11 @@
 #![warn(missing_docs)]
 
 pub mod checkpoint;
-pub mod cma_es;
-pub mod ga;
-pub mod hill_climber;
 pub mod optimiser;
 pub mod problem;
 pub mod run;
+
+pub use optimiser::{cma_es, ga, hill_climber};
 
 pub use optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 pub use problem::{Outcome, Problem};

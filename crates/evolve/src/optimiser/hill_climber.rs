@@ -16,7 +16,7 @@
 //! asks λ children of the best and keeps the best of them if it beats it,
 //! a (1+λ) scheme.
 
-use crate::optimiser::{check_told, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{check_told, BestSoFar, Bounds, Optimiser, Random, Setup};
 use serde::{Deserialize, Serialize};
 
 /// Hill climbing with the thesis's per-lane mutation size.

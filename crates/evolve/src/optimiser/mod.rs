@@ -5,10 +5,17 @@
 //! An optimiser draws its random numbers from [`Random::for_evaluation`]
 //! (seed, lane, generation): it stores no generator state, so a checkpoint
 //! taken between generations resumes to the identical run.
+//!
+//! One file per strategy in this folder; adding one: its file, and its
+//! place in [`OptimiserKind`] and [`AnyOptimiser`] below.
 
-use crate::cma_es::CmaEs;
-use crate::ga::Ga;
-use crate::hill_climber::HillClimber;
+pub mod cma_es;
+pub mod ga;
+pub mod hill_climber;
+
+use cma_es::CmaEs;
+use ga::Ga;
+use hill_climber::HillClimber;
 use serde::{Deserialize, Serialize};
 
 pub use animats_creatures::random::Random;
@@ -96,7 +103,10 @@ impl OptimiserKind {
         OptimiserKind::ALL
             .into_iter()
             .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown optimiser `{s}`: use hill-climber, ga or cma-es"))
+            .ok_or_else(|| {
+                let names: Vec<&str> = OptimiserKind::ALL.iter().map(|k| k.name()).collect();
+                format!("unknown optimiser `{s}`: use {}", names.join(", "))
+            })
     }
 
     /// The population a generation asks for by default in `dim` dimensions.

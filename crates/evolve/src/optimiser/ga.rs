@@ -13,7 +13,7 @@
 //!   tenth of its bounds' width (or of its magnitude, at least 0.1, when
 //!   unbounded), clamped into the bounds.
 
-use crate::optimiser::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
 use serde::{Deserialize, Serialize};
 
 /// Tournament size.

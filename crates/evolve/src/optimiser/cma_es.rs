@@ -30,7 +30,7 @@
 //! generation's values (at least 1e-9 × max(1, |median|)), so that a
 //! candidate outside the box ranks below an equal one inside.
 
-use crate::optimiser::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
 use serde::{Deserialize, Serialize};
 
 /// CMA-ES's whole state (what a checkpoint stores).
