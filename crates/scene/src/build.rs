@@ -2,7 +2,7 @@
 //! particle name resolved, every mistake reported with its entry and field.
 
 use crate::def::*;
-use crate::entries::{each, one, Builder};
+use crate::entries::Builder;
 use crate::error::SceneError;
 use crate::nervous::Handles;
 use crate::source::Source;
@@ -213,28 +213,6 @@ fn world_table(def: &SceneDef, src: &Source) -> Result<(World, WorldTable), Scen
     Ok((world, table))
 }
 
-/// Every entry builds itself (`entries/`), in this order: particles and
-/// food first, so that everything else can name them; creatures after the
-/// forces.
-fn entries(def: &SceneDef, cx: &mut Builder) -> Result<(), SceneError> {
-    each(&def.particle, "particle", cx)?;
-    each(&def.food, "food", cx)?;
-    one(&def.floor, "floor", cx)?;
-    one(&def.fluid, "fluid", cx)?;
-    each(&def.spring, "spring", cx)?;
-    each(&def.angle_joint, "angle_joint", cx)?;
-    each(&def.torque_joint, "torque_joint", cx)?;
-    each(&def.constant_force, "constant_force", cx)?;
-    each(&def.nbody, "nbody", cx)?;
-    each(&def.roobot, "roobot", cx)?;
-    each(&def.jellyfish, "jellyfish", cx)?;
-    each(&def.seaweed, "seaweed", cx)?;
-    each(&def.bubble_column, "bubble_column", cx)?;
-    each(&def.rocks, "rocks", cx)?;
-    each(&def.quadruped, "quadruped", cx)?;
-    one(&def.contacts, "contacts", cx)
-}
-
 /// Builds the world a scene describes.
 pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     let (world, table) = world_table(def, src)?;
@@ -254,7 +232,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         seed: table.seed,
         gravity: table.gravity,
     };
-    entries(def, &mut cx)?;
+    crate::entries::build_all(def, &mut cx)?;
     let Builder {
         mut world,
         names,

@@ -25,7 +25,7 @@
 
 pub mod build;
 pub mod def;
-pub(crate) mod entries;
+pub mod entries;
 pub mod env;
 pub mod error;
 pub mod evaluate;

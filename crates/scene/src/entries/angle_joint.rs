@@ -2,6 +2,27 @@
 
 use super::*;
 
+/// `[[angle_joint]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AngleJointEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
+    /// End of the first arm.
+    pub a: String,
+    /// Where the arms meet.
+    pub joint: String,
+    /// End of the second arm.
+    pub b: String,
+    /// N m/rad, >= 0.
+    pub stiffness: f64,
+    /// N m s/rad, >= 0, default 0.
+    #[serde(default)]
+    pub damping: f64,
+    /// rad in [0, π]; default the initial angle.
+    pub rest_angle: Option<f64>,
+}
+
 impl Build for AngleJointEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let j = self;

@@ -2,6 +2,26 @@
 
 use super::*;
 
+/// `[[bubble_column]]`: a particle system of rising bubbles.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BubbleColumnEntry {
+    /// Prefix of its particles' names; default `bubbles{k}`.
+    pub name: Option<String>,
+    /// Base of the column, m (y is ignored: on the floor).
+    pub position: [f64; 3],
+    /// Bubbles in the pool; default 15.
+    pub bubbles: Option<usize>,
+    /// Time between spawns, s; default [0.1, 0.4].
+    pub interval: Option<[f64; 2]>,
+    /// Bubble radius range, m; default [0.002, 0.005].
+    pub radius: Option<[f64; 2]>,
+    /// Effective density with added mass, kg/m³; default 500.
+    pub density: Option<f64>,
+    /// Water surface height, m; default 1.5.
+    pub surface: Option<f64>,
+}
+
 impl Build for BubbleColumnEntry {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let b = self;

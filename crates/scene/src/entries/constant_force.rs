@@ -2,6 +2,18 @@
 
 use super::*;
 
+/// `[[constant_force]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConstantForceEntry {
+    /// Optional, unique among its kind: actuators refer to it by name.
+    pub name: Option<String>,
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+    /// N, on each.
+    pub force: [f64; 3],
+}
+
 impl Build for ConstantForceEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let c = self;

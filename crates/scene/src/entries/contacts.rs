@@ -4,6 +4,36 @@
 
 use super::*;
 
+/// `[contacts]`: the spheres collide with each other (not only with the
+/// floor); pairs joined by a spring or a joint never do.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactsEntry {
+    /// The spheres that collide; default all.
+    pub particles: Option<Vec<String>>,
+    /// The restitution of every contact, in [0, 1]; default the product of
+    /// the two spheres' restitutions.
+    pub restitution: Option<f64>,
+    /// m: an overlap deeper than this = missed; default 0.01.
+    #[serde(default = "default_envelope")]
+    pub envelope: f64,
+    /// m/s: approaches slower than this do not bounce; default 0.05.
+    #[serde(default = "default_rest_speed")]
+    pub rest_speed: f64,
+    /// m/s: a sphere in contact that stays within `sleep_speed ·
+    /// sleep_time` of one place for `sleep_time` falls asleep; default 0
+    /// (never).
+    #[serde(default)]
+    pub sleep_speed: f64,
+    /// s: default 0.5.
+    #[serde(default = "default_sleep_time")]
+    pub sleep_time: f64,
+}
+
+fn default_sleep_time() -> f64 {
+    0.5
+}
+
 impl Build for ContactsEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let targets = cx.names.targets(at, &self.particles)?;

@@ -2,6 +2,60 @@
 
 use super::*;
 
+/// `[fluid]`: drag and buoyancy.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FluidEntry {
+    /// kg/m³, default 1000 (water).
+    #[serde(default = "default_density")]
+    pub density: f64,
+    /// Default 0.47 (a sphere).
+    #[serde(default = "default_drag")]
+    pub drag_coefficient: f64,
+    /// The fluid's velocity field; default still.
+    #[serde(default)]
+    pub current: CurrentEntry,
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+}
+
+fn default_density() -> f64 {
+    1000.0
+}
+
+fn default_drag() -> f64 {
+    0.47
+}
+
+/// `current = { kind = "..." ... }`.
+#[derive(Clone, Debug, Deserialize, Default)]
+#[serde(tag = "kind", rename_all = "lowercase", deny_unknown_fields)]
+pub enum CurrentEntry {
+    /// At rest.
+    #[default]
+    Still,
+    /// The same velocity everywhere.
+    Uniform {
+        /// m/s.
+        velocity: [f64; 3],
+    },
+    /// Swaying currents under passing waves (see `ReefWater`).
+    Reef {
+        /// Height of the mean water surface, m; default 1.5.
+        surface: Option<f64>,
+        /// Wave amplitude at the surface, m; default 0.1.
+        amplitude: Option<f64>,
+        /// m; default 3.
+        wavelength: Option<f64>,
+        /// s; default: deep-water waves of that wavelength.
+        period: Option<f64>,
+        /// Horizontal direction of travel; default `[1, 0, 0]`.
+        direction: Option<[f64; 3]>,
+        /// Steady current added everywhere, m/s; default 0.
+        drift: Option<[f64; 3]>,
+    },
+}
+
 impl Build for FluidEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let f = self;

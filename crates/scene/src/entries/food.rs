@@ -2,6 +2,19 @@
 
 use super::*;
 
+/// `[[food]]`: a fixed particle that jellyfish track.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FoodEntry {
+    /// Default `food`.
+    #[serde(default = "default_food")]
+    pub name: String,
+    /// m.
+    pub position: [f64; 3],
+    /// m; default 0.062 (Appendix B's volume of 1 litre).
+    pub radius: Option<f64>,
+}
+
 impl Build for FoodEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let f = self;

@@ -2,6 +2,41 @@
 
 use super::*;
 
+/// `[[jellyfish]]`: Appendix B's jellyfish.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JellyfishEntry {
+    /// Prefix of its particles' names; default `jellyfish{k}`.
+    pub name: Option<String>,
+    /// Centre of its dome, m.
+    pub position: [f64; 3],
+    /// Mass of each dome mass, kg; default 0.2.
+    #[serde(default = "default_dome_mass")]
+    pub dome_mass: f64,
+    /// Mass of each tentacle segment, kg; default 0.02.
+    #[serde(default = "default_tentacle_mass")]
+    pub tentacle_mass: f64,
+    /// The particle it tracks; default `food`.
+    #[serde(default = "default_food")]
+    pub food: String,
+    /// Pulse force range per dome mass, N; default 4.5× the submerged weight
+    /// it carries (Appendix B: 5).
+    pub pulse_force: Option<f64>,
+    /// Steering force range per dome mass, N; default a tenth of the pulse's
+    /// (Appendix B: 0.5).
+    pub steer_force: Option<f64>,
+    /// Height its depth sense reads as "too high", m; default 1.
+    pub ceiling: Option<f64>,
+}
+
+fn default_dome_mass() -> f64 {
+    0.2
+}
+
+fn default_tentacle_mass() -> f64 {
+    0.02
+}
+
 impl Build for JellyfishEntry {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let j = self;

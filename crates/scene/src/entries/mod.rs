@@ -1,26 +1,88 @@
-//! Each kind of scene entry builds itself: one file per kind, each an
-//! `impl Build for ...Entry` that validates its entry and adds it to the
-//! world, naming what it adds. `build.rs` calls them in a fixed order
-//! (particles and food first, so that the rest can name them; creatures
-//! after forces). Adding an entry kind: its struct in `def.rs`, a file here,
-//! and one line in `build.rs`.
+//! Each kind of scene entry is one file here: its struct (the keys a scene
+//! file gives it, checked by serde) and its `impl Build`, which validates
+//! it and adds it to the world, naming what it adds. Adding an entry kind:
+//! its file, and its line in the [`entries!`] list below.
 
-pub(crate) mod angle_joint;
-pub(crate) mod bubble_column;
-pub(crate) mod constant_force;
-pub(crate) mod contacts;
-pub(crate) mod floor;
-pub(crate) mod fluid;
-pub(crate) mod food;
-pub(crate) mod jellyfish;
-pub(crate) mod nbody;
-pub(crate) mod particle;
-pub(crate) mod quadruped;
-pub(crate) mod rocks;
-pub(crate) mod roobot;
-pub(crate) mod seaweed;
-pub(crate) mod spring;
-pub(crate) mod torque_joint;
+/// Declares every kind of entry once, in the order they are built (the
+/// order written): its module (the file `entries/NAME.rs`, holding its
+/// struct and its [`Build`]), and its field of [`SceneDef`], a `[[NAME]]`
+/// array (`Vec`) or a `[NAME]` table (`Option`). Particles and food come
+/// first, so that everything else can name them; creatures after forces.
+macro_rules! entries {
+    ($($(#[doc = $doc:literal])* $field:ident: $many:ident<$entry:ident>,)*) => {
+        $(pub mod $field;)*
+        $(pub use $field::$entry;)*
+
+        /// A whole scene file.
+        #[derive(Clone, Debug, Deserialize, Default)]
+        #[serde(deny_unknown_fields)]
+        pub struct SceneDef {
+            /// `[world]`: gravity, step, integrator, duration.
+            #[serde(default)]
+            pub world: Option<Spanned<WorldDef>>,
+            $(
+                $(#[doc = $doc])*
+                #[serde(default)]
+                pub $field: $many<Spanned<$entry>>,
+            )*
+            /// `[[actuator]]` entries: levels in [0, 1] onto a named spring,
+            /// joint or force.
+            #[serde(default)]
+            pub actuator: Vec<Spanned<Typed<ActuatorEntry>>>,
+            /// `[[sensor]]` entries: readings mapped onto [0, 1].
+            #[serde(default)]
+            pub sensor: Vec<Spanned<Typed<SensorEntry>>>,
+            /// `[[controller]]` entries: brains from sensors to actuators.
+            #[serde(default)]
+            pub controller: Vec<Spanned<Typed<ControllerEntry>>>,
+            /// `[evolve]`: the controller evolution tunes and how a run is
+            /// scored.
+            #[serde(default)]
+            pub evolve: Option<Spanned<EvolveEntry>>,
+        }
+
+        /// Builds every entry of the scene, in the order declared.
+        pub(crate) fn build_all(def: &SceneDef, cx: &mut Builder) -> Result<(), SceneError> {
+            $(Entries::build_all(&def.$field, stringify!($field), cx)?;)*
+            Ok(())
+        }
+    };
+}
+
+entries! {
+    /// `[[particle]]` entries.
+    particle: Vec<ParticleEntry>,
+    /// `[[food]]` entries: fixed particles that jellyfish smell.
+    food: Vec<FoodEntry>,
+    /// `[floor]`: the plane y = 0.
+    floor: Option<FloorEntry>,
+    /// `[fluid]`: drag and buoyancy.
+    fluid: Option<FluidEntry>,
+    /// `[[spring]]` entries.
+    spring: Vec<SpringEntry>,
+    /// `[[angle_joint]]` entries.
+    angle_joint: Vec<AngleJointEntry>,
+    /// `[[torque_joint]]` entries.
+    torque_joint: Vec<TorqueJointEntry>,
+    /// `[[constant_force]]` entries.
+    constant_force: Vec<ConstantForceEntry>,
+    /// `[[nbody]]` entries.
+    nbody: Vec<NBodyEntry>,
+    /// `[[roobot]]` entries: hopping monopods with their brains.
+    roobot: Vec<RoobotEntry>,
+    /// `[[jellyfish]]` entries.
+    jellyfish: Vec<JellyfishEntry>,
+    /// `[[seaweed]]` entries: fronds.
+    seaweed: Vec<SeaweedEntry>,
+    /// `[[bubble_column]]` entries.
+    bubble_column: Vec<BubbleColumnEntry>,
+    /// `[[rocks]]` entries: scattered sinking stones.
+    rocks: Vec<RocksEntry>,
+    /// `[[quadruped]]` entries: the thesis's three failed quadrupeds.
+    quadruped: Vec<QuadrupedEntry>,
+    /// `[contacts]`: sphere–sphere contact (opt-in).
+    contacts: Option<ContactsEntry>,
+}
 
 pub(crate) use crate::build::{at, check_name, room, At, Names, CREATURE_PARTICLES};
 pub(crate) use crate::def::*;
@@ -43,6 +105,7 @@ pub(crate) use animats_engine::{
     AngleJointDef, Current, DVec3, FloorDef, FluidMedium, NBodyGravity, ParticleDef, ParticleId,
     ReefWater, SpringDef, Targets, TorqueJointDef, World,
 };
+pub(crate) use serde::Deserialize;
 pub(crate) use toml::Spanned;
 
 /// What entries build into, and the names they have given so far.
@@ -116,28 +179,29 @@ pub(crate) trait Build {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError>;
 }
 
-/// Builds every entry of one kind (`[[kind]]`), in order.
-pub(crate) fn each<T: Build>(
-    entries: &[Spanned<T>],
-    kind: &str,
-    cx: &mut Builder,
-) -> Result<(), SceneError> {
-    for (k, e) in entries.iter().enumerate() {
-        let at = at(cx.src, format!("{kind}[{k}]"), e);
-        e.get_ref().build(k, &at, cx)?;
-    }
-    Ok(())
+/// The entries of one kind: a `[[kind]]` array's, or a `[kind]` table's if
+/// the scene has one.
+pub(crate) trait Entries {
+    /// Builds them, in order.
+    fn build_all(&self, kind: &str, cx: &mut Builder) -> Result<(), SceneError>;
 }
 
-/// Builds a single table (`[kind]`), if the scene has one.
-pub(crate) fn one<T: Build>(
-    entry: &Option<Spanned<T>>,
-    kind: &str,
-    cx: &mut Builder,
-) -> Result<(), SceneError> {
-    if let Some(e) = entry {
-        let at = at(cx.src, kind, e);
-        e.get_ref().build(0, &at, cx)?;
+impl<T: Build> Entries for Vec<Spanned<T>> {
+    fn build_all(&self, kind: &str, cx: &mut Builder) -> Result<(), SceneError> {
+        for (k, e) in self.iter().enumerate() {
+            let at = at(cx.src, format!("{kind}[{k}]"), e);
+            e.get_ref().build(k, &at, cx)?;
+        }
+        Ok(())
     }
-    Ok(())
+}
+
+impl<T: Build> Entries for Option<Spanned<T>> {
+    fn build_all(&self, kind: &str, cx: &mut Builder) -> Result<(), SceneError> {
+        if let Some(e) = self {
+            let at = at(cx.src, kind, e);
+            e.get_ref().build(0, &at, cx)?;
+        }
+        Ok(())
+    }
 }

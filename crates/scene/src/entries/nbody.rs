@@ -2,6 +2,24 @@
 
 use super::*;
 
+/// `[[nbody]]`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NBodyEntry {
+    /// Default: all particles.
+    pub particles: Option<Vec<String>>,
+    /// Gravitational constant; default 6.674e-11.
+    #[serde(rename = "G", default = "default_big_g")]
+    pub g: f64,
+    /// m, default 0.
+    #[serde(default)]
+    pub softening: f64,
+}
+
+fn default_big_g() -> f64 {
+    6.674e-11
+}
+
 impl Build for NBodyEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let n = self;

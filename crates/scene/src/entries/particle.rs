@@ -2,6 +2,49 @@
 
 use super::*;
 
+/// `[[particle]]`: a sphere.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleEntry {
+    /// Unique; forces refer to particles by name.
+    pub name: String,
+    /// kg, > 0.
+    pub mass: f64,
+    /// m.
+    pub position: [f64; 3],
+    /// m/s, default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// m; or `volume`; at least one.
+    pub radius: Option<f64>,
+    /// m³; or `radius`; at least one.
+    pub volume: Option<f64>,
+    /// Default 0.5.
+    #[serde(default = "default_mu_s")]
+    pub mu_s: f64,
+    /// Default 0.3.
+    #[serde(default = "default_mu_k")]
+    pub mu_k: f64,
+    /// 0..=1, default 0.5.
+    #[serde(default = "default_restitution")]
+    pub restitution: f64,
+    /// Nailed in place; default false.
+    #[serde(default)]
+    pub fixed: bool,
+}
+
+fn default_mu_s() -> f64 {
+    0.5
+}
+
+fn default_mu_k() -> f64 {
+    0.3
+}
+
+fn default_restitution() -> f64 {
+    0.5
+}
+
 impl Build for ParticleEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let p = self;

@@ -2,6 +2,30 @@
 
 use super::*;
 
+/// `[[quadruped]]`: one of the thesis's three quadruped models.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuadrupedEntry {
+    /// Prefix of its particles' names; default `quadruped{k}`.
+    pub name: Option<String>,
+    /// 1, 2 or 3 (thesis §3.2.3).
+    pub model: u32,
+    /// Where the centre of its torso stands, m (y ignored).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// rad from +x, counter-clockwise seen from above.
+    #[serde(default)]
+    pub heading: f64,
+    /// When to run the thesis's failing experiment, s (model 2 raises its
+    /// front feet, model 3 tries a step); default 2; a negative time never.
+    #[serde(default = "default_demo")]
+    pub demo_at: f64,
+}
+
+fn default_demo() -> f64 {
+    2.0
+}
+
 impl Build for QuadrupedEntry {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let q = self;

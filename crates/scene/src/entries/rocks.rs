@@ -2,6 +2,24 @@
 
 use super::*;
 
+/// `[[rocks]]`: stones scattered at random.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RocksEntry {
+    /// Prefix of their names; default `rock` (`rock0`, `rock1`...).
+    pub name: Option<String>,
+    /// How many; default 10.
+    pub count: Option<usize>,
+    /// Mass range, kg; default [0.05, 0.3].
+    pub mass: Option<[f64; 2]>,
+    /// kg/m³; default 2000.
+    pub density: Option<f64>,
+    /// Least corner of the drop box, m; default [-0.5, 0.2, -0.5].
+    pub from: Option<[f64; 3]>,
+    /// Greatest corner, m; default [0.5, 1.2, 0.5].
+    pub to: Option<[f64; 3]>,
+}
+
 impl Build for RocksEntry {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let r = self;

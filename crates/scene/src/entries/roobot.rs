@@ -2,6 +2,53 @@
 //! the scene's nervous system under its name.
 
 use super::*;
+
+/// Where a creature's parameters come from: a built-in name or file path, or
+/// the numbers themselves.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum ParamsEntry {
+    /// `"evolved"`, `"initial"`, or a parameter file (relative to the scene file).
+    Named(String),
+    /// The 14 numbers inline.
+    Inline(Vec<f64>),
+}
+
+/// `[[roobot]]`: a hopping monopod with its brain. Its sensors, actuators
+/// and brain join the scene's (`NAME.foot_height`..., `NAME.leg`...,
+/// controller `NAME`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RoobotEntry {
+    /// Prefix of its particles' names (`NAME.hip`...); default `roobot{k}`.
+    pub name: Option<String>,
+    /// Where its foot stands, m (y is ignored: the foot rests on the floor).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// Direction it faces, rad from +x, counter-clockwise seen from above.
+    #[serde(default)]
+    pub heading: f64,
+    /// `hop` (the thesis's FSM), `raibert` or `none`; default `hop`.
+    #[serde(default)]
+    pub brain: RoobotBrainName,
+    /// `hop`: its hopping parameters; default `"evolved"`.
+    pub params: Option<ParamsEntry>,
+    /// `raibert`: its 8 gains; default the hand-set ones.
+    pub gains: Option<Vec<f64>>,
+}
+
+/// A roobot's brain, as written in files.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum RoobotBrainName {
+    /// The thesis's hopping FSM.
+    #[default]
+    Hop,
+    /// Raibert's three-part controller.
+    Raibert,
+    /// None: a program or a scene's controller drives its actuators.
+    None,
+}
 use animats_creatures::roobot::raibert;
 
 impl Build for RoobotEntry {

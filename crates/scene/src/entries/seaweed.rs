@@ -2,6 +2,28 @@
 
 use super::*;
 
+/// `[[seaweed]]`: a frond nailed to the floor.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeaweedEntry {
+    /// Prefix of its particles' names; default `seaweed{k}`.
+    pub name: Option<String>,
+    /// Where its base is nailed, m (y is ignored: on the floor).
+    pub position: [f64; 3],
+    /// Default 12.
+    pub segments: Option<usize>,
+    /// m; default 0.06.
+    pub segment_length: Option<f64>,
+    /// kg per segment; default 0.004.
+    pub mass: Option<f64>,
+    /// kg/m³; default 980.
+    pub density: Option<f64>,
+    /// N/m; default 10.
+    pub stiffness: Option<f64>,
+    /// N s/m; default 0.02.
+    pub damping: Option<f64>,
+}
+
 impl Build for SeaweedEntry {
     fn build(&self, k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let w = self;
