@@ -571,7 +571,7 @@ fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
             checks,
         ));
         // One world on two threads, where the world is large enough to split
-        // (docs/DESIGN.md, "Forces on many threads"); the same bits.
+        // (docs/DESIGN.md, "Threads"); the same bits.
         if name == "cloth-128" {
             let (both, both_base, world2, _) = measure_pair(
                 runs,

@@ -93,7 +93,7 @@ fn a_thousand_spheres_poured_into_a_ring_lose_their_energy_without_deep_overlaps
 fn a_thousand_spheres_that_may_sleep_come_to_rest_and_stay() {
     let (r, h) = (0.02, 1e-3);
     // Twice a step's gravity g h: above what a resting sphere trembles by
-    // (with half of g h the heap never sleeps: docs/DESIGN.md "Sleeping").
+    // (with half of g h the heap never sleeps: docs/DESIGN.md, "Sphere–sphere contact").
     let def = SphereContactDef {
         sleep_speed: 2.0 * 9.8 * h,
         ..SphereContactDef::default()

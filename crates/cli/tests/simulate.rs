@@ -546,8 +546,7 @@ fn realtime_runs_to_the_duration_and_a_blow_up_there_names_the_particle_and_keep
 /// flat updates, both vectorised), under mutual gravitation as well (the
 /// all-pairs gather), dropped onto the floor with RK4: the bytes of its
 /// trajectory must not depend on the vector instructions the engine
-/// chose, whatever `ANIMATS_SIMD` caps them to (docs/DESIGN.md, "Which
-/// vectors, per CPU"). On an Intel CPU the caps reach only the
+/// chose, whatever `ANIMATS_SIMD` caps them to (docs/DESIGN.md, "Determinism"). On an Intel CPU the caps reach only the
 /// arithmetic's choice (its updates stay SSE2); the loops' own unit tests
 /// compare every width this CPU has directly.
 #[test]

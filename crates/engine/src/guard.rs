@@ -1,8 +1,8 @@
 //! Blow-ups that stay finite. A stiff system stepped past its stability
 //! limit need not overflow: it can tangle at 100 m/s with many times its
 //! energy, or grow for a long time before it reaches infinity. The guard
-//! calls such a run a blow-up, by two criteria (docs/DESIGN.md, "When a run
-//! has blown up"):
+//! calls such a run a blow-up, by two criteria (docs/DESIGN.md, "Blow-ups
+//! and the recommended step"):
 //!
 //! - **Energy, for passive worlds.** With nothing to drive it (no motors,
 //!   constant forces, currents, user forces or events that may add energy)

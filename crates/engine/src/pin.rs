@@ -4,8 +4,7 @@
 //! at a time (we suppose because a woken thread is placed beside the one
 //! that woke it; the probe saw only where they ran), and the second
 //! thread then gains less than it could (allpairs-1000 on two threads: 1.63–
-//! 1.65× one thread unpinned, 1.89–1.91× pinned; docs/PERFORMANCE.md,
-//! 2026-11-25 11:38 UTC). Pinning changes speed only, never results.
+//! 1.65× one thread unpinned, 1.89–1.91× pinned, measured 2026-11-25). Pinning changes speed only, never results.
 //!
 //! Thread `i` of a pool of `n` is pinned to the `i`-th processor the
 //! process may use, and only when it may use at least `n` (a pool larger

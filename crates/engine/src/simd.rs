@@ -12,8 +12,7 @@
 //! in the same order, nothing fused; the tests of each loop compare them),
 //! so the choice changes speed only, never a result.
 //!
-//! The policy comes from measurements (docs/PERFORMANCE.md, 2026-11-25,
-//! "AVX-512 on an Intel Xeon"): on the AMD EPYC (Zen 4) the widest vectors
+//! The policy comes from measurements (2026-11-25, in the git log): on the AMD EPYC (Zen 4) the widest vectors
 //! were fastest for both kinds; on the Intel Xeon, 256-bit vectors beat
 //! 512-bit ones for the arithmetic (cloth-128's force evaluations 293–297
 //! against 332–333 ms) and the baseline's SSE2 beat both for the updates

@@ -1,6 +1,6 @@
 //! Small worlds (under 16 particles) step particle by particle, larger ones
-//! by flat loops over coordinates (docs/DESIGN.md, "Small worlds step
-//! particle by particle"): both must give the same bits. A chain of 12
+//! by flat loops over coordinates (docs/DESIGN.md, "A
+//! step"): both must give the same bits. A chain of 12
 //! springs under gravity and drag is stepped alone, and again beside 40
 //! free particles that touch nothing (which put it on the other path); its
 //! trajectory must be identical, for every explicit integrator, and a blow-up must

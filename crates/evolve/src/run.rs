@@ -629,8 +629,7 @@ const BATCH_SECONDS: f64 = 0.25;
 /// at most four times as many as before. Each batch ends with the pool's
 /// threads waiting for the slowest lane and starts by waking them: on the
 /// 2-core test machine the thesis experiment took 13 % longer in batches
-/// of 10 generations than in one (docs/PERFORMANCE.md, 2026-11-25 17:40
-/// UTC). The batches never change the results: a lane's generations run
+/// of 10 generations than in one (measured 2026-11-25; git log). The batches never change the results: a lane's generations run
 /// in order whatever they are.
 pub fn next_batch(batch: u64, took: std::time::Duration) -> u64 {
     let rate = batch as f64 / took.as_secs_f64().max(1e-6);

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 
 /// mimalloc for the module's own blocks, as in the `animats` command:
 /// evaluations on many threads then share no cache lines
-/// (docs/DESIGN.md, "The allocator").
+/// (docs/DESIGN.md, "Threads").
 #[global_allocator]
 static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 

@@ -8,8 +8,8 @@
 //! `v_y ← -r v_y` (Eq. 16).
 //!
 //! Two refinements of the thesis's response keep an impact from adding
-//! energy and let a bouncing sphere come to rest (docs/DESIGN.md, "Floor
-//! impacts"):
+//! energy and let a bouncing sphere come to rest (docs/DESIGN.md, "The
+//! floor"):
 //! - The velocity reflected is the one the sphere had *at the plane*, not
 //!   at the end of the trial, which includes the acceleration of the part of
 //!   the step spent below the plane. Under the trial's mean normal

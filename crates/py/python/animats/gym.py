@@ -2,20 +2,22 @@
 
 Importing this module registers:
 
-- ``animats/Roobot-v0``: the thesis's hopping monopod. Actions: the levels
-  of its leg, hip and ankle actuators, in [0, 1] (the hip motor acts only in
-  flight, the ankle only in stance). Observations: its four sensors (foot
-  height, leg angle, hip forward speed, time till touchdown), in [0, 1].
-  Reward: the increase over the step of the thesis's fitness, time upright +
-  50 × forward distance of the hip, so an episode's rewards add up to the
-  fitness ``animats.evaluate`` gives the same run. 8 ms per step, 20 s (2500
-  steps) per episode, terminated when the hip touches the floor.
+- ``animats/Roobot-v0``: the thesis's hopping monopod, the scene
+  ``scenes/hop_evolver.toml``. Actions: the levels of its actuators
+  ``roobot.leg``, ``roobot.hip`` and ``roobot.ankle``, in [0, 1] (the hip
+  motor acts only in flight, the ankle only in stance). Observations: its
+  four sensors (foot height, leg angle, hip forward speed, time till
+  touchdown), in [0, 1]. Reward: the increase over the step of the thesis's
+  fitness, time upright + 50 × forward distance of the hip, so an episode's
+  rewards add up to the fitness ``animats.evaluate`` gives the same run.
+  8 ms per step, 20 s (2500 steps) per episode, terminated when the hip,
+  head or tail touches the floor or the leg stretches to 1 m.
 - ``animats/Scene-v0``: any scene with actuators, sensors and an
   ``[evolve]`` table, ``gymnasium.make("animats/Scene-v0", scene=path)``.
   Actions: every actuator's level (the scene's own controllers do not run);
   observations: every sensor's level; reward: the increase of the
   ``[evolve]`` fitness; the episode lasts its ``duration`` and terminates
-  when a ``fail_on_touch`` particle touches the floor or the run blows up.
+  when an ``[evolve]`` end rule holds or the run blows up.
 
 Both accept ``noise`` (m/s): each reset adds to every particle's velocity a
 uniform random vector of up to ``noise`` per component, drawn from the
