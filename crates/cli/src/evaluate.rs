@@ -6,7 +6,7 @@
 //! them.
 
 use crate::Failure;
-use animats_scene::evaluate::{evaluate, SceneProblem};
+use animats_scene::evaluate::{evaluate, evaluate_robust, SceneProblem};
 use std::path::PathBuf;
 
 /// Arguments of `animats evaluate`.
@@ -43,19 +43,32 @@ pub fn run(args: Args) -> Result<(), Failure> {
                 "--params and --lane are the roobot's: a scene's parameters are in its file".into(),
             ));
         }
-        let scene = animats_scene::load(&args.scene).map_err(|e| input(e.to_string()))?;
+        let file = args.scene.display().to_string();
+        let text = animats_scene::read(&args.scene).map_err(|e| input(e.to_string()))?;
+        let scene = animats_scene::parse(&text, &file).map_err(|e| input(e.to_string()))?;
         crate::warn(&args.scene, &scene.warnings);
-        if scene.evolve.is_none() {
-            return Err(input(format!(
-                "{}: the scene has no [evolve] table: nothing to evaluate (docs/SCENES.md)",
-                args.scene.display()
-            )));
+        match &scene.evolve {
+            None => {
+                return Err(input(format!(
+                    "{file}: the scene has no [evolve] table: nothing to evaluate (docs/SCENES.md)"
+                )))
+            }
+            // `robust = true`: at the scene's step and half of it, as
+            // evolution scores it.
+            Some(spec) if spec.robust => {
+                let build = || animats_scene::parse(&text, &file).map_err(|e| e.to_string());
+                return report(evaluate_robust(build).map_err(Failure::Other)?, args.json);
+            }
+            Some(_) => scene,
         }
-        scene
     };
-    let e = evaluate(scene).map_err(Failure::Other)?;
+    report(evaluate(scene).map_err(Failure::Other)?, args.json)
+}
+
+/// Prints an evaluation: a JSON object, or a line a field.
+fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Failure> {
     let (fitness, distance, time, ended) = (e.fitness, e.distance, e.time, e.ended.to_string());
-    if args.json {
+    if json {
         let out = serde_json::json!({
             "fitness": fitness,
             "distance": distance,

@@ -214,6 +214,11 @@ fn watch(args: &Args, state: &State, stop: &Arc<AtomicBool>) -> Result<Option<Vi
     if !args.view {
         return Ok(None);
     }
+    if state.config.optimiser == OptimiserKind::BodyGa {
+        return Err(input(
+            "--view watches a controller evolve; a [morphology] run's best body and brain are DIR/best.toml: `animats view DIR/best.toml`",
+        ));
+    }
     let problem = state.config.problem.parse().map_err(input)?;
     let board = BestBrain::default();
     let stage = Exhibition::new(problem, board.clone()).map_err(Failure::Other)?;
@@ -359,6 +364,19 @@ pub fn run(args: Args) -> Result<(), Failure> {
         println!(
             "  lane {}: best fitness {:>8.2}  time {:>6.3} s  distance {:>7.3} m  ({})",
             l.lane, b.fitness, b.time, b.distance, b.ended
+        );
+    }
+    if let Some((by, kept)) = state.refusals() {
+        let total: u64 = by.values().sum();
+        let reasons: Vec<String> = by.iter().map(|(r, n)| format!("{r} {n}")).collect();
+        println!(
+            "  refused: {total} variations ({}); {kept} children kept their parent after {} tries",
+            if reasons.is_empty() {
+                "none".to_string()
+            } else {
+                reasons.join(", ")
+            },
+            animats_scene::morphology::vary::RETRIES + 1
         );
     }
     println!(

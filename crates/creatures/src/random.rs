@@ -39,6 +39,15 @@ impl Random {
         Random(Pcg64Mcg::seed_from_u64(key))
     }
 
+    /// The stream of child `child` of `lane` at `generation`: each
+    /// offspring of a generation made from its own stream, so that they can
+    /// be made on any thread in any order.
+    pub fn for_child(seed: u64, lane: usize, generation: u64, child: u64) -> Random {
+        let key = mix(mix(mix(mix(seed) ^ lane as u64) ^ generation)
+            ^ child.wrapping_add(0x5851_f42d_4c95_7f2d));
+        Random(Pcg64Mcg::seed_from_u64(key))
+    }
+
     /// Uniform in [0, 1), with 53 random bits.
     pub fn uniform(&mut self) -> f64 {
         (self.0.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)

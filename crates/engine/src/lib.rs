@@ -60,6 +60,7 @@ pub use forces::{
     gravity::Gravity,
     linear_drag::LinearDrag,
     nbody::NBodyGravity,
+    soft_contact::SoftContact,
     spring::{Spring, SpringDef, SpringId},
     torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},
 };

@@ -4,9 +4,11 @@
 //! driven by anything that scores genomes the same way (tests count
 //! evaluations through it).
 
-use crate::optimiser::Bounds;
+use crate::optimiser::body_ga::Variation;
+use crate::optimiser::{Bounds, Random};
 use animats_scene::def::MutationName;
-use animats_scene::evaluate::SceneProblem;
+use animats_scene::evaluate::{EvolveSpec, SceneProblem};
+use animats_scene::morphology::{BodyStats, MorphologyProblem};
 
 /// The outcome of one evaluation: the scene's.
 pub use animats_scene::evaluate::{Ended, Evaluation as Outcome};
@@ -27,6 +29,26 @@ pub trait Problem: Send + Sync {
     /// Evaluates one genome. Deterministic: the same genome gives the same
     /// bits on any thread.
     fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String>;
+    /// The scene's `[evolve]` table, resolved (none for a problem that is
+    /// not a scene).
+    fn spec(&self) -> Option<&EvolveSpec> {
+        None
+    }
+    /// The problem's own variation, for genomes whose shape changes (a
+    /// `[morphology]` scene's bodies).
+    fn variation(&self) -> Option<&dyn Variation> {
+        None
+    }
+    /// The size of the body a genome encodes, for a problem whose bodies
+    /// evolve.
+    fn stats(&self, _genome: &[f64]) -> Option<BodyStats> {
+        None
+    }
+    /// The whole scene with `genome` written in, preceded by `comment` as
+    /// `#` lines: what `best.toml` holds.
+    fn scene_toml(&self, _genome: &[f64], _comment: &str) -> Result<String, String> {
+        Err("this problem is not a scene: it has no scene file to write".into())
+    }
 }
 
 /// A scene's `[evolve]` controller (see `animats_scene::evaluate`).
@@ -49,5 +71,64 @@ impl Problem for SceneEvolution {
     }
     fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
         self.0.evaluate(genome)
+    }
+    fn spec(&self) -> Option<&EvolveSpec> {
+        Some(self.0.spec())
+    }
+    fn scene_toml(&self, genome: &[f64], comment: &str) -> Result<String, String> {
+        self.0.best_toml(genome, comment)
+    }
+}
+
+/// A `[morphology]` scene: bodies and their brains evolve together (see
+/// `animats_scene::morphology`). Genomes change length as bodies grow and
+/// shrink; the body GA varies them with the scene's own operators.
+#[derive(Clone, Debug)]
+pub struct BodyEvolution(pub MorphologyProblem);
+
+impl Problem for BodyEvolution {
+    /// The starting body's genes' length (0 for random starts): bodies
+    /// have no fixed length.
+    fn dim(&self) -> usize {
+        self.0.start().map_or(0, <[f64]>::len)
+    }
+    fn start(&self) -> Vec<f64> {
+        self.0.start().map(<[f64]>::to_vec).unwrap_or_default()
+    }
+    fn bounds(&self) -> Option<Bounds> {
+        None
+    }
+    fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
+        self.0.evaluate(genome)
+    }
+    fn spec(&self) -> Option<&EvolveSpec> {
+        Some(self.0.spec())
+    }
+    fn variation(&self) -> Option<&dyn Variation> {
+        Some(self)
+    }
+    fn stats(&self, genome: &[f64]) -> Option<BodyStats> {
+        self.0.stats(genome)
+    }
+    fn scene_toml(&self, genome: &[f64], comment: &str) -> Result<String, String> {
+        self.0.develop(genome, comment)
+    }
+}
+
+impl Variation for BodyEvolution {
+    fn start(&self) -> Option<Vec<f64>> {
+        self.0.start().map(<[f64]>::to_vec)
+    }
+    fn random(&self, rng: &mut Random) -> Vec<f64> {
+        self.0.random(rng)
+    }
+    fn mutate(&self, parent: &[f64], rng: &mut Random) -> Vec<f64> {
+        self.0.mutate(parent, rng)
+    }
+    fn crossover(&self, a: &[f64], b: &[f64], rng: &mut Random) -> Vec<f64> {
+        self.0.crossover(a, b, rng)
+    }
+    fn check(&self, genome: &[f64]) -> Result<(), &'static str> {
+        self.0.check(genome).map_err(|r| r.name())
     }
 }

@@ -11,9 +11,10 @@
 //! same bits whatever the number of threads.
 
 use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
-use crate::problem::{Outcome, Problem, SceneEvolution};
+use crate::problem::{BodyEvolution, Outcome, Problem, SceneEvolution};
 use animats_scene::def::LogName;
 use animats_scene::evaluate::{SceneProblem, MAX_LANES};
+use animats_scene::morphology::MorphologyProblem;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -39,14 +40,31 @@ impl ProblemSpec {
         }
     }
 
-    /// Parses and checks the scene.
+    /// Parses and checks a scene whose controller evolves (a
+    /// `[morphology]` scene is refused: see [`ProblemSpec::build`]).
     pub fn parse(&self) -> Result<SceneProblem, String> {
         SceneProblem::parse(&self.text, &self.file).map_err(|e| e.to_string())
     }
 
-    /// Builds the problem.
+    /// True if the scene has a `[morphology]` table: its bodies evolve.
+    pub fn has_morphology(&self) -> Result<bool, String> {
+        let src = animats_scene::source::Source {
+            file: &self.file,
+            text: &self.text,
+        };
+        let def = animats_scene::parse_def(&src).map_err(|e| e.to_string())?;
+        Ok(def.morphology.is_some())
+    }
+
+    /// Builds the problem: a `[morphology]` scene's bodies, else its
+    /// `[evolve]` controller.
     pub fn build(&self) -> Result<Box<dyn Problem>, String> {
-        Ok(Box::new(SceneEvolution(self.parse()?)))
+        if self.has_morphology()? {
+            let m = MorphologyProblem::parse(&self.text, &self.file).map_err(|e| e.to_string())?;
+            Ok(Box::new(BodyEvolution(m)))
+        } else {
+            Ok(Box::new(SceneEvolution(self.parse()?)))
+        }
     }
 }
 
@@ -110,9 +128,33 @@ impl Config {
     /// A run of `problem` as `choices` say, the rest defaulted; refused
     /// (naming the field) if the scene or a choice is not valid.
     pub fn new(problem: ProblemSpec, choices: &Choices) -> Result<Config, String> {
-        let scene = problem.parse()?;
-        let spec = scene.spec();
-        let optimiser = choices.optimiser.unwrap_or(OptimiserKind::HillClimber);
+        let built = problem.build()?;
+        let spec = built
+            .spec()
+            .ok_or("the problem is not a scene with an [evolve] table")?;
+        let bodies = built.variation().is_some();
+        let optimiser = choices.optimiser.unwrap_or(if bodies {
+            OptimiserKind::BodyGa
+        } else {
+            OptimiserKind::HillClimber
+        });
+        if bodies != (optimiser == OptimiserKind::BodyGa) {
+            return Err(if bodies {
+                format!(
+                    "optimiser: a [morphology] scene's bodies evolve with body-ga, not {} (its genomes change shape as bodies grow)",
+                    optimiser.name()
+                )
+            } else {
+                "optimiser: body-ga evolves bodies: give it a scene with a [morphology] table"
+                    .into()
+            });
+        }
+        if bodies && spec.log == LogName::Improvements {
+            return Err(
+                "[evolve] log: a [morphology] scene logs generations (its genomes have no fixed columns)"
+                    .into(),
+            );
+        }
         if choices.restarts.is_some() && optimiser != OptimiserKind::CmaEs {
             return Err(format!(
                 "restarts: are for the cma-es optimiser, not {}",
@@ -184,6 +226,19 @@ impl Config {
     }
 }
 
+/// The size of a generation's best body (a `[morphology]` run's log).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BodyRow {
+    /// Particles.
+    pub particles: usize,
+    /// Springs, muscles included.
+    pub springs: usize,
+    /// Muscles.
+    pub muscles: usize,
+    /// kg.
+    pub mass: f64,
+}
+
 /// One lane's generation: a row of the full log.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct LogRow {
@@ -205,6 +260,12 @@ pub struct LogRow {
     pub ended: String,
     /// The new best genome, when this generation improved on the lane's best.
     pub improved: Option<Vec<f64>>,
+    /// A `[morphology]` run: the generation's best body's size.
+    #[serde(default)]
+    pub body: Option<BodyRow>,
+    /// A `[morphology]` run: variations the lane has refused so far.
+    #[serde(default)]
+    pub refused: Option<u64>,
 }
 
 /// The best a lane has found.
@@ -331,6 +392,22 @@ impl State {
         Ok(())
     }
 
+    /// A body GA run's refused variations, all lanes together, by reason,
+    /// and the children that kept their parent after every retry; `None`
+    /// for a run of any other optimiser.
+    pub fn refusals(&self) -> Option<(std::collections::BTreeMap<String, u64>, u64)> {
+        let mut by = std::collections::BTreeMap::new();
+        let mut kept = 0;
+        for l in &self.lanes {
+            let (r, k) = l.optimiser.refusals()?;
+            for (reason, n) in r {
+                *by.entry(reason.clone()).or_insert(0) += n;
+            }
+            kept += k;
+        }
+        Some((by, kept))
+    }
+
     /// Generations completed by every lane.
     pub fn generation(&self) -> u64 {
         self.lanes.iter().map(|l| l.generation).min().unwrap_or(0)
@@ -389,15 +466,27 @@ impl State {
     /// to be evaluated elsewhere (another process, a cluster) and handed
     /// back to [`State::tell`]. A run advanced by `ask`/`tell` writes the
     /// same log, bit for bit, as one advanced by [`State::advance`].
-    pub fn ask(&mut self) -> Generation {
+    pub fn ask(&mut self) -> Result<Generation, String> {
         let target = self.config.generations;
+        let problem = self.bodies()?;
+        let variation = problem.as_ref().and_then(|p| p.variation());
         let lanes = self
             .lanes
             .iter_mut()
             .filter(|l| l.generation < target)
-            .map(|l| (l.lane, l.optimiser.ask()))
-            .collect();
-        Generation { lanes }
+            .map(|l| Ok((l.lane, l.optimiser.ask_with(variation)?)))
+            .collect::<Result<_, String>>()?;
+        Ok(Generation { lanes })
+    }
+
+    /// The problem, built, when its bodies evolve (asking and telling need
+    /// its variation and its bodies' sizes); `None` otherwise.
+    fn bodies(&self) -> Result<Option<Box<dyn Problem>>, String> {
+        if self.config.optimiser == OptimiserKind::BodyGa {
+            self.config.problem.build().map(Some)
+        } else {
+            Ok(None)
+        }
     }
 
     /// Takes the outcomes of `generation`'s genomes, in the order of
@@ -410,6 +499,7 @@ impl State {
                 outcomes.len()
             ));
         }
+        let problem = self.bodies()?;
         let mut rows = Vec::with_capacity(generation.lanes.len());
         let mut at = 0;
         for (lane, population) in generation.lanes {
@@ -418,7 +508,12 @@ impl State {
                 .lanes
                 .get_mut(lane)
                 .ok_or_else(|| format!("lane {lane} does not exist"))?;
-            rows.push(record(l, population, &outcomes[at..at + n])?);
+            rows.push(record(
+                l,
+                problem.as_deref(),
+                population,
+                &outcomes[at..at + n],
+            )?);
             at += n;
         }
         self.extend_log(rows);
@@ -454,9 +549,14 @@ impl State {
         let Some(best) = &l.best else {
             return Ok(None);
         };
-        let problem = self.config.problem.parse()?;
+        let problem = self.config.problem.build()?;
+        let what = if self.config.optimiser == OptimiserKind::BodyGa {
+            "body and brain"
+        } else {
+            "controller"
+        };
         let comment = format!(
-            "{} with the best controller of lane {lane} of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate FILE`; watch it with `animats view FILE`.",
+            "{} with the best {what} of lane {lane} of `animats evolve` ({}, seed {}, {} lanes, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}.\nReproduce it with `animats evaluate FILE`; watch it with `animats view FILE`.",
             self.config.problem.file,
             self.config.optimiser.name(),
             self.config.seed,
@@ -467,7 +567,7 @@ impl State {
             best.time,
             best.ended
         );
-        problem.best_toml(&best.genome, &comment).map(Some)
+        problem.scene_toml(&best.genome, &comment).map(Some)
     }
 
     /// `log.csv`: one row per lane per generation, or, for a log of
@@ -498,7 +598,12 @@ impl State {
                 out.push('\n');
             }
         } else {
-            out.push_str("lane,generation,evaluations,fitness,best_fitness,time,distance,ended\n");
+            let bodies = self.config.optimiser == OptimiserKind::BodyGa;
+            out.push_str("lane,generation,evaluations,fitness,best_fitness,time,distance,ended");
+            if bodies {
+                out.push_str(",particles,springs,muscles,mass,refused");
+            }
+            out.push('\n');
             for r in &self.log {
                 out.push_str(&format!("{},{},{}", r.lane, r.generation, r.evaluations));
                 for x in [r.fitness, r.best_fitness, r.time, r.distance] {
@@ -507,6 +612,16 @@ impl State {
                 }
                 out.push(',');
                 out.push_str(&r.ended);
+                if bodies {
+                    match &r.body {
+                        Some(s) => {
+                            out.push_str(&format!(",{},{},{},", s.particles, s.springs, s.muscles));
+                            out.push_str(b.format(s.mass));
+                        }
+                        None => out.push_str(",,,,"),
+                    }
+                    out.push_str(&format!(",{}", r.refused.unwrap_or(0)));
+                }
                 out.push('\n');
             }
         }
@@ -645,12 +760,12 @@ fn lanes_len(todo: &[u64]) -> usize {
 fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {
-        let population = lane.optimiser.ask();
+        let population = lane.optimiser.ask_with(problem.variation())?;
         let outcomes: Vec<Outcome> = population
             .par_iter()
             .map(|g| problem.evaluate(g))
             .collect::<Result<_, _>>()?;
-        rows.push(record(lane, population, &outcomes)?);
+        rows.push(record(lane, Some(problem), population, &outcomes)?);
     }
     Ok(rows)
 }
@@ -659,9 +774,18 @@ fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<Lo
 /// one generation's log row.
 fn record(
     lane: &mut Lane,
+    problem: Option<&dyn Problem>,
     population: Vec<Vec<f64>>,
     outcomes: &[Outcome],
 ) -> Result<LogRow, String> {
+    if population.is_empty() || population.len() != outcomes.len() {
+        return Err(format!(
+            "lane {}: {} outcomes for a generation of {} genomes",
+            lane.lane,
+            outcomes.len(),
+            population.len()
+        ));
+    }
     let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
     lane.optimiser.tell(&fitness)?;
     lane.generation += 1;
@@ -686,6 +810,14 @@ fn record(
             ended: ended.clone(),
         });
     }
+    let body = problem
+        .and_then(|p| p.stats(&population[top]))
+        .map(|s| BodyRow {
+            particles: s.particles,
+            springs: s.springs,
+            muscles: s.muscles,
+            mass: s.mass,
+        });
     Ok(LogRow {
         lane: lane.lane,
         generation: lane.generation,
@@ -696,6 +828,8 @@ fn record(
         distance: o.distance,
         ended,
         improved: improved.then(|| population[top].clone()),
+        body,
+        refused: lane.optimiser.refused(),
     })
 }
 

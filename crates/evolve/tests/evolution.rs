@@ -231,7 +231,7 @@ fn external(config: Config, reverse: bool) -> State {
     let mut s = State::new(config).unwrap();
     let problem = s.config.problem.build().unwrap();
     while !s.done() {
-        let g = s.ask();
+        let g = s.ask().unwrap();
         let genomes: Vec<&[f64]> = g.genomes().collect();
         // Evaluated back to front, as workers finishing in any order would.
         let mut outcomes = vec![None; genomes.len()];
@@ -276,7 +276,7 @@ fn a_run_evaluated_elsewhere_equals_one_advanced_here() {
     assert_eq!(a.best_toml().unwrap(), b.best_toml().unwrap());
     // Outcomes of the wrong count are refused.
     let mut s = State::new(a.config.clone()).unwrap();
-    let g = s.ask();
+    let g = s.ask().unwrap();
     assert!(s.tell(g, &[]).is_err());
 }
 

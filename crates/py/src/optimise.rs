@@ -228,7 +228,7 @@ impl Evolution {
                 "tell the outcomes of the last generation first",
             ));
         }
-        let g = self.state.ask();
+        let g = self.state.ask().map_err(runtime_error)?;
         let d = self.problem.dim();
         let rows: Vec<Vec<f64>> = g.genomes().map(|x| x.to_vec()).collect();
         let lanes = g

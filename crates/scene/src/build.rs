@@ -215,6 +215,12 @@ fn world_table(def: &SceneDef, src: &Source) -> Result<(World, WorldTable), Scen
 
 /// Builds the world a scene describes.
 pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
+    if let Some(m) = &def.morphology {
+        return Err(at(src, "morphology", m).err(
+            "",
+            "a [morphology] scene describes bodies, not one: develop one first (`animats evolve`, or `animats_scene::parse`, which develops its starting body)",
+        ));
+    }
     let (world, table) = world_table(def, src)?;
     let mut cx = Builder {
         src,

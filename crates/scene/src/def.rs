@@ -294,8 +294,9 @@ fn default_level() -> f64 {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EvolveEntry {
-    /// The controller whose parameters form the genome.
-    pub controller: String,
+    /// The controller whose parameters form the genome (a `[morphology]`
+    /// scene's is its body's own, `body`: left out).
+    pub controller: Option<String>,
     /// Seconds per evaluation; default 20.
     #[serde(default = "default_eval_duration")]
     pub duration: f64,
@@ -331,6 +332,9 @@ pub struct EvolveEntry {
     pub log: LogName,
     /// Lanes `animats evolve` runs unless told; default 1.
     pub lanes: Option<usize>,
+    /// Score each evaluation at the scene's step and at half of it and
+    /// keep the worse; default false (true in a `[morphology]` scene).
+    pub robust: Option<bool>,
 }
 
 /// `fail_on_stretch = [{ a = "...", b = "...", length = 1.0 }]`.

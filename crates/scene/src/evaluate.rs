@@ -63,6 +63,9 @@ pub struct EvolveSpec {
     pub log: LogName,
     /// Lanes to run unless told.
     pub lanes: Option<usize>,
+    /// Each evaluation runs at the scene's step and at half of it; the
+    /// worse counts.
+    pub robust: bool,
 }
 
 /// An `[evolve]` table's end rules, resolved.
@@ -95,12 +98,15 @@ impl EvolveSpec {
         world: &World,
         dt: f64,
     ) -> Result<EvolveSpec, SceneError> {
-        let index = nervous.controller(&e.controller).ok_or_else(|| {
+        let controller = e.controller.as_deref().ok_or_else(|| {
             at.err(
                 "controller",
-                format!("no controller named `{}`", e.controller),
+                "name the controller whose parameters evolve (docs/SCENES.md)",
             )
         })?;
+        let index = nervous
+            .controller(controller)
+            .ok_or_else(|| at.err("controller", format!("no controller named `{controller}`")))?;
         let duration = Self::duration(at, e, dt)?;
         let particles = match &e.particles {
             None => world.particle_ids().collect(),
@@ -127,7 +133,7 @@ impl EvolveSpec {
         if nervous.controllers[index].brain.genome().is_empty() {
             return Err(at.err(
                 "controller",
-                format!("controller `{}` has no parameters to evolve", e.controller),
+                format!("controller `{controller}` has no parameters to evolve"),
             ));
         }
         let lanes = match e.lanes {
@@ -140,7 +146,7 @@ impl EvolveSpec {
             other => other,
         };
         Ok(EvolveSpec {
-            controller: e.controller.clone(),
+            controller: controller.to_string(),
             index,
             duration,
             particles,
@@ -154,6 +160,7 @@ impl EvolveSpec {
             mutation: e.mutation,
             log: e.log,
             lanes,
+            robust: e.robust.unwrap_or(false),
         })
     }
 
@@ -363,9 +370,28 @@ pub fn evaluate_with(
     })
 }
 
-/// Runs `scene`'s `[evolve]` evaluation.
+/// Runs `scene`'s `[evolve]` evaluation once, at the scene's step (see
+/// [`SceneProblem::evaluate`] for a robust scene's two).
 pub fn evaluate(scene: Scene) -> Result<Evaluation, String> {
     evaluate_with(scene, |_| {})
+}
+
+/// `[evolve] robust = true`: the evaluation of `make()` at its step and of
+/// another `make()` at half of it; the worse fitness counts (the first of
+/// equals; NaN is worst). A body tuned to the step's errors, which loses
+/// its gait when the step is refined, scores as it would at the finer
+/// step.
+pub fn evaluate_robust(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
+    let first = evaluate(make()?)?;
+    let mut fine = make()?;
+    fine.dt *= 0.5;
+    let second = evaluate(fine)?;
+    let sane = |f: f64| if f.is_nan() { f64::NEG_INFINITY } else { f };
+    Ok(if sane(second.fitness) < sane(first.fitness) {
+        second
+    } else {
+        first
+    })
 }
 
 /// A scene whose `[evolve]` controller is evolved: genome → evaluation.
@@ -453,9 +479,14 @@ impl SceneProblem {
         Ok(scene)
     }
 
-    /// Evaluates `genome`.
+    /// Evaluates `genome`: once, or for a robust scene ([`EvolveSpec::robust`])
+    /// at the scene's step and half of it, the worse counting.
     pub fn evaluate(&self, genome: &[f64]) -> Result<Evaluation, String> {
-        evaluate(self.scene(genome)?)
+        if self.spec.robust {
+            evaluate_robust(|| self.scene(genome))
+        } else {
+            evaluate(self.scene(genome)?)
+        }
     }
 
     /// The scene's text with `genome` written into the `[evolve]`

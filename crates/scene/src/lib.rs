@@ -29,6 +29,7 @@ pub mod entries;
 pub mod env;
 pub mod error;
 pub mod evaluate;
+pub mod morphology;
 pub(crate) mod nervous;
 pub mod params;
 pub mod source;
@@ -251,10 +252,25 @@ pub fn read(path: &Path) -> Result<String, SceneError> {
         .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))
 }
 
-/// Parses and builds a scene from its text; `file` names it in errors.
+/// Parses and builds a scene from its text; `file` names it in errors. A
+/// `[morphology]` scene is built with its starting body (the `start`
+/// scene's, or the first random body of seed 1) developed into it.
 pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
     let src = Source { file, text };
     let def = parse_def(&src)?;
+    if def.morphology.is_some() {
+        let problem = morphology::MorphologyProblem::parse(text, file)?;
+        let genes = match problem.start() {
+            Some(g) => g.to_vec(),
+            None => problem.random(&mut animats_creatures::random::Random::for_evaluation(
+                1, 0, 0,
+            )),
+        };
+        let developed = problem
+            .develop(&genes, "")
+            .map_err(|m| SceneError::file(file, m))?;
+        return parse(&developed, file);
+    }
     build::build(&def, &src)
 }
 

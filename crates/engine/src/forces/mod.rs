@@ -9,5 +9,6 @@ pub mod fluid;
 pub mod gravity;
 pub mod linear_drag;
 pub mod nbody;
+pub mod soft_contact;
 pub mod spring;
 pub mod torque_joint;

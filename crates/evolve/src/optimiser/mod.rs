@@ -9,10 +9,12 @@
 //! One file per strategy in this folder; adding one: its file, and its
 //! place in [`OptimiserKind`] and [`AnyOptimiser`] below.
 
+pub mod body_ga;
 pub mod cma_es;
 pub mod ga;
 pub mod hill_climber;
 
+use body_ga::{BodyGa, Variation};
 use cma_es::CmaEs;
 use ga::Ga;
 use hill_climber::HillClimber;
@@ -79,14 +81,18 @@ pub enum OptimiserKind {
     Ga,
     /// Hansen's CMA-ES, (μ/μ_w, λ).
     CmaEs,
+    /// A (μ + λ) GA over bodies, with the problem's own variation and
+    /// checks: what a `[morphology]` scene evolves with.
+    BodyGa,
 }
 
 impl OptimiserKind {
     /// All kinds, in the order they are documented.
-    pub const ALL: [OptimiserKind; 3] = [
+    pub const ALL: [OptimiserKind; 4] = [
         OptimiserKind::HillClimber,
         OptimiserKind::Ga,
         OptimiserKind::CmaEs,
+        OptimiserKind::BodyGa,
     ];
 
     /// The command-line name.
@@ -95,6 +101,7 @@ impl OptimiserKind {
             OptimiserKind::HillClimber => "hill-climber",
             OptimiserKind::Ga => "ga",
             OptimiserKind::CmaEs => "cma-es",
+            OptimiserKind::BodyGa => "body-ga",
         }
     }
 
@@ -115,6 +122,7 @@ impl OptimiserKind {
             OptimiserKind::HillClimber => 1,
             OptimiserKind::Ga => 32,
             OptimiserKind::CmaEs => cma_default_lambda(dim),
+            OptimiserKind::BodyGa => body_ga::POPULATION,
         }
     }
 }
@@ -193,17 +201,57 @@ pub enum AnyOptimiser {
     Ga(Ga),
     /// See [`CmaEs`] (boxed: its state is the largest by far).
     CmaEs(Box<CmaEs>),
+    /// See [`BodyGa`].
+    BodyGa(Box<BodyGa>),
 }
 
 impl AnyOptimiser {
-    /// A fresh optimiser.
+    /// A fresh optimiser. A body GA starts from its problem's bodies, not
+    /// from `setup.start`.
     pub fn new(setup: &Setup) -> Result<AnyOptimiser, String> {
-        setup.validate()?;
+        if setup.kind != OptimiserKind::BodyGa {
+            setup.validate()?;
+        }
         Ok(match setup.kind {
             OptimiserKind::HillClimber => AnyOptimiser::HillClimber(HillClimber::from_setup(setup)),
             OptimiserKind::Ga => AnyOptimiser::Ga(Ga::new(setup)),
             OptimiserKind::CmaEs => AnyOptimiser::CmaEs(Box::new(CmaEs::new(setup))),
+            OptimiserKind::BodyGa => AnyOptimiser::BodyGa(Box::new(BodyGa::new(
+                setup.seed,
+                setup.lane,
+                setup.population,
+            ))),
         })
+    }
+
+    /// The next generation: a body GA's made by `variation` (refused
+    /// without one), any other's by its own [`Optimiser::ask`].
+    pub fn ask_with(&mut self, variation: Option<&dyn Variation>) -> Result<Vec<Vec<f64>>, String> {
+        match self {
+            AnyOptimiser::BodyGa(o) => {
+                let v = variation
+                    .ok_or("body-ga varies bodies: it evolves a scene with a [morphology] table")?;
+                Ok(o.ask(v))
+            }
+            other => Ok(other.ask()),
+        }
+    }
+
+    /// A body GA's refused variations so far by reason, and the children
+    /// that kept their parent; `None` for any other optimiser.
+    pub fn refusals(&self) -> Option<(&std::collections::BTreeMap<String, u64>, u64)> {
+        match self {
+            AnyOptimiser::BodyGa(o) => Some((o.refused(), o.kept())),
+            _ => None,
+        }
+    }
+
+    /// A body GA's refused variations so far (all reasons), else `None`.
+    pub fn refused(&self) -> Option<u64> {
+        match self {
+            AnyOptimiser::BodyGa(o) => Some(o.refused_total()),
+            _ => None,
+        }
     }
 
     /// Which kind this is.
@@ -212,38 +260,53 @@ impl AnyOptimiser {
             AnyOptimiser::HillClimber(_) => OptimiserKind::HillClimber,
             AnyOptimiser::Ga(_) => OptimiserKind::Ga,
             AnyOptimiser::CmaEs(_) => OptimiserKind::CmaEs,
+            AnyOptimiser::BodyGa(_) => OptimiserKind::BodyGa,
         }
     }
 
-    fn inner(&self) -> &dyn Optimiser {
+    /// The real-vector optimiser inside, if it is one.
+    fn inner(&self) -> Option<&dyn Optimiser> {
         match self {
-            AnyOptimiser::HillClimber(o) => o,
-            AnyOptimiser::Ga(o) => o,
-            AnyOptimiser::CmaEs(o) => o.as_ref(),
+            AnyOptimiser::HillClimber(o) => Some(o),
+            AnyOptimiser::Ga(o) => Some(o),
+            AnyOptimiser::CmaEs(o) => Some(o.as_ref()),
+            AnyOptimiser::BodyGa(_) => None,
         }
     }
 
-    fn inner_mut(&mut self) -> &mut dyn Optimiser {
+    fn inner_mut(&mut self) -> Option<&mut dyn Optimiser> {
         match self {
-            AnyOptimiser::HillClimber(o) => o,
-            AnyOptimiser::Ga(o) => o,
-            AnyOptimiser::CmaEs(o) => o.as_mut(),
+            AnyOptimiser::HillClimber(o) => Some(o),
+            AnyOptimiser::Ga(o) => Some(o),
+            AnyOptimiser::CmaEs(o) => Some(o.as_mut()),
+            AnyOptimiser::BodyGa(_) => None,
         }
     }
 }
 
 impl Optimiser for AnyOptimiser {
+    /// A body GA asked without its problem's variation ([`AnyOptimiser::ask_with`])
+    /// has nothing to offer: an empty generation, which a `tell` refuses.
     fn ask(&mut self) -> Vec<Vec<f64>> {
-        self.inner_mut().ask()
+        self.inner_mut().map_or_else(Vec::new, |o| o.ask())
     }
     fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
-        self.inner_mut().tell(fitness)
+        match self {
+            AnyOptimiser::BodyGa(o) => o.tell(fitness),
+            other => other.inner_mut().map_or(Ok(()), |o| o.tell(fitness)),
+        }
     }
     fn best(&self) -> Option<(&[f64], f64)> {
-        self.inner().best()
+        match self {
+            AnyOptimiser::BodyGa(o) => o.best(),
+            other => other.inner().and_then(|o| o.best()),
+        }
     }
     fn generation(&self) -> u64 {
-        self.inner().generation()
+        match self {
+            AnyOptimiser::BodyGa(o) => o.generation(),
+            other => other.inner().map_or(0, |o| o.generation()),
+        }
     }
 }
 

@@ -11,6 +11,17 @@ use super::*;
 pub struct ContactsEntry {
     /// The spheres that collide; default all.
     pub particles: Option<Vec<String>>,
+    /// `impulse` (the event: overlaps removed, impulses with restitution
+    /// and friction; for rigid rocks and balls) or `penalty` (a force
+    /// `k δ − c u` along the line of centres, with no friction: for soft
+    /// bodies, whose springs would otherwise store the event's
+    /// displacements; what `[morphology]` bodies use); default `impulse`.
+    #[serde(default)]
+    pub model: ContactModel,
+    /// `penalty`: N/m; default 5000.
+    pub stiffness: Option<f64>,
+    /// `penalty`: N s/m; default 2.
+    pub damping: Option<f64>,
     /// The restitution of every contact, in [0, 1]; default the product of
     /// the two spheres' restitutions.
     pub restitution: Option<f64>,
@@ -34,9 +45,41 @@ fn default_sleep_time() -> f64 {
     0.5
 }
 
+/// `[contacts] model`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactModel {
+    /// The sphere-contact event.
+    #[default]
+    Impulse,
+    /// A penalty force.
+    Penalty,
+}
+
 impl Build for ContactsEntry {
     fn build(&self, _k: usize, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
         let targets = cx.names.targets(at, &self.particles)?;
+        if self.model == ContactModel::Penalty {
+            let spheres: Vec<ParticleId> = match targets {
+                Targets::All => cx.world.particle_ids().collect(),
+                Targets::Only(ids) => ids,
+            };
+            let force = animats_engine::SoftContact::new(
+                self.stiffness.unwrap_or(5000.0),
+                self.damping.unwrap_or(2.0),
+                &spheres,
+                &cx.world.joined_pairs(),
+            )
+            .map_err(|e| at.model(e))?;
+            cx.world.add_force(Box::new(force));
+            return Ok(());
+        }
+        if self.stiffness.is_some() || self.damping.is_some() {
+            return Err(at.err(
+                if self.stiffness.is_some() { "stiffness" } else { "damping" },
+                "is for model = \"penalty\"",
+            ));
+        }
         cx.world
             .add_sphere_contact(animats_engine::SphereContactDef {
                 envelope: self.envelope,

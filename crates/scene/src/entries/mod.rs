@@ -39,6 +39,10 @@ macro_rules! entries {
             /// scored.
             #[serde(default)]
             pub evolve: Option<Spanned<EvolveEntry>>,
+            /// `[morphology]`: the bodies evolution searches
+            /// ([`crate::morphology`]).
+            #[serde(default)]
+            pub morphology: Option<Spanned<crate::morphology::MorphologyEntry>>,
         }
 
         /// Builds every entry of the scene, in the order declared.

@@ -1,0 +1,154 @@
+//! `animats evolve` on a `[morphology]` scene (issue 39), through the real
+//! binary: the log's body columns and the refusals' summary; `evaluate`
+//! on `best.toml` reproduces the logged fitness bit for bit; 1 and 2
+//! threads and a run killed and resumed write the same log and best; bad
+//! `[morphology]` keys exit 2 naming the field, and write nothing.
+
+mod common;
+use common::*;
+
+const SMALL: &str = r#"
+[world]
+dt = 0.001
+integrator = "symplectic"
+[floor]
+[morphology]
+max_particles = 10
+max_springs = 30
+[evolve]
+duration = 1.0
+distance_weight = 1.0
+time_weight = 0.0
+"#;
+
+fn evolve(scene: &str, dir: &std::path::Path, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["evolve", scene, "--population", "6", "--seed", "3"];
+    args.extend(extra);
+    args.extend(["--out", dir.to_str().unwrap()]);
+    animats(&args)
+}
+
+#[test]
+fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
+    let dir = scratch("bodies-small");
+    let scene = write(&dir, "small.toml", SMALL);
+    let out = dir.join("run");
+    let o = evolve(&scene, &out, &["--generations", "4"]);
+    let (stdout, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(stdout.contains("refused: "), "{stdout}");
+    let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let header = "lane,generation,evaluations,fitness,best_fitness,time,distance,ended,particles,springs,muscles,mass,refused";
+    assert_eq!(log.lines().next(), Some(header));
+    assert_eq!(log.lines().count(), 5);
+    let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
+    let logged: f64 = last[4].parse().unwrap();
+    let particles: usize = last[8].parse().unwrap();
+    assert!((2..=10).contains(&particles));
+    let best = out.join("best.toml");
+    let e = animats(&["evaluate", best.to_str().unwrap(), "--json"]);
+    let (json, err) = text(&e);
+    assert!(e.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(
+        v["fitness"].as_f64().unwrap().to_bits(),
+        logged.to_bits(),
+        "{json} against {logged}"
+    );
+    // The scene itself simulates with its first random body.
+    let s = animats(&["simulate", &scene, "--duration", "0.1"]);
+    assert!(s.status.success(), "{}", text(&s).1);
+}
+
+#[test]
+fn a_body_run_is_the_same_on_any_thread_count_and_after_a_kill() {
+    let dir = scratch("bodies-threads");
+    let scene = write(&dir, "small.toml", SMALL);
+    let read = |d: &std::path::Path, f: &str| std::fs::read(d.join(f)).unwrap();
+    let one = dir.join("one");
+    let o = evolve(&scene, &one, &["--generations", "6", "--threads", "1"]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let two = dir.join("two");
+    let o = evolve(&scene, &two, &["--generations", "6", "--threads", "2"]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert_eq!(read(&one, "log.csv"), read(&two, "log.csv"));
+    assert_eq!(read(&one, "best.toml"), read(&two, "best.toml"));
+    // Killed (SIGKILL: no clean stop) once a checkpoint exists, then
+    // resumed: the same log and best as the run that was never stopped.
+    let killed = dir.join("killed");
+    let mut child = command()
+        .args([
+            "evolve",
+            &scene,
+            "--population",
+            "6",
+            "--seed",
+            "3",
+            "--generations",
+            "6",
+            "--checkpoint-every",
+            "0",
+            "--out",
+            killed.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let began = std::time::Instant::now();
+    while !killed.join("checkpoint.json").exists() && began.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let o = animats(&["evolve", "--resume", killed.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert_eq!(read(&killed, "log.csv"), read(&one, "log.csv"));
+    assert_eq!(read(&killed, "best.toml"), read(&one, "best.toml"));
+}
+
+#[test]
+fn bad_morphology_exits_2_naming_the_field_and_writes_nothing() {
+    let dir = scratch("bodies-bad");
+    for (bad, field) in [
+        ("max_particles = 10", "max_particles = 1\n"),
+        ("max_particles = 10", "total_mass = -1.0\n"),
+        (
+            "max_particles = 10",
+            "encoding = \"lattice\"\ncells = [200, 100, 1]\n",
+        ),
+    ] {
+        let scene = write(&dir, "bad.toml", &SMALL.replace(bad, field));
+        let out = dir.join("out");
+        let o = evolve(&scene, &out, &["--generations", "2"]);
+        let err = text(&o).1;
+        let key = field.split(" =").next().unwrap();
+        let key = if key == "encoding" { "cells" } else { key };
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("bad.toml:") && err.contains(&format!("morphology.{key}")),
+            "{err}"
+        );
+        assert!(!out.join("log.csv").exists() && !out.join("best.toml").exists());
+    }
+    let o = evolve(
+        &write(&dir, "ok.toml", SMALL),
+        &dir.join("cma"),
+        &["--optimiser", "cma-es"],
+    );
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("body-ga"), "{}", text(&o).1);
+    let o = animats(&[
+        "evolve",
+        &write(&dir, "ok2.toml", SMALL),
+        "--view",
+        "--out",
+        dir.join("v").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).1.contains("animats view DIR/best.toml"),
+        "{}",
+        text(&o).1
+    );
+}

@@ -1,0 +1,338 @@
+//! [`MorphologyProblem`]: a `[morphology]` scene as an evolution problem.
+//! A genome (a `Vec<f64>`, [`super::genome`] or [`super::lattice`]'s
+//! layout) develops into the scene's text with the body written in; that
+//! text is parsed and evaluated exactly as `animats evaluate` would.
+
+use super::check::{self, Refusal};
+use super::develop::{self, Brain, NAME};
+use super::genome::{Body, Edge, Muscle, Node};
+use super::lattice::Lattice;
+use super::{vary, EncodingName, Morphology};
+use crate::build::at;
+use crate::error::SceneError;
+use crate::evaluate::{Evaluation, EvolveSpec, SceneProblem};
+use crate::source::Source;
+use animats_creatures::random::Random;
+use animats_engine::DVec3;
+use toml_edit::DocumentMut;
+
+/// A body's size, for logs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyStats {
+    /// Particles.
+    pub particles: usize,
+    /// Springs, muscles included.
+    pub springs: usize,
+    /// Muscles.
+    pub muscles: usize,
+    /// kg.
+    pub mass: f64,
+}
+
+/// A scene whose bodies evolve: genome → scene text → evaluation.
+#[derive(Clone, Debug)]
+pub struct MorphologyProblem {
+    file: String,
+    base: DocumentMut,
+    morphology: Morphology,
+    start: Option<Vec<f64>>,
+    spec: EvolveSpec,
+}
+
+impl MorphologyProblem {
+    /// Parses and checks a scene with a `[morphology]` table: every key,
+    /// the rest of the scene (built once without a body), the start body
+    /// if one is named, and the `[evolve]` table on a body developed into
+    /// the scene.
+    pub fn parse(text: &str, file: &str) -> Result<MorphologyProblem, SceneError> {
+        let src = Source { file, text };
+        let mut def = crate::parse_def(&src)?;
+        let entry = def
+            .morphology
+            .take()
+            .ok_or_else(|| SceneError::file(file, "the scene has no [morphology] table"))?;
+        let here = at(&src, "morphology", &entry);
+        let morphology = Morphology::from_entry(&here, entry.get_ref())?;
+        if let Some(e) = &def.evolve {
+            if e.get_ref().controller.as_deref().is_some_and(|c| c != NAME) {
+                return Err(at(&src, "evolve", e).err(
+                    "controller",
+                    format!("a [morphology] scene evolves its body's own controller, `{NAME}`: leave the key out"),
+                ));
+            }
+        }
+        // The rest of the scene, checked where the user wrote it.
+        def.evolve = None;
+        crate::build::build(&def, &src)?;
+        let mut base: DocumentMut = text
+            .parse()
+            .map_err(|e| SceneError::file(file, format!("{e}")))?;
+        base.remove("morphology");
+        let start = match (&entry.get_ref().start[..], morphology.encoding) {
+            ("random", EncodingName::Graph) => None,
+            ("random", EncodingName::Lattice) => morphology.lattice.as_ref().and_then(|s| {
+                s.start.as_ref().map(|materials| {
+                    Lattice {
+                        materials: materials.clone(),
+                        muscles: vec![
+                            Muscle {
+                                amplitude: 0.25,
+                                phase: 0.0,
+                                offset: 0.5
+                            };
+                            s.len()
+                        ],
+                        frequency: 1.0,
+                    }
+                    .to_genes(s)
+                })
+            }),
+            (path, EncodingName::Graph) => Some(
+                start_body(file, path)
+                    .map_err(|m| here.err("start", m))?
+                    .to_genes(),
+            ),
+            (_, EncodingName::Lattice) => {
+                return Err(here.err(
+                    "start",
+                    "a lattice starts from `random` (give `structure` for a starting body)",
+                ))
+            }
+        };
+        let mut problem = MorphologyProblem {
+            file: file.to_string(),
+            base,
+            morphology,
+            start,
+            spec: placeholder_spec(),
+        };
+        if let Some(g) = &problem.start {
+            problem.check(g).map_err(|r| {
+                here.err(
+                    "start",
+                    format!("the starting body fails its own checks: {r}"),
+                )
+            })?;
+        }
+        let probe = match &problem.start {
+            Some(g) => g.clone(),
+            None => problem.random(&mut Random::for_entry(0, 0)),
+        };
+        let text = problem
+            .develop(&probe, "")
+            .map_err(|m| SceneError::file(file, m))?;
+        let scene = SceneProblem::parse(&text, file)?;
+        problem.spec = scene.spec().clone();
+        Ok(problem)
+    }
+
+    /// The scene file's name.
+    pub fn file(&self) -> &str {
+        &self.file
+    }
+
+    /// The `[morphology]` table, checked.
+    pub fn morphology(&self) -> &Morphology {
+        &self.morphology
+    }
+
+    /// The `[evolve]` table, as resolved on a developed body (duration,
+    /// weights, lanes, robust: the same for every body).
+    pub fn spec(&self) -> &EvolveSpec {
+        &self.spec
+    }
+
+    /// The starting body's genes, if the scene names one.
+    pub fn start(&self) -> Option<&[f64]> {
+        self.start.as_deref()
+    }
+
+    /// The body a genome encodes.
+    pub fn body(&self, genes: &[f64]) -> Result<Body, String> {
+        match &self.morphology.lattice {
+            None => Body::from_genes(genes),
+            Some(shape) => Ok(Lattice::from_genes(genes, shape)?.develop(shape, &self.morphology)),
+        }
+    }
+
+    /// The scene with the body of `genes` written in, preceded by
+    /// `comment`: what `best.toml` holds.
+    pub fn develop(&self, genes: &[f64], comment: &str) -> Result<String, String> {
+        let body = self.body(genes)?;
+        develop::develop(&self.base, &body, &self.morphology, Brain::Driven, comment)
+    }
+
+    /// Evaluates the body of `genes` (a body the checks would refuse is
+    /// still evaluated: the checks are the optimiser's business).
+    pub fn evaluate(&self, genes: &[f64]) -> Result<Evaluation, String> {
+        let text = self.develop(genes, "")?;
+        let problem = SceneProblem::parse(&text, &self.file).map_err(|e| e.to_string())?;
+        problem.evaluate(problem.start())
+    }
+
+    /// Every check of [`super::check`], the settle last.
+    pub fn check(&self, genes: &[f64]) -> Result<(), Refusal> {
+        let body = self.body(genes).map_err(|_| Refusal::Malformed)?;
+        check::static_checks(&body, &self.morphology)?;
+        let text = develop::develop(&self.base, &body, &self.morphology, Brain::Held, "")
+            .map_err(|_| Refusal::Malformed)?;
+        let mut scene = crate::parse(&text, &self.file).map_err(|_| Refusal::SettleBlowUp)?;
+        let ids = (0..body.nodes.len())
+            .map(|i| scene.particle(&format!("{NAME}.p{i}")))
+            .collect::<Option<Vec<_>>>()
+            .ok_or(Refusal::Malformed)?;
+        let springs: Vec<(usize, usize)> = body.edges.iter().map(|e| (e.a, e.b)).collect();
+        check::settle(&mut scene, &ids, &springs)
+    }
+
+    /// A random body's genes.
+    pub fn random(&self, rng: &mut Random) -> Vec<f64> {
+        match &self.morphology.lattice {
+            None => vary::random_body(&self.morphology, rng).to_genes(),
+            Some(shape) => vary::random_lattice(shape, rng).to_genes(shape),
+        }
+    }
+
+    /// A mutant of `parent` (malformed genes come back unchanged, to be
+    /// refused by the checks).
+    pub fn mutate(&self, parent: &[f64], rng: &mut Random) -> Vec<f64> {
+        match &self.morphology.lattice {
+            None => match Body::from_genes(parent) {
+                Ok(b) => vary::mutate_body(&b, &self.morphology, rng).to_genes(),
+                Err(_) => parent.to_vec(),
+            },
+            Some(shape) => match Lattice::from_genes(parent, shape) {
+                Ok(l) => vary::mutate_lattice(&l, rng).to_genes(shape),
+                Err(_) => parent.to_vec(),
+            },
+        }
+    }
+
+    /// A child of `a` and `b`.
+    pub fn crossover(&self, a: &[f64], b: &[f64], rng: &mut Random) -> Vec<f64> {
+        match &self.morphology.lattice {
+            None => match (Body::from_genes(a), Body::from_genes(b)) {
+                (Ok(x), Ok(y)) => vary::cross_bodies(&x, &y, rng).to_genes(),
+                _ => a.to_vec(),
+            },
+            Some(shape) => match (Lattice::from_genes(a, shape), Lattice::from_genes(b, shape)) {
+                (Ok(x), Ok(y)) => vary::cross_lattices(&x, &y, shape, rng).to_genes(shape),
+                _ => a.to_vec(),
+            },
+        }
+    }
+
+    /// The size of the body `genes` encode.
+    pub fn stats(&self, genes: &[f64]) -> Option<BodyStats> {
+        let b = self.body(genes).ok()?;
+        Some(BodyStats {
+            particles: b.nodes.len(),
+            springs: b.edges.len(),
+            muscles: b.muscles(),
+            mass: b.mass(),
+        })
+    }
+}
+
+/// A stand-in until the probe body's `[evolve]` is resolved.
+fn placeholder_spec() -> EvolveSpec {
+    EvolveSpec {
+        controller: NAME.into(),
+        index: 0,
+        duration: 1.0,
+        particles: Vec::new(),
+        axis: DVec3::X,
+        distance_weight: 0.0,
+        time_weight: 0.0,
+        fail_on_touch: Vec::new(),
+        touch_tolerance: 0.0,
+        fail_on_stretch: Vec::new(),
+        table: ("controller", 0),
+        mutation: Default::default(),
+        log: Default::default(),
+        lanes: None,
+        robust: false,
+    }
+}
+
+/// The body of the scene file at `path` (relative to `file`'s folder, else
+/// to the working directory): its particles, its springs, and as muscles
+/// the springs an actuator drives (their genes from an oscillator that
+/// drives them, else amplitude 0.25, phase 0, offset 0.5); the frequency is
+/// that oscillator's, else 1 Hz.
+fn start_body(file: &str, path: &str) -> Result<Body, String> {
+    let beside = std::path::Path::new(file)
+        .parent()
+        .map(|d| d.join(path))
+        .filter(|p| p.exists());
+    let path = beside.unwrap_or_else(|| std::path::PathBuf::from(path));
+    let text = crate::read(&path).map_err(|e| e.to_string())?;
+    let name = path.display().to_string();
+    let def = crate::parse_def(&Source {
+        file: &name,
+        text: &text,
+    })
+    .map_err(|e| e.to_string())?;
+    let scene = crate::parse(&text, &name).map_err(|e| e.to_string())?;
+    let index = |p: &str| {
+        def.particle
+            .iter()
+            .position(|q| q.get_ref().name == p)
+            .ok_or_else(|| format!("{name}: spring end `{p}` is not a [[particle]] (a start body is made of [[particle]] and [[spring]] entries)"))
+    };
+    let nodes: Vec<Node> = def
+        .particle
+        .iter()
+        .map(|p| {
+            let p = p.get_ref();
+            let id = scene
+                .particle(&p.name)
+                .ok_or(format!("{name}: no particle `{}`", p.name))?;
+            Ok(Node {
+                position: DVec3::from_array(p.position),
+                mass: p.mass,
+                radius: scene.world.particles().radius[id.index()],
+            })
+        })
+        .collect::<Result<_, String>>()?;
+    let oscillator = def.controller.iter().find_map(|c| match c.get_ref().get() {
+        Ok(animats_creatures::brains::ControllerEntry::Oscillator(o)) => Some(o.clone()),
+        _ => None,
+    });
+    let mut edges = Vec::new();
+    for s in &def.spring {
+        let s = s.get_ref();
+        let driven = def.actuator.iter().find_map(|a| {
+            let a = a.get_ref().get().ok()?;
+            (matches!(&a.target, crate::def::Target::Spring(t) if Some(t) == s.name.as_ref()))
+                .then(|| a.name.clone())
+        });
+        let muscle = driven.map(|actuator| {
+            let k = oscillator
+                .as_ref()
+                .and_then(|o| o.outputs.iter().position(|x| *x == actuator));
+            let pick = |v: &Option<Vec<f64>>, default: f64| {
+                k.and_then(|k| v.as_ref().and_then(|v| v.get(k).copied()))
+                    .unwrap_or(default)
+            };
+            let o = oscillator.as_ref();
+            Muscle {
+                amplitude: pick(&o.and_then(|o| o.amplitude.clone()), 0.25),
+                phase: vary::wrap(pick(&o.and_then(|o| o.phase.clone()), 0.0)),
+                offset: pick(&o.and_then(|o| o.offset.clone()), 0.5),
+            }
+        });
+        edges.push(Edge {
+            a: index(&s.a)?,
+            b: index(&s.b)?,
+            stiffness: s.stiffness,
+            muscle,
+        });
+    }
+    let frequency = oscillator.and_then(|o| o.frequency).unwrap_or(1.0);
+    Ok(Body {
+        nodes,
+        edges,
+        frequency,
+    })
+}

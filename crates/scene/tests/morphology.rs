@@ -1,0 +1,392 @@
+//! `[morphology]` (issue 39): how a body develops into scene entries, how
+//! a lattice grows into one, every check on the way, and 100,000 random
+//! variations from the shipped start bodies, each valid or refused with a
+//! reason.
+
+use animats_creatures::random::Random;
+use animats_engine::DVec3;
+use animats_scene::evaluate::SceneProblem;
+use animats_scene::morphology::check::{static_checks, Refusal};
+use animats_scene::morphology::lattice::{Lattice, Material};
+use animats_scene::morphology::{Body, Edge, MorphologyProblem, Muscle, Node};
+
+const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+
+fn walk() -> String {
+    std::fs::read_to_string(format!("{ROOT}/scenes/bodies_walk.toml")).unwrap()
+}
+
+fn with(morphology: &str) -> String {
+    format!(
+        "[world]\ndt = 0.001\n[floor]\n[morphology]\n{morphology}\n[evolve]\nduration = 1.0\ndistance_weight = 1.0\ntime_weight = 0.0\n"
+    )
+}
+
+fn node(x: f64, y: f64, z: f64) -> Node {
+    Node {
+        position: DVec3::new(x, y, z),
+        mass: 0.1,
+        radius: 0.02,
+    }
+}
+
+fn edge(a: usize, b: usize, muscle: bool) -> Edge {
+    Edge {
+        a,
+        b,
+        stiffness: 400.0,
+        muscle: muscle.then_some(Muscle {
+            amplitude: 0.3,
+            phase: 0.5,
+            offset: 0.5,
+        }),
+    }
+}
+
+/// A tetrahedron with one muscle (not symmetric in x, or the muscle could
+/// not move its centre of mass along x at all).
+fn tetra() -> Body {
+    Body {
+        nodes: vec![
+            node(0.0, 0.0, 0.0),
+            node(0.2, 0.0, 0.0),
+            node(0.1, 0.0, 0.17),
+            node(0.15, 0.15, 0.06),
+        ],
+        edges: vec![
+            edge(0, 1, true),
+            edge(0, 2, false),
+            edge(1, 2, false),
+            edge(0, 3, false),
+            edge(1, 3, false),
+            edge(2, 3, false),
+        ],
+        frequency: 2.0,
+    }
+}
+
+#[test]
+fn a_body_develops_into_ordinary_entries_on_the_floor() {
+    let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();
+    let body = tetra();
+    let text = p.develop(&body.to_genes(), "a tetrahedron").unwrap();
+    assert!(text.starts_with("# a tetrahedron\n"));
+    assert!(!text.contains("[morphology]"));
+    let scene = animats_scene::parse(&text, "t.toml").unwrap();
+    assert_eq!(scene.world.len(), 4);
+    // The lowest sphere rests on the floor; the bounding box is centred on
+    // the origin in x and z; the shape is the genome's.
+    let y: Vec<f64> = (0..4).map(|i| scene.world.particles().radius[i]).collect();
+    let at: Vec<DVec3> = scene
+        .world
+        .particle_ids()
+        .map(|p| scene.world.position(p))
+        .collect();
+    let bottom = at
+        .iter()
+        .zip(&y)
+        .map(|(p, r)| p.y - r)
+        .fold(f64::INFINITY, f64::min);
+    assert!(bottom.abs() < 1e-15, "{bottom}");
+    assert!((at[0].x + at[1].x).abs() < 1e-15 && (at[0].z + at[2].z).abs() < 1e-15);
+    assert!(((at[3] - at[0]) - (body.nodes[3].position - body.nodes[0].position)).length() < 1e-15);
+    // The muscle: a spring actuator from 0.7 to 1.3 of its built length.
+    let length = (at[1] - at[0]).length();
+    assert!(text.contains(&format!("min = {}", length * 0.7)), "{text}");
+    assert!(text.contains(&format!("max = {}", length * 1.3)));
+    assert!(text.contains("rate = 4.0"));
+    assert!(text.contains("model = \"penalty\""));
+    // The [evolve] table is the scene's, targeting the body's oscillator,
+    // robust by default.
+    let problem = SceneProblem::parse(&text, "t.toml").unwrap();
+    assert_eq!(problem.spec().controller, "body");
+    assert!(problem.spec().robust);
+    assert_eq!(problem.start(), &[2.0, 0.3, 0.5, 0.5][..]);
+    // What evolution scores is what `evaluate` scores, to the bit.
+    let e = p.evaluate(&body.to_genes()).unwrap();
+    let again = problem.evaluate(problem.start()).unwrap();
+    assert_eq!(e.fitness.to_bits(), again.fitness.to_bits());
+}
+
+#[test]
+fn robust_evaluation_keeps_the_worse_of_the_step_and_half_of_it() {
+    let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();
+    let text = p.develop(&tetra().to_genes(), "").unwrap();
+    let robust = SceneProblem::parse(&text, "t.toml").unwrap();
+    let once = |dt_scale: f64| {
+        let mut s = robust.scene(robust.start()).unwrap();
+        s.dt *= dt_scale;
+        animats_scene::evaluate::evaluate(s).unwrap().fitness
+    };
+    let (coarse, fine) = (once(1.0), once(0.5));
+    assert_ne!(coarse, fine, "the two steps give different numbers");
+    let r = robust.evaluate(robust.start()).unwrap().fitness;
+    assert_eq!(r, coarse.min(fine));
+}
+
+#[test]
+fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
+    let text = with("encoding = \"lattice\"\ncells = [2, 1, 1]\ncell = 0.1\nmax_particles = 12\nmax_springs = 60\nmass = [0.001, 0.3]");
+    let p = MorphologyProblem::parse(&text, "l.toml").unwrap();
+    let shape = p.morphology().lattice.clone().unwrap();
+    let one = Lattice {
+        materials: vec![Material::MuscleX, Material::Empty],
+        muscles: vec![
+            Muscle {
+                amplitude: 0.2,
+                phase: 0.0,
+                offset: 0.5
+            };
+            2
+        ],
+        frequency: 1.0,
+    };
+    let b = one.develop(&shape, p.morphology());
+    // A cube: 8 corners, 12 edges and 12 face diagonals; its 4 x edges are
+    // muscles; the cell weighs the budget over the lattice's 2 cells.
+    assert_eq!((b.nodes.len(), b.edges.len(), b.muscles()), (8, 24, 4));
+    assert!((b.mass() - 0.8 / 2.0).abs() < 1e-12);
+    for e in b.edges.iter().filter(|e| e.muscle.is_some()) {
+        let d = b.nodes[e.b].position - b.nodes[e.a].position;
+        assert!(d.y == 0.0 && d.z == 0.0 && (d.x.abs() - 0.1).abs() < 1e-15);
+    }
+    // Two cells share a face: 12 corners, 24 + 24 − 6 springs.
+    let two = Lattice {
+        materials: vec![Material::Soft, Material::Rigid],
+        ..one.clone()
+    };
+    let b = two.develop(&shape, p.morphology());
+    assert_eq!((b.nodes.len(), b.edges.len(), b.muscles()), (12, 42, 0));
+    assert!(p.check(&two.to_genes(&shape)).unwrap_err() == Refusal::NoMuscle);
+    assert!(
+        p.check(&one.to_genes(&shape)).is_ok(),
+        "{:?}",
+        p.check(&one.to_genes(&shape))
+    );
+}
+
+#[test]
+fn an_evogym_structure_is_a_starting_body() {
+    let text = std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml")).unwrap();
+    let p = MorphologyProblem::parse(&text, "bodies_lattice.toml").unwrap();
+    let start = p.start().expect("the structure is the start");
+    let shape = p.morphology().lattice.clone().unwrap();
+    let l = Lattice::from_genes(start, &shape).unwrap();
+    // EvoGym's rows run top to bottom: the bottom row is y = 0.
+    let [nx, ny, nz] = shape.cells;
+    let painted = l
+        .materials
+        .iter()
+        .filter(|m| **m != Material::Empty)
+        .count();
+    assert!(painted > 0 && painted < nx * ny * nz);
+    assert!(p.check(start).is_ok(), "{:?}", p.check(start));
+    let scene = animats_scene::parse(&text, "bodies_lattice.toml").unwrap();
+    assert_eq!(scene.world.len(), p.body(start).unwrap().nodes.len());
+}
+
+#[test]
+fn every_check_names_its_reason() {
+    let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();
+    let m = p.morphology();
+    let ok = tetra();
+    assert_eq!(static_checks(&ok, m), Ok(()));
+    let mut b = ok.clone();
+    b.edges.push(edge(1, 0, false));
+    assert_eq!(static_checks(&b, m), Err(Refusal::Malformed));
+    let mut b = ok.clone();
+    b.nodes.push(node(0.3, 0.0, 0.0));
+    assert_eq!(static_checks(&b, m), Err(Refusal::Disconnected));
+    let mut b = ok.clone();
+    b.nodes[3].position = DVec3::new(0.01, 0.0, 0.0);
+    assert_eq!(static_checks(&b, m), Err(Refusal::Overlap));
+    let mut b = ok.clone();
+    b.nodes[1].position.x = 0.5;
+    assert_eq!(static_checks(&b, m), Err(Refusal::Size));
+    let mut b = ok.clone();
+    b.nodes.iter_mut().for_each(|n| n.mass = 0.25);
+    assert_eq!(static_checks(&b, m), Err(Refusal::Mass));
+    let mut b = ok.clone();
+    b.edges[2].stiffness = 900.0;
+    assert_eq!(static_checks(&b, m), Err(Refusal::Range));
+    let mut b = ok.clone();
+    b.edges[0].muscle = None;
+    assert_eq!(static_checks(&b, m), Err(Refusal::NoMuscle));
+    let mut b = ok.clone();
+    b.nodes.truncate(1);
+    b.edges.clear();
+    assert_eq!(static_checks(&b, m), Err(Refusal::Particles));
+    // The settle: the tetrahedron stands; a triangle standing on its edge,
+    // leaning 14° off the vertical, falls flat.
+    assert_eq!(p.check(&ok.to_genes()), Ok(()));
+    let triangle = Body {
+        nodes: vec![
+            node(0.0, 0.0, 0.0),
+            node(0.2, 0.0, 0.0),
+            node(0.1, 0.2, 0.05),
+        ],
+        edges: vec![edge(0, 1, true), edge(1, 2, false), edge(0, 2, false)],
+        frequency: 1.0,
+    };
+    assert_eq!(static_checks(&triangle, m), Ok(()));
+    assert_eq!(p.check(&triangle.to_genes()), Err(Refusal::SettleFlat));
+}
+
+#[test]
+fn bad_morphology_keys_are_refused_naming_the_field() {
+    let cases = [
+        ("total_mass = 0.0", "morphology.total_mass"),
+        ("max_particles = 1", "morphology.max_particles"),
+        (
+            "max_particles = 4\nmax_springs = 7",
+            "morphology.max_springs",
+        ),
+        ("stiffness = [800.0, 50.0]", "morphology.stiffness"),
+        ("encoding = \"voxels\"", "voxels"),
+        ("controller = \"neural\"", "morphology.controller"),
+        (
+            "encoding = \"lattice\"\ncells = [101, 100, 1]",
+            "morphology.cells",
+        ),
+        (
+            "encoding = \"lattice\"\ncells = [2, 1, 1]\nstructure = [[1, 7]]",
+            "morphology.structure",
+        ),
+        (
+            "encoding = \"lattice\"\ncells = [2, 1, 1]\nstructure = [[1]]",
+            "morphology.structure",
+        ),
+        ("cells = [2, 2, 2]", "morphology.cells"),
+        ("start = \"nowhere.toml\"", "morphology.start"),
+        ("size = 0.01", "morphology.size"),
+        ("wings = 2", "wings"),
+    ];
+    for (key, expect) in cases {
+        let e = MorphologyProblem::parse(&with(key), "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("m.toml:") && e.contains(expect), "{key}: {e}");
+    }
+    // An [evolve] that names another controller; a body that fails its own
+    // checks as a start.
+    let t = with("").replace("[evolve]\n", "[evolve]\ncontroller = \"gait\"\n");
+    let e = MorphologyProblem::parse(&t, "m.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("evolve.controller"), "{e}");
+    let dir = std::env::temp_dir().join(format!("animats-morph-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("lone.toml"),
+        "[[particle]]\nname = \"a\"\nmass = 0.1\nposition = [0.0, 0.1, 0.0]\nradius = 0.02\n",
+    )
+    .unwrap();
+    let e = MorphologyProblem::parse(
+        &with("start = \"lone.toml\""),
+        dir.join("m.toml").to_str().unwrap(),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("morphology.start") && e.contains("fails its own checks: particles"),
+        "{e}"
+    );
+    // A scene with [morphology] is not built as it is.
+    let e = animats_scene::build::build(
+        &animats_scene::parse_def(&animats_scene::source::Source {
+            file: "m.toml",
+            text: &with(""),
+        })
+        .unwrap(),
+        &animats_scene::source::Source {
+            file: "m.toml",
+            text: &with(""),
+        },
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(e.contains("describes bodies"), "{e}");
+}
+
+/// 100,000 variations (mutants and crossovers, chained as evolution chains
+/// them) from each shipped start: every one is a body that passes the
+/// checks that need no simulation or is refused with a reason, none
+/// panics; every 100th also runs the settle.
+#[test]
+fn a_hundred_thousand_random_variations_are_valid_or_refused_with_a_reason() {
+    let walker_start = with("start = \"walker.toml\"");
+    let scenes = [
+        (walk(), "bodies_walk.toml".to_string()),
+        (walker_start, format!("{ROOT}/scenes/from_walker.toml")),
+        (
+            std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml")).unwrap(),
+            "bodies_lattice.toml".to_string(),
+        ),
+    ];
+    let per = 100_000 / scenes.len() + 1;
+    let mut refused = std::collections::BTreeMap::<&str, usize>::new();
+    let mut valid = 0usize;
+    for (k, (text, file)) in scenes.iter().enumerate() {
+        let p = MorphologyProblem::parse(text, file).unwrap();
+        let mut rng = Random::for_entry(7, k as u64);
+        let start = p
+            .start()
+            .map(<[f64]>::to_vec)
+            .unwrap_or_else(|| p.random(&mut rng));
+        let mut pool = vec![start];
+        for i in 0..per {
+            let a = &pool[(rng.uniform() * pool.len() as f64) as usize];
+            let child = if rng.uniform() < 0.25 {
+                let b = &pool[(rng.uniform() * pool.len() as f64) as usize];
+                p.crossover(a, b, &mut rng)
+            } else {
+                p.mutate(a, &mut rng)
+            };
+            let body = p.body(&child).expect("variation keeps the genome's layout");
+            let verdict = if i % 100 == 0 {
+                p.check(&child)
+            } else {
+                static_checks(&body, p.morphology())
+            };
+            match verdict {
+                Ok(()) => {
+                    valid += 1;
+                    if pool.len() < 64 {
+                        pool.push(child);
+                    } else {
+                        let j = (rng.uniform() * 64.0) as usize;
+                        pool[j] = child;
+                    }
+                }
+                Err(r) => *refused.entry(r.name()).or_insert(0) += 1,
+            }
+        }
+    }
+    let total: usize = valid + refused.values().sum::<usize>();
+    println!("{total} variations: {valid} valid, refused {refused:?}");
+    assert!(total >= 100_000);
+    assert!(
+        valid > total / 10,
+        "variation mostly makes bodies: {valid} of {total}"
+    );
+}
+
+/// The body the sphere-contact event pumped to 64 m in 10 s: with penalty
+/// contact (what developed bodies get) its muscles move it centimetres.
+#[test]
+fn penalty_contact_gives_the_pumping_body_nothing() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/pumping_body.toml"
+    ))
+    .unwrap();
+    let distance = |text: &str| {
+        let p = SceneProblem::parse(text, "pumping_body.toml").unwrap();
+        p.evaluate(p.start()).unwrap().distance
+    };
+    let event = distance(&text);
+    let penalty = distance(&text.replace("[contacts]\n", "[contacts]\nmodel = \"penalty\"\n"));
+    println!("the event: {event} m; penalty contact: {penalty} m");
+    assert!(penalty.abs() < 0.5, "{penalty} m");
+}
