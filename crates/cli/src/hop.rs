@@ -82,17 +82,19 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let spec = scene.evolve.clone().ok_or_else(|| {
         Failure::Input(format!("{}: the scene has no [evolve] table", args.params))
     })?;
-    let controller = spec.index;
     // The roobot whose brain is evolved: its controller has its name.
-    let foot = (spec.table.0 == "roobot")
-        .then(|| scene.particle(&format!("{}.foot", spec.controller)))
-        .flatten()
-        .ok_or_else(|| {
-            Failure::Input(format!(
-                "{}: not a roobot's scene (its [evolve] controller is not a roobot's)",
-                args.params
-            ))
-        })?;
+    let roobot = || {
+        let controller = spec.index?;
+        (spec.table?.0 == "roobot").then_some(())?;
+        let foot = scene.particle(&format!("{}.foot", spec.controller.as_deref()?))?;
+        Some((controller, foot))
+    };
+    let (controller, foot) = roobot().ok_or_else(|| {
+        Failure::Input(format!(
+            "{}: not a roobot's scene (its [evolve] controller is not a roobot's)",
+            args.params
+        ))
+    })?;
     let mut trajectory = match &args.output {
         Some(path) => Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?),
         None => None,

@@ -66,8 +66,14 @@ impl FromStr for CameraSpec {
 /// Arguments of `animats render`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The scene file (TOML).
+    /// The scene file (TOML); with --zoo, the directory of an `animats
+    /// evolve` run of a [morphology] scene.
     scene: PathBuf,
+    /// The run's best bodies side by side, each walking in its own
+    /// picture captioned with its rank and fitness: this many (default 6),
+    /// the best first, from the bodies alive at the run's last checkpoint.
+    #[arg(long, num_args = 0..=1, default_missing_value = "6", value_parser = clap::value_parser!(u32).range(1..=36))]
+    zoo: Option<u32>,
     /// Simulated seconds to render.
     #[arg(long, value_parser = positive_f64)]
     seconds: f64,
@@ -352,6 +358,9 @@ fn write(args: &Args, format: Format, frames: &[Image]) -> Result<(), Failure> {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
+    if args.zoo.is_some() {
+        return zoo(&args);
+    }
     let format = format_of(&args)?;
     let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
     let mut stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
@@ -388,5 +397,89 @@ pub fn run(args: Args) -> Result<(), Failure> {
         snapshots.last().map_or(0.0, |s| s.t),
         args.out.display()
     );
+    Ok(())
+}
+
+/// `--zoo N`: the N best bodies of the run in `args.scene` (a directory),
+/// each in its own tile, the tiles side by side in every frame.
+fn zoo(args: &Args) -> Result<(), Failure> {
+    let format = format_of(args)?;
+    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
+    let dir = &args.scene;
+    let checkpoint = dir.join("checkpoint.json");
+    if !checkpoint.exists() {
+        return Err(Failure::Input(format!(
+            "{}: not the directory of an `animats evolve` run (no checkpoint.json)",
+            dir.display()
+        )));
+    }
+    let state = animats_evolve::checkpoint::load(&checkpoint).map_err(Failure::Input)?;
+    let count = args.zoo.unwrap_or(6) as usize;
+    let bodies = state.best_bodies(count).ok_or_else(|| {
+        Failure::Input(format!(
+            "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
+            dir.display()
+        ))
+    })?;
+    let problem = state.config.problem.build().map_err(Failure::Input)?;
+    let start = Instant::now();
+    // Each body in its own stage and camera, rendered as `render` renders a
+    // scene, captioned with its rank and fitness.
+    let tiles: Vec<Vec<Image>> = bodies
+        .par_iter()
+        .enumerate()
+        .map(|(k, (genome, fitness, lane))| {
+            let text = problem.scene_toml(genome, "").map_err(Failure::Other)?;
+            let name = dir.join(format!("zoo-{k}.toml"));
+            let scene = animats_scene::parse(&text, &name.display().to_string())
+                .map_err(|e| Failure::Other(e.to_string()))?;
+            let mut stage = SceneStage::from_scene(name, scene, None).map_err(Failure::Other)?;
+            let mut describe = stage.describe();
+            // Closer than a scene's framing: a tile shows one small body.
+            describe.distance = describe.distance.min(1.1);
+            let drawing = &describe.drawing;
+            let at_start = snapshot(&stage, drawing);
+            let snapshots = shoot(args, &mut stage, drawing, &times)?;
+            let cameras = Cameras::new(args, &stage, &describe, &at_start);
+            Ok(snapshots
+                .iter()
+                .map(|s| {
+                    let mut picture = picture(drawing, &s.positions, &s.bells);
+                    picture.caption = Some(format!(
+                        "#{} (lane {lane}): {fitness:.2}{}",
+                        k + 1,
+                        if args.no_caption {
+                            String::new()
+                        } else {
+                            format!("  t = {:.2} s", s.t)
+                        }
+                    ));
+                    render(&picture, &cameras.of(s), args.width, args.height)
+                })
+                .collect())
+        })
+        .collect::<Result<_, Failure>>()?;
+    let columns = (bodies.len() as f64).sqrt().ceil() as u32;
+    let frames: Vec<Image> = (0..times.len())
+        .map(|i| {
+            let row: Vec<Image> = tiles.iter().map(|t| t[i].clone()).collect();
+            Image::sheet(&row, columns)
+        })
+        .collect();
+    let (w, h) = frames.first().map_or((0, 0), |f| (f.width, f.height));
+    write(args, format, &frames)?;
+    let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
+    println!(
+        "{}: the {} best bodies, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
+        dir.display(),
+        bodies.len(),
+        frames.len(),
+        if frames.len() == 1 { "" } else { "s" },
+        start.elapsed().as_secs_f64(),
+        args.out.display()
+    );
+    for (k, (_, fitness, lane)) in bodies.iter().enumerate() {
+        println!("  #{}: fitness {fitness} (lane {lane})", k + 1);
+    }
     Ok(())
 }

@@ -55,6 +55,57 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         logged.to_bits(),
         "{json} against {logged}"
     );
+    // The zoo: the best bodies alive, best first; the first is the run's
+    // best (the body GA keeps it).
+    let zoo = dir.join("zoo.gif");
+    let z = animats(&[
+        "render",
+        out.to_str().unwrap(),
+        "--zoo",
+        "3",
+        "--seconds",
+        "0.5",
+        "--fps",
+        "4",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "--out",
+        zoo.to_str().unwrap(),
+    ]);
+    let (listing, err) = text(&z);
+    assert!(z.status.success(), "{err}");
+    let fitness: Vec<f64> = listing
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix('#'))
+        .map(|l| {
+            l.split("fitness ")
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(fitness.len(), 3, "{listing}");
+    assert_eq!(fitness[0].to_bits(), logged.to_bits());
+    assert!(fitness.windows(2).all(|w| w[0] >= w[1]), "{fitness:?}");
+    let gif = std::fs::read(&zoo).unwrap();
+    assert!(gif.starts_with(b"GIF89a"));
+    // A controller's run has no bodies to show.
+    let o = animats(&[
+        "render",
+        "crates/cli/tests",
+        "--zoo",
+        "--seconds",
+        "1",
+        "--out",
+        zoo.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
     // The scene itself simulates with its first random body.
     let s = animats(&["simulate", &scene, "--duration", "0.1"]);
     assert!(s.status.success(), "{}", text(&s).1);

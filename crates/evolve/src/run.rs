@@ -408,6 +408,33 @@ impl State {
         Some((by, kept))
     }
 
+    /// A body GA run's `n` best bodies now alive, every lane's together
+    /// (their genomes, fitness and lane), best first (the lower lane, then
+    /// the earlier, among equals), each genome once; `None` for a run of
+    /// any other optimiser.
+    pub fn best_bodies(&self, n: usize) -> Option<Vec<(Vec<f64>, f64, usize)>> {
+        let mut all = Vec::new();
+        for l in &self.lanes {
+            match &l.optimiser {
+                AnyOptimiser::BodyGa(o) => {
+                    all.extend(o.parents().iter().map(|(g, f)| (g.clone(), *f, l.lane)))
+                }
+                _ => return None,
+            }
+        }
+        all.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.2.cmp(&b.2)));
+        let mut out: Vec<(Vec<f64>, f64, usize)> = Vec::with_capacity(n);
+        for body in all {
+            if out.len() == n {
+                break;
+            }
+            if !out.iter().any(|o| o.0 == body.0) {
+                out.push(body);
+            }
+        }
+        Some(out)
+    }
+
     /// Generations completed by every lane.
     pub fn generation(&self) -> u64 {
         self.lanes.iter().map(|l| l.generation).min().unwrap_or(0)

@@ -41,40 +41,103 @@ pub(crate) fn build(spec: &ProblemSpec) -> PyResult<Box<dyn Problem>> {
     spec.build().map_err(scene_error)
 }
 
-/// Evaluates each row of `genomes` (contiguous, `(P, D)`) on `pool`.
+/// The genomes Python hands over: a `(P, D)` float array, or (for a
+/// problem whose bodies evolve, whose genomes differ in length) a list of
+/// 1-D arrays.
+pub(crate) fn rows(problem: &dyn Problem, genomes: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<f64>>> {
+    let rows: Vec<Vec<f64>> = match genomes.extract::<PyReadonlyArray2<'_, f64>>() {
+        Ok(array) => {
+            let d = array.shape()[1];
+            if d != problem.dim() && problem.variation().is_none() {
+                return Err(value_error(format!(
+                    "genomes have {d} columns; this problem's genome has {}",
+                    problem.dim()
+                )));
+            }
+            crate::elements(&array)
+                .chunks(d.max(1))
+                .map(<[f64]>::to_vec)
+                .collect()
+        }
+        Err(_) => genomes.extract().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(
+                "genomes must be a (P, D) float array, or a list of 1-D arrays (bodies)",
+            )
+        })?,
+    };
+    for (k, g) in rows.iter().enumerate() {
+        if let Some(x) = g.iter().find(|x| !x.is_finite()) {
+            return Err(value_error(format!(
+                "genome {k} has a gene that is not finite: {x}"
+            )));
+        }
+    }
+    Ok(rows)
+}
+
+/// Evaluates each of `genomes` ([`rows`]) on `pool`.
 pub(crate) fn outcomes(
     py: Python<'_>,
     problem: &dyn Problem,
-    genomes: &PyReadonlyArray2<'_, f64>,
+    genomes: &Bound<'_, PyAny>,
     pool: &Option<rayon::ThreadPool>,
 ) -> PyResult<Vec<Outcome>> {
-    let shape = genomes.shape();
-    let (p, d) = (shape[0], shape[1]);
-    if d != problem.dim() {
-        return Err(value_error(format!(
-            "genomes have {d} columns; this problem's genome has {}",
-            problem.dim()
-        )));
-    }
-    let flat = &*crate::elements(genomes);
-    if let Some(i) = flat.iter().position(|x| !x.is_finite()) {
-        return Err(value_error(format!(
-            "genome {} has a gene that is not finite: {}",
-            i / d.max(1),
-            flat[i]
-        )));
-    }
-    if p == 0 {
+    let rows = rows(problem, genomes)?;
+    if rows.is_empty() {
         return Ok(Vec::new());
     }
     py.detach(|| {
         on(pool, || {
-            flat.par_chunks(d)
+            rows.par_iter()
                 .map(|g| problem.evaluate(g))
                 .collect::<Result<Vec<_>, _>>()
         })
     })
     .map_err(runtime_error)
+}
+
+/// `animats.evaluate_scenes`: each complete scene text (any bodies, as a
+/// researcher's own encoding writes them) evaluated by its `[evolve]`
+/// table, in parallel on `threads` threads with the GIL released: the
+/// same bits as `animats evaluate` on each. A text that is not a scene,
+/// or has no `[evolve]` table, raises `SceneError` naming its index.
+#[pyfunction]
+#[pyo3(signature = (texts, threads = None))]
+pub fn evaluate_scenes<'py>(
+    py: Python<'py>,
+    texts: Vec<String>,
+    threads: Option<usize>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let pool = pool(threads)?;
+    let files: Vec<String> = (0..texts.len()).map(|k| format!("<scene {k}>")).collect();
+    let results: Vec<Result<Outcome, String>> = py.detach(|| {
+        on(&pool, || {
+            texts
+                .par_iter()
+                .zip(&files)
+                .map(|(text, file)| evaluate_text(text, file))
+                .collect()
+        })
+    });
+    let o = results
+        .into_iter()
+        .collect::<Result<Vec<_>, String>>()
+        .map_err(scene_error)?;
+    outcome_dict(py, &o)
+}
+
+/// One scene text scored as `animats evaluate` scores its file.
+fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
+    let scene = animats_scene::parse(text, file).map_err(|e| e.to_string())?;
+    match &scene.evolve {
+        None => Err(format!(
+            "{file}: the scene has no [evolve] table: nothing to evaluate"
+        )),
+        Some(spec) if spec.robust => animats_scene::evaluate::evaluate_robust(|| {
+            animats_scene::parse(text, file).map_err(|e| e.to_string())
+        }),
+        Some(_) => animats_scene::evaluate::evaluate(scene),
+    }
 }
 
 /// Fitness of each row of a `(P, D)` float64 array of genomes under a
@@ -84,12 +147,12 @@ pub(crate) fn outcomes(
 pub fn evaluate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
-    genomes: PyReadonlyArray2<'py, f64>,
+    genomes: &Bound<'py, PyAny>,
     threads: Option<usize>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let problem = build(&problem_spec(scene)?)?;
     let pool = pool(threads)?;
-    let o = outcomes(py, problem.as_ref(), &genomes, &pool)?;
+    let o = outcomes(py, problem.as_ref(), genomes, &pool)?;
     Ok(PyArray1::from_vec(
         py,
         o.iter().map(|o| o.fitness).collect(),
@@ -135,9 +198,9 @@ impl Evaluator {
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
-        genomes: PyReadonlyArray2<'py, f64>,
+        genomes: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let o = outcomes(py, self.problem.as_ref(), &genomes, &self.pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool)?;
         Ok(PyArray1::from_vec(
             py,
             o.iter().map(|o| o.fitness).collect(),
@@ -149,9 +212,9 @@ impl Evaluator {
     fn outcomes<'py>(
         &self,
         py: Python<'py>,
-        genomes: PyReadonlyArray2<'py, f64>,
+        genomes: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = outcomes(py, self.problem.as_ref(), &genomes, &self.pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool)?;
         outcome_dict(py, &o)
     }
 }

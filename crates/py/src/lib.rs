@@ -93,6 +93,7 @@ fn _animats(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::World>()?;
     m.add_class::<scene::Snapshot>()?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate_scenes, m)?)?;
     m.add_class::<evaluate::Evaluator>()?;
     m.add_class::<optimise::Optimiser>()?;
     m.add_class::<optimise::Evolution>()?;

@@ -185,13 +185,13 @@ impl Evolution {
     /// `scene`: an `animats.Scene`, a path, or "roobot" (the default). The
     /// other arguments are `animats evolve`'s, with its defaults.
     #[new]
-    #[pyo3(signature = (scene = None, *, lanes = None, generations = 100, seed = 1, optimiser = "hill-climber", population = None, restarts = 0))]
+    #[pyo3(signature = (scene = None, *, lanes = None, generations = 100, seed = 1, optimiser = None, population = None, restarts = 0))]
     fn new(
         scene: Option<&Bound<'_, PyAny>>,
         lanes: Option<usize>,
         generations: u64,
         seed: u64,
-        optimiser: &str,
+        optimiser: Option<&str>,
         population: Option<usize>,
         restarts: u32,
     ) -> PyResult<Evolution> {
@@ -206,7 +206,7 @@ impl Evolution {
             lanes,
             generations: Some(generations),
             seed: Some(seed),
-            optimiser: Some(kind(optimiser)?),
+            optimiser: optimiser.map(kind).transpose()?,
             population,
             restarts: (restarts > 0).then_some(restarts),
         };
@@ -221,8 +221,10 @@ impl Evolution {
     }
 
     /// The next generation of every lane not yet done: `(genomes, lanes)`,
-    /// a `(N, D)` array and each row's lane. Evaluate every row and `tell`.
-    fn ask<'py>(&mut self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray2<f64>>, Vec<usize>)> {
+    /// a `(N, D)` array (a list of N 1-D arrays when bodies evolve: their
+    /// genomes differ in length) and each one's lane. Evaluate every one
+    /// and `tell`.
+    fn ask<'py>(&mut self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Vec<usize>)> {
         if self.pending.is_some() {
             return Err(value_error(
                 "tell the outcomes of the last generation first",
@@ -237,7 +239,14 @@ impl Evolution {
             .flat_map(|(l, p)| std::iter::repeat_n(*l, p.len()))
             .collect();
         self.pending = Some(g);
-        Ok((matrix(py, &rows, d)?, lanes))
+        if self.problem.variation().is_some() {
+            let list: Vec<Bound<'py, PyArray1<f64>>> = rows
+                .into_iter()
+                .map(|r| PyArray1::from_vec(py, r))
+                .collect();
+            return Ok((list.into_pyobject(py)?.into_any(), lanes));
+        }
+        Ok((matrix(py, &rows, d)?.into_any(), lanes))
     }
 
     /// The outcomes of the last `ask()`'s rows: a dict with `fitness`,
@@ -288,11 +297,11 @@ impl Evolution {
     fn evaluate<'py>(
         &mut self,
         py: Python<'py>,
-        genomes: PyReadonlyArray2<'py, f64>,
+        genomes: &Bound<'py, PyAny>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pool = pool(threads)?;
-        let o = outcomes(py, self.problem.as_ref(), &genomes, &pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &pool)?;
         outcome_dict(py, &o)
     }
 

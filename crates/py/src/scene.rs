@@ -34,7 +34,25 @@ impl Scene {
 
     pub(crate) fn from_text(text: String, file: String) -> PyResult<Scene> {
         let s = animats_scene::parse(&text, &file).map_err(scene_error)?;
+        let src = animats_scene::source::Source {
+            file: &file,
+            text: &text,
+        };
+        let bodies = animats_scene::parse_def(&src)
+            .map_err(scene_error)?
+            .morphology
+            .is_some();
         let evolve = match &s.evolve {
+            // Bodies evolve: the start is the scene's starting body, if it
+            // names one; genomes have no bounds (nor a fixed length).
+            Some(_) if bodies => {
+                let p = animats_scene::morphology::MorphologyProblem::parse(&text, &file)
+                    .map_err(scene_error)?;
+                Some((
+                    p.start().map(<[f64]>::to_vec).unwrap_or_default(),
+                    Vec::new(),
+                ))
+            }
             Some(_) => {
                 let p = animats_scene::evaluate::SceneProblem::parse(&text, &file)
                     .map_err(scene_error)?;

@@ -70,3 +70,16 @@ def test_a_pool_evaluates_as_evaluate_does(cluster, crawler):
         assert np.array_equal(pool.evaluate(g), animats.evaluate(scene, g))
     finally:
         pool.shutdown()
+
+
+def test_a_ray_evolution_of_bodies_writes_the_command_lines_log(cluster, cli, tmp_path):
+    from test_bodies import SMALL
+
+    scene = tmp_path / "small.toml"
+    scene.write_text(SMALL)
+    cli("evolve", scene, "--population", 6, "--generations", 3, "--seed", 3, "--out", tmp_path / "cli")
+    run, stats = distributed.evolve(str(scene), population=6, generations=3, seed=3, actors=2,
+                                    out=tmp_path / "ray")
+    assert stats.generations == 3
+    for f in ("log.csv", "best.toml"):
+        assert (tmp_path / "ray" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f

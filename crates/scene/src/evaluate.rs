@@ -34,10 +34,11 @@ pub const MAX_STEPS: f64 = 1e12;
 /// A scene's `[evolve]` table, resolved against its world.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EvolveSpec {
-    /// The controller's name.
-    pub controller: String,
+    /// The controller evolved, if the table names one (a scene whose
+    /// `[evolve]` names none is scored as it is, and cannot be evolved).
+    pub controller: Option<String>,
     /// Its index in [`NervousSystem::controllers`].
-    pub index: usize,
+    pub index: Option<usize>,
     /// Seconds per evaluation.
     pub duration: f64,
     /// Whose centre of mass counts.
@@ -56,7 +57,7 @@ pub struct EvolveSpec {
     pub fail_on_stretch: Vec<Stretch>,
     /// The table the controller was written in (`controller`, 2), where its
     /// genes are written back.
-    pub table: (&'static str, usize),
+    pub table: Option<(&'static str, usize)>,
     /// How the hill climber mutates.
     pub mutation: MutationName,
     /// What `log.csv` holds.
@@ -98,15 +99,14 @@ impl EvolveSpec {
         world: &World,
         dt: f64,
     ) -> Result<EvolveSpec, SceneError> {
-        let controller = e.controller.as_deref().ok_or_else(|| {
-            at.err(
-                "controller",
-                "name the controller whose parameters evolve (docs/SCENES.md)",
-            )
-        })?;
-        let index = nervous
-            .controller(controller)
-            .ok_or_else(|| at.err("controller", format!("no controller named `{controller}`")))?;
+        let index = match e.controller.as_deref() {
+            None => None,
+            Some(c) => Some(
+                nervous
+                    .controller(c)
+                    .ok_or_else(|| at.err("controller", format!("no controller named `{c}`")))?,
+            ),
+        };
         let duration = Self::duration(at, e, dt)?;
         let particles = match &e.particles {
             None => world.particle_ids().collect(),
@@ -130,11 +130,13 @@ impl EvolveSpec {
             touch_tolerance,
             fail_on_stretch,
         } = Self::end_rules(at, e, names)?;
-        if nervous.controllers[index].brain.genome().is_empty() {
-            return Err(at.err(
-                "controller",
-                format!("controller `{controller}` has no parameters to evolve"),
-            ));
+        if let (Some(i), Some(c)) = (index, &e.controller) {
+            if nervous.controllers[i].brain.genome().is_empty() {
+                return Err(at.err(
+                    "controller",
+                    format!("controller `{c}` has no parameters to evolve"),
+                ));
+            }
         }
         let lanes = match e.lanes {
             Some(l) if !(1..=crate::evaluate::MAX_LANES).contains(&l) => {
@@ -146,7 +148,7 @@ impl EvolveSpec {
             other => other,
         };
         Ok(EvolveSpec {
-            controller: controller.to_string(),
+            controller: e.controller.clone(),
             index,
             duration,
             particles,
@@ -156,7 +158,7 @@ impl EvolveSpec {
             fail_on_touch,
             touch_tolerance,
             fail_on_stretch,
-            table: origins[index],
+            table: index.map(|i| origins[i]),
             mutation: e.mutation,
             log: e.log,
             lanes,
@@ -418,7 +420,13 @@ impl SceneProblem {
                 "the scene has no [evolve] table: add one naming the controller to evolve (docs/SCENES.md)",
             )
         })?;
-        let brain = &scene.nervous.controllers[spec.index].brain;
+        let index = spec.index.ok_or_else(|| {
+            SceneError::file(
+                file,
+                "[evolve] names no controller: the scene can be evaluated as it is, not evolved; add `controller = \"NAME\"` (docs/SCENES.md)",
+            )
+        })?;
+        let brain = &scene.nervous.controllers[index].brain;
         Ok(SceneProblem {
             file: file.to_string(),
             text: text.to_string(),
@@ -474,7 +482,10 @@ impl SceneProblem {
     /// The scene built afresh with `genome` in its `[evolve]` controller.
     pub fn scene(&self, genome: &[f64]) -> Result<Scene, String> {
         let mut scene = self.fresh()?;
-        let index = scene.evolve.as_ref().map_or(0, |s| s.index);
+        let index = self
+            .spec
+            .index
+            .ok_or("the scene names no controller to evolve")?;
         scene.nervous.controllers[index].brain.set_genome(genome)?;
         Ok(scene)
     }
@@ -497,7 +508,10 @@ impl SceneProblem {
             .text
             .parse()
             .map_err(|e| format!("{}: {e}", self.file))?;
-        let (kind, k) = self.spec.table;
+        let (kind, k) = self
+            .spec
+            .table
+            .ok_or("the scene names no controller to evolve")?;
         let table = doc
             .get_mut(kind)
             .and_then(|c| c.as_array_of_tables_mut())

@@ -9,6 +9,7 @@ evaluation, the optimisers and whole evolution runs, and environments.
     >>> world.positions()                       # (N, 3) float64
     >>> animats.evaluate(scene, scene.start())  # its own parameters' fitness
     >>> animats.evaluate("roobot", np.tile(animats.ROOBOT_INITIAL, (8, 1)))
+    >>> animats.evaluate_scenes([open("scenes/walker.toml").read()])
 
 ``import animats.gym`` registers the Gymnasium environments
 ``animats/Roobot-v0`` and ``animats/Scene-v0``; ``animats.distributed``
@@ -48,6 +49,7 @@ __all__ = [
     "VecEnv",
     "World",
     "evaluate",
+    "evaluate_scenes",
     "load",
     "parse",
     "ROOBOT_INITIAL",
@@ -71,9 +73,27 @@ def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None) -> np.nda
     ``threads`` threads (default: every core) with the GIL released, and
     each is bit-identical to ``animats evaluate`` on the same parameters.
     """
+    if isinstance(genomes, list):
+        # Bodies ([morphology] scenes): genomes differ in length.
+        return _animats.evaluate(scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads)
     g = np.ascontiguousarray(genomes, dtype=np.float64)
     if g.ndim == 1:
         g = g[None, :]
     if g.ndim != 2:
         raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
     return _animats.evaluate(scene, g, threads)
+
+
+def evaluate_scenes(texts, threads: Optional[int] = None) -> dict:
+    """Each complete scene text in ``texts`` scored by its own ``[evolve]``
+    table, in parallel on ``threads`` threads (default: every core) with the
+    GIL released: a dict of arrays ``fitness``, ``distance``, ``time`` and
+    the list ``ended``, one entry per text, each bit-identical to
+    ``animats evaluate`` on that text as a file. For encodings of your own
+    (CPPNs, grammars, learned decoders): write the body your genome
+    describes as ``[[particle]]``, ``[[spring]]``, ``[[actuator]]`` and a
+    ``[[controller]]``, and let animats simulate it. A text that is not a
+    valid scene raises ``SceneError`` naming it ``<scene K>``."""
+    if isinstance(texts, str):
+        raise TypeError("texts must be a list of scene texts, not one string")
+    return _animats.evaluate_scenes(list(texts), threads)

@@ -46,7 +46,10 @@ class _Worker:
 
     def outcomes(self, genomes: np.ndarray) -> dict:
         start = time.perf_counter()
-        out = self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
+        if isinstance(genomes, list):
+            out = self.evaluator.outcomes([np.ascontiguousarray(g, dtype=np.float64) for g in genomes])
+        else:
+            out = self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
         out["seconds"] = time.perf_counter() - start
         return out
 
@@ -130,9 +133,13 @@ class Pool:
         a worker there)."""
         import ray
 
-        g = np.ascontiguousarray(genomes, dtype=np.float64)
-        if g.ndim != 2:
-            raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
+        if isinstance(genomes, list):
+            # Bodies: genomes of different lengths, sent as lists.
+            g = [np.ascontiguousarray(x, dtype=np.float64) for x in genomes]
+        else:
+            g = np.ascontiguousarray(genomes, dtype=np.float64)
+            if g.ndim != 2:
+                raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
         start = time.perf_counter()
         n_shares = min(len(g), len(self.actors) * self.chunks)
         shares = [s for s in np.array_split(np.arange(len(g)), max(n_shares, 1)) if len(s)]
@@ -144,7 +151,8 @@ class Pool:
 
         def send(actor: int) -> None:
             i = queue.pop(0)
-            pending[self.actors[actor].outcomes.remote(g[shares[i]])] = (i, actor)
+            share = [g[k] for k in shares[i]] if isinstance(g, list) else g[shares[i]]
+            pending[self.actors[actor].outcomes.remote(share)] = (i, actor)
 
         for a in range(len(self.actors)):
             if queue:
@@ -211,7 +219,7 @@ def evolve(
     generations: int = 100,
     lanes: Optional[int] = None,
     seed: int = 1,
-    optimiser: str = "hill-climber",
+    optimiser: Optional[str] = None,
     population: Optional[int] = None,
     restarts: int = 0,
     actors: int = 2,

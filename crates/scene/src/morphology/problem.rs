@@ -237,8 +237,8 @@ impl MorphologyProblem {
 /// A stand-in until the probe body's `[evolve]` is resolved.
 fn placeholder_spec() -> EvolveSpec {
     EvolveSpec {
-        controller: NAME.into(),
-        index: 0,
+        controller: Some(NAME.into()),
+        index: None,
         duration: 1.0,
         particles: Vec::new(),
         axis: DVec3::X,
@@ -247,7 +247,7 @@ fn placeholder_spec() -> EvolveSpec {
         fail_on_touch: Vec::new(),
         touch_tolerance: 0.0,
         fail_on_stretch: Vec::new(),
-        table: ("controller", 0),
+        table: None,
         mutation: Default::default(),
         log: Default::default(),
         lanes: None,

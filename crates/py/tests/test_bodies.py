@@ -1,0 +1,75 @@
+"""Bodies that evolve, from Python (issue 39): `Evolution` and the Ray
+runner on a [morphology] scene write the command line's log.csv and
+best.toml bit for bit; `evaluate_scenes` scores complete scene texts (any
+bodies) as `animats evaluate` scores the files."""
+
+import json
+
+import numpy as np
+import pytest
+
+import animats
+
+SMALL = """
+[world]
+dt = 0.001
+integrator = "symplectic"
+[floor]
+[morphology]
+max_particles = 10
+max_springs = 30
+[evolve]
+duration = 1.0
+distance_weight = 1.0
+time_weight = 0.0
+"""
+
+
+@pytest.fixture
+def small(tmp_path):
+    p = tmp_path / "small.toml"
+    p.write_text(SMALL)
+    return p
+
+
+def test_an_evolution_of_bodies_writes_the_command_lines_files(cli, small, tmp_path):
+    cli("evolve", small, "--population", 6, "--generations", 4, "--seed", 3, "--out", tmp_path / "cli")
+    run = animats.Evolution(str(small), population=6, generations=4, seed=3)
+    assert run.config["optimiser"] == "body-ga"
+    run.run()
+    run.save(tmp_path / "py")
+    for f in ("log.csv", "best.toml"):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    # Asked and told by hand: genomes of different lengths come as a list.
+    by_hand = animats.Evolution(str(small), population=6, generations=4, seed=3)
+    while not by_hand.done:
+        genomes, lanes = by_hand.ask()
+        assert isinstance(genomes, list) and len(genomes) == 6 and lanes == [0] * 6
+        by_hand.tell(by_hand.evaluate(genomes))
+    assert by_hand.log_csv() == run.log_csv()
+
+
+def test_evaluate_scenes_scores_texts_as_evaluate_scores_files(cli, small, tmp_path):
+    cli("evolve", small, "--population", 6, "--generations", 2, "--seed", 3, "--out", tmp_path / "b")
+    files = [animats_root() / "scenes" / "walker.toml", tmp_path / "b" / "best.toml",
+             animats_root() / "scenes" / "jellyfish_swim.toml"]
+    texts = [f.read_text() for f in files]
+    out = animats.evaluate_scenes(texts, threads=2)
+    assert set(out) == {"fitness", "distance", "time", "ended"}
+    for k, f in enumerate(files):
+        e = json.loads(cli("evaluate", f, "--json"))
+        assert out["fitness"][k] == e["fitness"] and out["distance"][k] == e["distance"], f
+        assert out["time"][k] == e["time"] and out["ended"][k] == e["ended"]
+    with pytest.raises(animats.SceneError, match="<scene 1>"):
+        animats.evaluate_scenes([texts[0], "[world]\ndt = -1.0\n"])
+    with pytest.raises(animats.SceneError, match="no \\[evolve\\] table"):
+        animats.evaluate_scenes(["[world]\n"])
+    with pytest.raises(TypeError):
+        animats.evaluate_scenes(texts[0])
+    assert animats.evaluate_scenes([])["fitness"].shape == (0,)
+
+
+def animats_root():
+    import pathlib
+
+    return pathlib.Path(__file__).resolve().parents[3]
