@@ -99,7 +99,7 @@ fn a_body_develops_into_ordinary_entries_on_the_floor() {
     // The [evolve] table is the scene's, targeting the body's oscillator,
     // robust by default.
     let problem = SceneProblem::parse(&text, "t.toml").unwrap();
-    assert_eq!(problem.spec().controller, "body");
+    assert_eq!(problem.spec().controller.as_deref(), Some("body"));
     assert!(problem.spec().robust);
     assert_eq!(problem.start(), &[2.0, 0.3, 0.5, 0.5][..]);
     // What evolution scores is what `evaluate` scores, to the bit.
