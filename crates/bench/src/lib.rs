@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod allpairs;
+pub mod bodies;
 pub mod brains;
 pub mod hopper;
 pub mod mass_spring;
@@ -40,7 +41,7 @@ pub const WORKLOADS: [&str; 10] = [
 ];
 
 /// Workloads run only when named (they take minutes).
-pub const ON_REQUEST: [&str; 2] = ["implicit", "contacts"];
+pub const ON_REQUEST: [&str; 3] = ["implicit", "contacts", "bodies"];
 
 /// True when `name` is a workload, run by default or on request.
 pub fn is_workload(name: &str) -> bool {
@@ -394,6 +395,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
         "hopper" => hopper::run(opts.quick, runs),
         "brains" => brains::run(opts.quick, runs),
+        "bodies" => bodies::run(opts.quick, runs),
         "seaworld" => seaworld::run(opts.quick, runs),
         "implicit" => Ok(run_implicit(opts.quick)),
         "contacts" => Ok(pile::run(opts.quick, runs)),

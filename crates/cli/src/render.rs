@@ -69,6 +69,10 @@ pub struct Args {
     /// The scene file (TOML); with --zoo, the directory of an `animats
     /// evolve` run of a [morphology] scene.
     scene: PathBuf,
+    /// With --zoo, more runs' directories: each run's best body first (the
+    /// best run first), then each run's second best, and so on.
+    #[arg(requires = "zoo")]
+    more_runs: Vec<PathBuf>,
     /// The run's best bodies side by side, each walking in its own
     /// picture captioned with its rank and fitness: this many (default 6),
     /// the best first, from the bodies alive at the run's last checkpoint.
@@ -400,37 +404,64 @@ pub fn run(args: Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// `--zoo N`: the N best bodies of the run in `args.scene` (a directory),
-/// each in its own tile, the tiles side by side in every frame.
+/// `--zoo N`: the N best bodies of the run in `args.scene` (a directory)
+/// and of any `more_runs`, each in its own tile, the tiles side by side in
+/// every frame.
 fn zoo(args: &Args) -> Result<(), Failure> {
     let format = format_of(args)?;
     let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
-    let dir = &args.scene;
-    let checkpoint = dir.join("checkpoint.json");
-    if !checkpoint.exists() {
-        return Err(Failure::Input(format!(
-            "{}: not the directory of an `animats evolve` run (no checkpoint.json)",
-            dir.display()
-        )));
-    }
-    let state = animats_evolve::checkpoint::load(&checkpoint).map_err(Failure::Input)?;
     let count = args.zoo.unwrap_or(6) as usize;
-    let bodies = state.best_bodies(count).ok_or_else(|| {
-        Failure::Input(format!(
-            "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
-            dir.display()
-        ))
-    })?;
-    let problem = state.config.problem.build().map_err(Failure::Input)?;
+    let dirs: Vec<&PathBuf> = std::iter::once(&args.scene)
+        .chain(&args.more_runs)
+        .collect();
+    // Each run's best bodies, best first.
+    let mut runs = Vec::with_capacity(dirs.len());
+    for dir in &dirs {
+        let checkpoint = dir.join("checkpoint.json");
+        if !checkpoint.exists() {
+            return Err(Failure::Input(format!(
+                "{}: not the directory of an `animats evolve` run (no checkpoint.json)",
+                dir.display()
+            )));
+        }
+        let state = animats_evolve::checkpoint::load(&checkpoint).map_err(Failure::Input)?;
+        let bodies = state.best_bodies(count).ok_or_else(|| {
+            Failure::Input(format!(
+                "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
+                dir.display()
+            ))
+        })?;
+        let problem = state.config.problem.build().map_err(Failure::Input)?;
+        runs.push((dir, problem, bodies));
+    }
+    // Rank by rank: every run's best (the best run first), then every
+    // run's second, until `count`.
+    let mut bodies = Vec::with_capacity(count);
+    for rank in 0.. {
+        let mut at_rank: Vec<_> = runs
+            .iter()
+            .filter_map(|(dir, problem, list)| {
+                list.get(rank)
+                    .map(|(g, f, lane)| (*dir, problem, g.clone(), *f, *lane))
+            })
+            .collect();
+        if at_rank.is_empty() || bodies.len() == count {
+            break;
+        }
+        at_rank.sort_by(|a, b| b.3.total_cmp(&a.3));
+        bodies.extend(at_rank.into_iter().take(count - bodies.len()));
+    }
+    let several = dirs.len() > 1;
+    let dir = &args.scene;
     let start = Instant::now();
     // Each body in its own stage and camera, rendered as `render` renders a
     // scene, captioned with its rank and fitness.
     let tiles: Vec<Vec<Image>> = bodies
         .par_iter()
         .enumerate()
-        .map(|(k, (genome, fitness, lane))| {
+        .map(|(k, (run, problem, genome, fitness, lane))| {
             let text = problem.scene_toml(genome, "").map_err(Failure::Other)?;
-            let name = dir.join(format!("zoo-{k}.toml"));
+            let name = run.join(format!("zoo-{k}.toml"));
             let scene = animats_scene::parse(&text, &name.display().to_string())
                 .map_err(|e| Failure::Other(e.to_string()))?;
             let mut stage = SceneStage::from_scene(name, scene, None).map_err(Failure::Other)?;
@@ -446,8 +477,13 @@ fn zoo(args: &Args) -> Result<(), Failure> {
                 .map(|s| {
                     let mut picture = picture(drawing, &s.positions, &s.bells);
                     picture.caption = Some(format!(
-                        "#{} (lane {lane}): {fitness:.2}{}",
+                        "#{} {}(lane {lane}): {fitness:.2}{}",
                         k + 1,
+                        if several {
+                            format!("{} ", run_name(run))
+                        } else {
+                            String::new()
+                        },
                         if args.no_caption {
                             String::new()
                         } else {
@@ -470,16 +506,37 @@ fn zoo(args: &Args) -> Result<(), Failure> {
     write(args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
     println!(
-        "{}: the {} best bodies, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
+        "{}{}: the {} best bodies, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
         dir.display(),
+        if several {
+            format!(" and {} more runs", dirs.len() - 1)
+        } else {
+            String::new()
+        },
         bodies.len(),
         frames.len(),
         if frames.len() == 1 { "" } else { "s" },
         start.elapsed().as_secs_f64(),
         args.out.display()
     );
-    for (k, (_, fitness, lane)) in bodies.iter().enumerate() {
-        println!("  #{}: fitness {fitness} (lane {lane})", k + 1);
+    for (k, (run, _, _, fitness, lane)) in bodies.iter().enumerate() {
+        println!(
+            "  #{}: fitness {fitness} ({}lane {lane})",
+            k + 1,
+            if several {
+                format!("{}, ", run.display())
+            } else {
+                String::new()
+            }
+        );
     }
     Ok(())
+}
+
+/// A run directory's last component, for a caption.
+fn run_name(dir: &std::path::Path) -> String {
+    dir.file_name().map_or_else(
+        || dir.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }

@@ -95,6 +95,70 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     assert!(fitness.windows(2).all(|w| w[0] >= w[1]), "{fitness:?}");
     let gif = std::fs::read(&zoo).unwrap();
     assert!(gif.starts_with(b"GIF89a"));
+    // Several runs: each run's best first, the better run first, then each
+    // run's second best.
+    let other = dir.join("other");
+    let o = animats(&[
+        "evolve",
+        &scene,
+        "--population",
+        "4",
+        "--seed",
+        "9",
+        "--generations",
+        "2",
+        "--out",
+        other.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let other_log = std::fs::read_to_string(other.join("log.csv")).unwrap();
+    let other_best: f64 = other_log
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(4)
+        .unwrap()
+        .parse()
+        .unwrap();
+    let z = animats(&[
+        "render",
+        out.to_str().unwrap(),
+        other.to_str().unwrap(),
+        "--zoo",
+        "3",
+        "--seconds",
+        "0.2",
+        "--out",
+        dir.join("zoo2.png").to_str().unwrap(),
+    ]);
+    let (listing, err) = text(&z);
+    assert!(z.status.success(), "{err}");
+    let ranked: Vec<(f64, bool)> = listing
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix('#'))
+        .map(|l| {
+            let f: f64 = l
+                .split("fitness ")
+                .nth(1)
+                .unwrap()
+                .split(' ')
+                .next()
+                .unwrap()
+                .parse()
+                .unwrap();
+            (f, l.contains("other"))
+        })
+        .collect();
+    assert_eq!(ranked.len(), 3, "{listing}");
+    let (hi, lo) = if logged >= other_best {
+        (logged, other_best)
+    } else {
+        (other_best, logged)
+    };
+    assert_eq!(ranked[0].0.to_bits(), hi.to_bits(), "{listing}");
+    assert_eq!(ranked[1].0.to_bits(), lo.to_bits(), "{listing}");
+    assert_ne!(ranked[0].1, ranked[1].1, "one from each run: {listing}");
     // A controller's run has no bodies to show.
     let o = animats(&[
         "render",

@@ -1,4 +1,5 @@
-//! Bodies evolve (issue 39): from random starts, with each encoding,
+//! Bodies evolve (issue 39): from random starts, with each encoding (and
+//! graph bodies with each controller),
 //! fitness rises, the best body differs in structure from every start
 //! body, and its `best.toml` evaluates to the logged fitness exactly; the
 //! same seed gives the same log and best on 1 and 2 threads and after a
@@ -88,7 +89,15 @@ fn parents(s: &State) -> Vec<Vec<f64>> {
 
 #[test]
 fn bodies_evolve_from_random_starts_with_each_encoding() {
-    for (name, text, generations) in [("graph", GRAPH, 8), ("lattice", LATTICE, 8)] {
+    let neural = GRAPH.replace(
+        "encoding = \"graph\"",
+        "encoding = \"graph\"\ncontroller = \"neural\"",
+    );
+    for (name, text, generations) in [
+        ("graph", GRAPH, 8),
+        ("lattice", LATTICE, 8),
+        ("graph, neural", &neural[..], 8),
+    ] {
         let p = MorphologyProblem::parse(text, "bodies.toml").unwrap();
         let mut s = State::new(config(text, generations)).unwrap();
         let threads = pool(2);
@@ -120,6 +129,11 @@ fn bodies_evolve_from_random_starts_with_each_encoding() {
         // best.toml is an ordinary scene, and it scores what the log says.
         let text = s.best_toml().unwrap().unwrap();
         assert!(!text.contains("[morphology]"));
+        assert_eq!(
+            text.contains("kind = \"neural\""),
+            name.contains("neural"),
+            "{name}"
+        );
         let back = SceneProblem::parse(&text, "best.toml").unwrap();
         let again = back.evaluate(back.start()).unwrap();
         assert_eq!(again.fitness.to_bits(), best.fitness.to_bits(), "{name}");

@@ -39,6 +39,7 @@ fn edge(a: usize, b: usize, muscle: bool) -> Edge {
             amplitude: 0.3,
             phase: 0.5,
             offset: 0.5,
+            touch: [0.0; 2],
         }),
     }
 }
@@ -62,6 +63,7 @@ fn tetra() -> Body {
             edge(2, 3, false),
         ],
         frequency: 2.0,
+        neural: false,
     }
 }
 
@@ -108,6 +110,67 @@ fn a_body_develops_into_ordinary_entries_on_the_floor() {
     assert_eq!(e.fitness.to_bits(), again.fitness.to_bits());
 }
 
+/// Two spheres and a muscle with touch weights `touch`, no oscillation
+/// (amplitude 0, offset ½), built with their lowest points at `height`;
+/// the muscle's length over its built length after 1 s.
+fn reflex(touch: [f64; 2], height: f64) -> f64 {
+    let text = with(&format!(
+        "controller = \"neural\"\norigin = [0.0, {height}, 0.0]"
+    ));
+    let p = MorphologyProblem::parse(&text, "n.toml").unwrap();
+    let body = Body {
+        nodes: vec![node(0.0, 0.0, 0.0), node(0.2, 0.0, 0.0)],
+        edges: vec![Edge {
+            a: 0,
+            b: 1,
+            stiffness: 400.0,
+            muscle: Some(Muscle {
+                amplitude: 0.0,
+                phase: 0.0,
+                offset: 0.5,
+                touch,
+            }),
+        }],
+        frequency: 1.0,
+        neural: true,
+    };
+    let genes = body.to_genes();
+    assert_eq!(p.check(&genes), Ok(()), "a valid neural body");
+    let developed = p.develop(&genes, "").unwrap();
+    assert!(developed.contains("kind = \"touch\"") && developed.contains("kind = \"neural\""));
+    let mut scene = animats_scene::parse(&developed, "n.toml").unwrap();
+    let (a, b) = (
+        scene.particle("body.p0").unwrap(),
+        scene.particle("body.p1").unwrap(),
+    );
+    let built = (scene.world.position(a) - scene.world.position(b)).length();
+    scene.steps(1000, 0.001).unwrap();
+    (scene.world.position(a) - scene.world.position(b)).length() / built
+}
+
+/// A `neural` body's muscles feel the floor: with both touch weights 1 a
+/// muscle whose ends rest on the floor is driven to σ(4) = 0.982 of its
+/// range, a rest length of 0.7 + 0.6 × 0.982 = 1.289 of its built length,
+/// give or take what static friction can hold (μ_s m g = 0.98 N on a
+/// 400 N/m spring of 0.2 m: 0.012 of its length); the same muscle falling
+/// through the air (10 m up: 4.9 m of fall in the second), or with both
+/// weights 0, stays at level ½, its built length.
+#[test]
+fn a_neural_body_feels_the_floor() {
+    let on_floor = reflex([1.0, 1.0], 0.0);
+    let in_air = reflex([1.0, 1.0], 10.0);
+    let numb = reflex([0.0, 0.0], 0.0);
+    println!("on the floor {on_floor}, in the air {in_air}, numb {numb}");
+    assert!((on_floor - 1.289).abs() < 0.013, "{on_floor}");
+    assert!((in_air - 1.0).abs() < 1e-3, "{in_air}");
+    assert!((numb - 1.0).abs() < 1e-3, "{numb}");
+    // A neural genome is not an oscillator body's.
+    let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();
+    let mut b = tetra();
+    b.neural = true;
+    assert_eq!(static_checks(&b, p.morphology()), Err(Refusal::Malformed));
+}
+
 #[test]
 fn robust_evaluation_keeps_the_worse_of_the_step_and_half_of_it() {
     let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();
@@ -135,7 +198,8 @@ fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
             Muscle {
                 amplitude: 0.2,
                 phase: 0.0,
-                offset: 0.5
+                offset: 0.5,
+                touch: [0.0; 2],
             };
             2
         ],
@@ -227,6 +291,7 @@ fn every_check_names_its_reason() {
         ],
         edges: vec![edge(0, 1, true), edge(1, 2, false), edge(0, 2, false)],
         frequency: 1.0,
+        neural: false,
     };
     assert_eq!(static_checks(&triangle, m), Ok(()));
     assert_eq!(p.check(&triangle.to_genes()), Err(Refusal::SettleFlat));
@@ -243,7 +308,10 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
         ),
         ("stiffness = [800.0, 50.0]", "morphology.stiffness"),
         ("encoding = \"voxels\"", "voxels"),
-        ("controller = \"neural\"", "morphology.controller"),
+        (
+            "encoding = \"lattice\"\ncontroller = \"neural\"",
+            "morphology.controller",
+        ),
         (
             "encoding = \"lattice\"\ncells = [101, 100, 1]",
             "morphology.cells",
@@ -267,6 +335,17 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
             .to_string();
         assert!(e.starts_with("m.toml:") && e.contains(expect), "{key}: {e}");
     }
+    // Touch sensors need a floor.
+    let e = MorphologyProblem::parse(
+        &with("controller = \"neural\"").replace("[floor]\n", ""),
+        "m.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("morphology.controller") && e.contains("no [floor]"),
+        "{e}"
+    );
     // An [evolve] that names another controller; a body that fails its own
     // checks as a start.
     let t = with("").replace("[evolve]\n", "[evolve]\ncontroller = \"gait\"\n");
@@ -310,7 +389,8 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
 }
 
 /// 100,000 variations (mutants and crossovers, chained as evolution chains
-/// them) from each shipped start: every one is a body that passes the
+/// them) from each shipped start (random graph bodies, with either
+/// controller; the soft walker; the EvoGym lattice): every one is a body that passes the
 /// checks that need no simulation or is refused with a reason, none
 /// panics; every 100th also runs the settle.
 #[test]
@@ -318,6 +398,10 @@ fn a_hundred_thousand_random_variations_are_valid_or_refused_with_a_reason() {
     let walker_start = with("start = \"walker.toml\"");
     let scenes = [
         (walk(), "bodies_walk.toml".to_string()),
+        (
+            std::fs::read_to_string(format!("{ROOT}/scenes/bodies_walk_neural.toml")).unwrap(),
+            "bodies_walk_neural.toml".to_string(),
+        ),
         (walker_start, format!("{ROOT}/scenes/from_walker.toml")),
         (
             std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml")).unwrap(),

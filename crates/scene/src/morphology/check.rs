@@ -6,7 +6,7 @@
 //! its built length) that neither blows up nor collapses flat.
 
 use super::genome::Body;
-use super::{EncodingName, Morphology, AMPLITUDE, FREQUENCY};
+use super::{EncodingName, Morphology, AMPLITUDE, FREQUENCY, TOUCH};
 use animats_engine::DVec3;
 use std::collections::HashSet;
 use std::fmt;
@@ -25,7 +25,8 @@ pub const TORN: f64 = 3.0;
 /// Why a body was refused.
 #[derive(Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Refusal {
-    /// Not a body: a spring joins a particle to itself or repeats a pair.
+    /// Not a body: a spring joins a particle to itself or repeats a pair,
+    /// or its genome is the other controller's.
     Malformed,
     /// Fewer than two particles, or more than `max_particles`.
     Particles,
@@ -97,6 +98,9 @@ fn within(x: f64, (lo, hi): (f64, f64)) -> bool {
 
 /// The checks that need no simulation, cheapest first.
 pub fn static_checks(body: &Body, m: &Morphology) -> Result<(), Refusal> {
+    if body.neural != m.neural {
+        return Err(Refusal::Malformed);
+    }
     let n = body.nodes.len();
     if n < 2 || n > m.max_particles {
         return Err(Refusal::Particles);
@@ -129,6 +133,7 @@ pub fn static_checks(body: &Body, m: &Morphology) -> Result<(), Refusal> {
                     within(mu.amplitude, AMPLITUDE)
                         && within(mu.phase, (-std::f64::consts::PI, std::f64::consts::PI))
                         && within(mu.offset, (0.0, 1.0))
+                        && mu.touch.iter().all(|&w| within(w, TOUCH))
                 })
         });
     if !genes_ok {

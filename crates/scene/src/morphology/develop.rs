@@ -5,9 +5,12 @@
 //! is actuator `body.m{j}` (its rest length from `1 − muscle_strain` to
 //! `1 + muscle_strain` times its built length, level 0.5 at the built
 //! length, at most `muscle_rate` a second), driven by controller `body`, an
-//! oscillator; `[contacts]` (`model = "penalty"`: a force, which stores no
+//! oscillator (or, for a `neural` body, a one-layer network fed by touch
+//! sensor `body.t{i}` on every particle and a clock); `[contacts]` (`model = "penalty"`: a force, which stores no
 //! energy it does not give back) makes the body's spheres collide with
 //! each other (pairs a spring joins never do) unless `self_contact = false`.
+//! The scene's `[evolve]` gets `controller = "body"`, and unless it says
+//! otherwise `robust = true` and `particles` = the body's.
 //!
 //! The text is the one definition of the creature: an evaluation during
 //! evolution parses it exactly as `animats evaluate` parses `best.toml`,
@@ -106,19 +109,34 @@ pub fn develop(
     append(&mut doc, "actuator", actuators)?;
     match brain {
         Brain::Driven => {
-            let mut c = Table::new();
-            c["name"] = value(NAME);
-            c["kind"] = value("oscillator");
-            c["outputs"] = value(oscillator.0.iter().map(String::as_str).collect::<Array>());
-            c["frequency"] = value(body.frequency);
-            c["amplitude"] = value(floats(&oscillator.1));
-            c["phase"] = value(floats(&oscillator.2));
-            c["offset"] = value(floats(&oscillator.3));
+            let c = if body.neural {
+                let sensors = touch_sensors(body.nodes.len());
+                let c = neural(body, &oscillator.0);
+                append(&mut doc, "sensor", sensors)?;
+                c
+            } else {
+                let mut c = Table::new();
+                c["name"] = value(NAME);
+                c["kind"] = value("oscillator");
+                c["outputs"] = value(oscillator.0.iter().map(String::as_str).collect::<Array>());
+                c["frequency"] = value(body.frequency);
+                c["amplitude"] = value(floats(&oscillator.1));
+                c["phase"] = value(floats(&oscillator.2));
+                c["offset"] = value(floats(&oscillator.3));
+                c
+            };
             append(&mut doc, "controller", vec![c])?;
             if let Some(evolve) = doc.get_mut("evolve").and_then(Item::as_table_mut) {
                 evolve["controller"] = value(NAME);
                 if !evolve.contains_key("robust") {
                     evolve["robust"] = value(true);
+                }
+                // The body's centre of mass, not the scene's.
+                if !evolve.contains_key("particles") {
+                    let names: Array = (0..body.nodes.len())
+                        .map(|i| format!("{NAME}.p{i}"))
+                        .collect();
+                    evolve["particles"] = value(names);
                 }
             }
         }
@@ -143,6 +161,56 @@ pub fn develop(
     }
     out.push_str(&doc.to_string());
     Ok(out)
+}
+
+/// A touch sensor `body.t{i}` on every particle (any of them may reach the
+/// floor).
+fn touch_sensors(n: usize) -> Vec<Table> {
+    (0..n)
+        .map(|i| {
+            let mut t = Table::new();
+            t["name"] = value(format!("{NAME}.t{i}"));
+            t["kind"] = value("touch");
+            t["particle"] = value(format!("{NAME}.p{i}"));
+            t
+        })
+        .collect()
+}
+
+/// A `neural` body's controller: one layer from the touch sensors and a
+/// clock at the body's frequency to every muscle. Muscle `j` on the spring
+/// from `a` to `b` computes `σ(4 (offset − ½) + 4 amplitude sin(2π f t +
+/// phase) + 2 touch[0] t_a + 2 touch[1] t_b)`: the network sees a touch
+/// level `t` as `2t − 1`, so its weight on `a`'s sensor is `touch[0]`, and
+/// its bias carries `touch[0] + touch[1]`; `A sin(ωt + φ)` is `A cos φ` on
+/// the clock's sine and `A sin φ` on its cosine.
+fn neural(body: &Body, outputs: &[String]) -> Table {
+    let n = body.nodes.len();
+    let muscles: Vec<_> = body
+        .edges
+        .iter()
+        .filter_map(|e| e.muscle.map(|mu| (e.a, e.b, mu)))
+        .collect();
+    let mut weights = Vec::with_capacity(muscles.len() * (n + 3));
+    for &(a, b, mu) in &muscles {
+        let mut row = vec![0.0; n + 2];
+        row[a] = mu.touch[0];
+        row[b] = mu.touch[1];
+        row[n] = 4.0 * mu.amplitude * libm::cos(mu.phase);
+        row[n + 1] = 4.0 * mu.amplitude * libm::sin(mu.phase);
+        weights.extend(row);
+    }
+    for &(_, _, mu) in &muscles {
+        weights.push(4.0 * (mu.offset - 0.5) + mu.touch[0] + mu.touch[1]);
+    }
+    let mut c = Table::new();
+    c["name"] = value(NAME);
+    c["kind"] = value("neural");
+    c["inputs"] = value((0..n).map(|i| format!("{NAME}.t{i}")).collect::<Array>());
+    c["outputs"] = value(outputs.iter().map(String::as_str).collect::<Array>());
+    c["clock"] = value(body.frequency);
+    c["weights"] = value(floats(&weights));
+    c
 }
 
 fn floats(xs: &[f64]) -> Array {

@@ -1,5 +1,7 @@
 //! A body's genome, as evolution holds it: the particle/spring graph itself
-//! (Framsticks f0-like), with each muscle's oscillator genes on its spring.
+//! (Framsticks f0-like), with each muscle's oscillator genes on its spring
+//! (and, for a `neural` body, the weights of the touch sensors at its two
+//! ends).
 //! A lattice genome ([`super::lattice`]) develops into one of these.
 //!
 //! Evolution's runs hold genomes as `Vec<f64>` (so that checkpoints, logs
@@ -10,8 +12,11 @@
 
 use animats_engine::DVec3;
 
-/// The first gene of a graph genome.
+/// The first gene of a graph genome driven by oscillators.
 pub const GRAPH_TAG: f64 = 1.0;
+/// The first gene of a graph genome whose muscles also feel touch
+/// (`controller = "neural"`).
+pub const NEURAL_TAG: f64 = 3.0;
 
 /// A particle of the body.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -24,8 +29,11 @@ pub struct Node {
     pub radius: f64,
 }
 
-/// A muscle's oscillator genes: its level is
-/// `offset + amplitude sin(2π f t + phase)`.
+/// A muscle's genes. Driven by an oscillator its level is
+/// `offset + amplitude sin(2π f t + phase)`; in a `neural` body it is
+/// `σ(4 (offset − ½) + 4 amplitude sin(2π f t + phase) + 2 touch[0] t_a +
+/// 2 touch[1] t_b)`, with `t_a`, `t_b` 1 while the spring's ends touch the
+/// floor, else 0, and σ the logistic function (near ½ the same slope).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Muscle {
     /// In [0, 0.5].
@@ -34,6 +42,9 @@ pub struct Muscle {
     pub phase: f64,
     /// In [0, 1].
     pub offset: f64,
+    /// The weights of the touch sensors at the spring's ends `a` and `b`,
+    /// each in [`super::TOUCH`] (a `neural` body's; 0 otherwise).
+    pub touch: [f64; 2],
 }
 
 /// A spring between two particles; a muscle if it carries muscle genes.
@@ -59,12 +70,16 @@ pub struct Body {
     pub edges: Vec<Edge>,
     /// Hz, shared by every muscle.
     pub frequency: f64,
+    /// Its muscles feel touch (`controller = "neural"`): the genome carries
+    /// every muscle's `touch` weights.
+    pub neural: bool,
 }
 
 /// Genes a node takes.
 const NODE_GENES: usize = 5;
-/// Genes an edge takes.
+/// Genes an edge takes, and in a `neural` body.
 const EDGE_GENES: usize = 7;
+const NEURAL_EDGE_GENES: usize = 9;
 
 impl Body {
     /// Muscles in the body.
@@ -79,12 +94,18 @@ impl Body {
 
     /// The genes: `[1, particles, springs, frequency]`, then each particle's
     /// `x, y, z, mass, radius`, then each spring's `a, b, stiffness, muscle
-    /// (0 or 1), amplitude, phase, offset`.
+    /// (0 or 1), amplitude, phase, offset`. A `neural` body starts with 3
+    /// and each spring adds `touch_a, touch_b`.
     pub fn to_genes(&self) -> Vec<f64> {
+        let per_edge = if self.neural {
+            NEURAL_EDGE_GENES
+        } else {
+            EDGE_GENES
+        };
         let mut g =
-            Vec::with_capacity(4 + NODE_GENES * self.nodes.len() + EDGE_GENES * self.edges.len());
+            Vec::with_capacity(4 + NODE_GENES * self.nodes.len() + per_edge * self.edges.len());
         g.extend([
-            GRAPH_TAG,
+            if self.neural { NEURAL_TAG } else { GRAPH_TAG },
             self.nodes.len() as f64,
             self.edges.len() as f64,
             self.frequency,
@@ -97,6 +118,7 @@ impl Body {
                 amplitude: 0.0,
                 phase: 0.0,
                 offset: 0.5,
+                touch: [0.0; 2],
             });
             g.extend([
                 e.a as f64,
@@ -107,6 +129,9 @@ impl Body {
                 m.phase,
                 m.offset,
             ]);
+            if self.neural {
+                g.extend(m.touch);
+            }
         }
         g
     }
@@ -117,11 +142,17 @@ impl Body {
         if let Some(i) = g.iter().position(|x| !x.is_finite()) {
             return Err(format!("gene {i} is not finite: {}", g[i]));
         }
-        if g.len() < 4 || g[0] != GRAPH_TAG {
+        if g.len() < 4 || (g[0] != GRAPH_TAG && g[0] != NEURAL_TAG) {
             return Err(
-                "not a body genome: it must start [1, particles, springs, frequency]".into(),
+                "not a body genome: it must start [1, particles, springs, frequency] (3 for a neural body)".into(),
             );
         }
+        let neural = g[0] == NEURAL_TAG;
+        let per_edge = if neural {
+            NEURAL_EDGE_GENES
+        } else {
+            EDGE_GENES
+        };
         let count = |x: f64, what: &str| -> Result<usize, String> {
             if x >= 0.0 && x.fract() == 0.0 && x <= 1e6 {
                 Ok(x as usize)
@@ -131,7 +162,7 @@ impl Body {
         };
         let n = count(g[1], "particles")?;
         let m = count(g[2], "springs")?;
-        let need = 4 + NODE_GENES * n + EDGE_GENES * m;
+        let need = 4 + NODE_GENES * n + per_edge * m;
         if g.len() != need {
             return Err(format!(
                 "a body of {n} particles and {m} springs takes {need} genes, not {}",
@@ -147,7 +178,7 @@ impl Body {
             })
             .collect();
         let edges = g[4 + NODE_GENES * n..]
-            .chunks_exact(EDGE_GENES)
+            .chunks_exact(per_edge)
             .enumerate()
             .map(|(j, c)| {
                 let a = count(c[0], &format!("spring {j}'s first end"))?;
@@ -161,6 +192,7 @@ impl Body {
                         amplitude: c[4],
                         phase: c[5],
                         offset: c[6],
+                        touch: if neural { [c[7], c[8]] } else { [0.0; 2] },
                     }),
                     x => return Err(format!("spring {j}: muscle flag {x} is neither 0 nor 1")),
                 };
@@ -176,6 +208,7 @@ impl Body {
             nodes,
             edges,
             frequency: g[3],
+            neural,
         })
     }
 }
@@ -206,9 +239,11 @@ mod tests {
                     amplitude: 0.2,
                     phase: -1.0,
                     offset: 0.4,
+                    touch: [0.0; 2],
                 }),
             }],
             frequency: 1.5,
+            neural: false,
         }
     }
 
@@ -234,5 +269,24 @@ mod tests {
         let mut nan = g;
         nan[5] = f64::NAN;
         assert!(Body::from_genes(&nan).unwrap_err().contains("not finite"));
+    }
+
+    #[test]
+    fn a_neural_body_carries_two_touch_weights_per_spring() {
+        let mut b = two();
+        b.neural = true;
+        if let Some(mu) = b.edges[0].muscle.as_mut() {
+            mu.touch = [0.7, -0.3];
+        }
+        let g = b.to_genes();
+        assert_eq!(g[0], NEURAL_TAG);
+        assert_eq!(g.len(), 4 + 10 + 9);
+        assert_eq!(Body::from_genes(&g).unwrap(), b);
+        // The same genes read as an oscillator body's are the wrong length.
+        let mut as_graph = g;
+        as_graph[0] = GRAPH_TAG;
+        assert!(Body::from_genes(&as_graph)
+            .unwrap_err()
+            .contains("takes 21 genes"));
     }
 }

@@ -215,6 +215,7 @@ impl Lattice {
                 amplitude: c[0],
                 phase: c[1],
                 offset: c[2],
+                touch: [0.0; 2],
             })
             .collect();
         Ok(Lattice {
@@ -267,6 +268,7 @@ impl Lattice {
             nodes,
             edges: edges.into_values().collect(),
             frequency: self.frequency,
+            neural: false,
         }
     }
 }

@@ -66,7 +66,9 @@ pub struct MorphologyEntry {
     #[serde(default = "default_size")]
     pub size: f64,
     /// `oscillator` (each muscle carries its amplitude, phase and offset
-    /// genes; one shared frequency); default `oscillator`.
+    /// genes; one shared frequency) or `neural` (a network from a touch
+    /// sensor on every particle and a clock to every muscle; graph bodies
+    /// only); default `oscillator`.
     #[serde(default)]
     pub controller: BrainName,
     /// The body's spheres that no spring joins collide with each other;
@@ -124,7 +126,8 @@ pub enum BrainName {
     /// A sine per muscle at one shared frequency.
     #[default]
     Oscillator,
-    /// Touch sensors to muscles (not built yet: refused with a message).
+    /// Touch sensors on every particle and a clock, to every muscle: a
+    /// one-layer network whose weights are the muscles' genes.
     Neural,
 }
 
@@ -217,20 +220,25 @@ pub struct Morphology {
     pub origin: animats_engine::DVec3,
     /// A lattice's shape, if the encoding is one.
     pub lattice: Option<lattice::Shape>,
+    /// `controller = "neural"`: muscles feel touch.
+    pub neural: bool,
 }
 
 /// Frequency bounds of the muscles' shared oscillator, Hz.
 pub const FREQUENCY: (f64, f64) = (0.2, 5.0);
 /// A muscle's amplitude bounds.
 pub const AMPLITUDE: (f64, f64) = (0.0, 0.5);
+/// A `neural` muscle's touch weight bounds.
+pub const TOUCH: (f64, f64) = (-1.0, 1.0);
 
 impl Morphology {
     /// Checks every key, naming the field.
     pub(crate) fn from_entry(at: &At, e: &MorphologyEntry) -> Result<Morphology, SceneError> {
-        if e.controller == BrainName::Neural {
+        let neural = e.controller == BrainName::Neural;
+        if neural && e.encoding == EncodingName::Lattice {
             return Err(at.err(
                 "controller",
-                "`neural` bodies are not built yet: use `oscillator` (docs/BODIES.md)",
+                "`neural` is for graph bodies (a lattice's muscles carry oscillator genes only): use `oscillator`, or encoding = \"graph\"",
             ));
         }
         let range = |field: &str, r: [f64; 2], least: f64| -> Result<(f64, f64), SceneError> {
@@ -261,6 +269,16 @@ impl Morphology {
                 "max_particles",
                 format!(
                     "must be between 2 (the smallest body: two particles and a muscle) and {MAX_BODY_PARTICLES}, got {}",
+                    e.max_particles
+                ),
+            ));
+        }
+        let most = animats_engine::forces::soft_contact::MAX_SPHERES;
+        if e.self_contact && e.max_particles > most {
+            return Err(at.err(
+                "max_particles",
+                format!(
+                    "{} particles with self_contact: penalty contact tests every pair, at most {most} spheres; lower the cap or set self_contact = false",
                     e.max_particles
                 ),
             ));
@@ -329,6 +347,7 @@ impl Morphology {
             restitution: unit("restitution", e.restitution)?,
             origin: at.vec3("origin", e.origin)?,
             lattice,
+            neural,
         })
     }
 }

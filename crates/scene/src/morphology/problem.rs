@@ -61,6 +61,12 @@ impl MorphologyProblem {
                 ));
             }
         }
+        if morphology.neural && def.floor.is_none() {
+            return Err(here.err(
+                "controller",
+                "`neural` bodies feel the floor through touch sensors, and this scene has no [floor]: use `oscillator`",
+            ));
+        }
         // The rest of the scene, checked where the user wrote it.
         def.evolve = None;
         crate::build::build(&def, &src)?;
@@ -78,7 +84,8 @@ impl MorphologyProblem {
                             Muscle {
                                 amplitude: 0.25,
                                 phase: 0.0,
-                                offset: 0.5
+                                offset: 0.5,
+                                touch: [0.0; 2],
                             };
                             s.len()
                         ],
@@ -87,11 +94,11 @@ impl MorphologyProblem {
                     .to_genes(s)
                 })
             }),
-            (path, EncodingName::Graph) => Some(
-                start_body(file, path)
-                    .map_err(|m| here.err("start", m))?
-                    .to_genes(),
-            ),
+            (path, EncodingName::Graph) => {
+                let mut body = start_body(file, path).map_err(|m| here.err("start", m))?;
+                body.neural = morphology.neural;
+                Some(body.to_genes())
+            }
             (_, EncodingName::Lattice) => {
                 return Err(here.err(
                     "start",
@@ -320,6 +327,7 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
                 amplitude: pick(&o.and_then(|o| o.amplitude.clone()), 0.25),
                 phase: vary::wrap(pick(&o.and_then(|o| o.phase.clone()), 0.0)),
                 offset: pick(&o.and_then(|o| o.offset.clone()), 0.5),
+                touch: [0.0; 2],
             }
         });
         edges.push(Edge {
@@ -334,5 +342,6 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
         nodes,
         edges,
         frequency,
+        neural: false,
     })
 }

@@ -6,9 +6,10 @@
 //! Graph mutations (one to three a child): add a particle (joined to its
 //! two or three nearest), remove one (with its springs), add or remove a
 //! spring, move a particle, change a mass, a radius or a stiffness, turn a
-//! spring into a muscle or back, change a muscle's genes, change the
-//! frequency, or nudge every muscle's genes and the frequency a little at
-//! once (the gait's local search). Graph crossover exchanges spatial halves: a random plane
+//! spring into a muscle or back, change a muscle's genes (a `neural`
+//! body's touch weights with them), change the frequency, or nudge every
+//! muscle's genes and the frequency a little at once (the gait's local
+//! search). Graph crossover exchanges spatial halves: a random plane
 //! through each parent's centre keeps one side of the first and the other
 //! side of the second (moved onto the first's centre), and every spring the
 //! cut severed is rejoined to the nearest particle across it.
@@ -19,7 +20,7 @@
 
 use super::genome::{Body, Edge, Muscle, Node};
 use super::lattice::{Lattice, Material, Shape};
-use super::{Morphology, AMPLITUDE, FREQUENCY};
+use super::{Morphology, AMPLITUDE, FREQUENCY, TOUCH};
 use animats_creatures::random::Random;
 use animats_engine::DVec3;
 use std::f64::consts::PI;
@@ -53,11 +54,34 @@ fn log_between(rng: &mut Random, (lo, hi): (f64, f64)) -> f64 {
     (libm::exp(rng.between(libm::log(lo), libm::log(hi)))).clamp(lo, hi)
 }
 
-fn random_muscle(rng: &mut Random) -> Muscle {
-    Muscle {
+/// A muscle with random genes; a `neural` one's touch weights start small
+/// (a reflex evolution grows).
+fn random_muscle(rng: &mut Random, neural: bool) -> Muscle {
+    let mut mu = Muscle {
         amplitude: rng.between(AMPLITUDE.0, AMPLITUDE.1),
         phase: rng.between(-PI, PI),
         offset: rng.between(0.2, 0.8),
+        touch: [0.0; 2],
+    };
+    if neural {
+        mu.touch = [
+            rng.between(0.25 * TOUCH.0, 0.25 * TOUCH.1),
+            rng.between(0.25 * TOUCH.0, 0.25 * TOUCH.1),
+        ];
+    }
+    mu
+}
+
+/// `mu`'s genes nudged by normal steps of `scale` of their ranges (the
+/// phase by `phase_step` rad).
+fn nudge_muscle(rng: &mut Random, mu: &mut Muscle, scale: f64, phase_step: f64, neural: bool) {
+    mu.amplitude = nudge(rng, mu.amplitude, AMPLITUDE, scale);
+    mu.phase = wrap(mu.phase + phase_step * normal(rng));
+    mu.offset = nudge(rng, mu.offset, (0.0, 1.0), scale);
+    if neural {
+        for w in &mut mu.touch {
+            *w = nudge(rng, *w, TOUCH, scale);
+        }
     }
 }
 
@@ -96,7 +120,7 @@ fn spring(rng: &mut Random, m: &Morphology, a: usize, b: usize) -> Edge {
         a,
         b,
         stiffness: log_between(rng, m.stiffness),
-        muscle: (rng.uniform() < 0.5).then(|| random_muscle(rng)),
+        muscle: (rng.uniform() < 0.5).then(|| random_muscle(rng, m.neural)),
     }
 }
 
@@ -113,6 +137,7 @@ pub fn random_body(m: &Morphology, rng: &mut Random) -> Body {
         nodes: Vec::with_capacity(n),
         edges: Vec::new(),
         frequency: rng.between(0.5, 3.0),
+        neural: m.neural,
     };
     for _ in 0..n {
         let radius = rng.between(m.radius.0, r_hi);
@@ -152,7 +177,7 @@ pub fn random_body(m: &Morphology, rng: &mut Random) -> Body {
     }
     if body.muscles() == 0 {
         let k = int(rng, 0, body.edges.len() - 1);
-        body.edges[k].muscle = Some(random_muscle(rng));
+        body.edges[k].muscle = Some(random_muscle(rng, m.neural));
     }
     body
 }
@@ -221,17 +246,16 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
                 let e = &mut body.edges[k];
                 e.muscle = match e.muscle {
                     Some(_) => None,
-                    None => Some(random_muscle(rng)),
+                    None => Some(random_muscle(rng, body.neural)),
                 };
             }
         }
         9 => {
             let muscles: Vec<usize> = (0..s).filter(|&k| body.edges[k].muscle.is_some()).collect();
             if let Some(&k) = muscles.get(int(rng, 0, muscles.len().max(1) - 1)) {
+                let neural = body.neural;
                 if let Some(mu) = body.edges[k].muscle.as_mut() {
-                    mu.amplitude = nudge(rng, mu.amplitude, AMPLITUDE, 0.1);
-                    mu.phase = wrap(mu.phase + 0.2 * PI * normal(rng));
-                    mu.offset = nudge(rng, mu.offset, (0.0, 1.0), 0.1);
+                    nudge_muscle(rng, mu, 0.1, 0.2 * PI, neural);
                 }
             }
         }
@@ -239,11 +263,10 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
         _ => {
             // The whole brain at once, a little: every muscle's genes and
             // the frequency (a local search of the gait on a fixed body).
+            let neural = body.neural;
             for e in &mut body.edges {
                 if let Some(mu) = e.muscle.as_mut() {
-                    mu.amplitude = nudge(rng, mu.amplitude, AMPLITUDE, 0.03);
-                    mu.phase = wrap(mu.phase + 0.05 * PI * normal(rng));
-                    mu.offset = nudge(rng, mu.offset, (0.0, 1.0), 0.03);
+                    nudge_muscle(rng, mu, 0.03, 0.05 * PI, neural);
                 }
             }
             body.frequency = nudge(rng, body.frequency, FREQUENCY, 0.01);
@@ -317,6 +340,7 @@ pub fn cross_bodies(a: &Body, b: &Body, rng: &mut Random) -> Body {
         } else {
             b.frequency
         },
+        neural: a.neural,
     };
     let mut index_a = vec![usize::MAX; a.nodes.len()];
     for (i, n) in a.nodes.iter().enumerate().filter(|(i, _)| keep_a[*i]) {
@@ -373,7 +397,9 @@ pub fn random_lattice(shape: &Shape, rng: &mut Random) -> Lattice {
             }
         })
         .collect();
-    let muscles = (0..shape.len()).map(|_| random_muscle(rng)).collect();
+    let muscles = (0..shape.len())
+        .map(|_| random_muscle(rng, false))
+        .collect();
     Lattice {
         materials,
         muscles,
@@ -398,9 +424,7 @@ pub fn mutate_lattice(parent: &Lattice, rng: &mut Random) -> Lattice {
     }
     for _ in 0..int(rng, 0, 2) {
         let mu = &mut l.muscles[int(rng, 0, n - 1)];
-        mu.amplitude = nudge(rng, mu.amplitude, AMPLITUDE, 0.1);
-        mu.phase = wrap(mu.phase + 0.2 * PI * normal(rng));
-        mu.offset = nudge(rng, mu.offset, (0.0, 1.0), 0.1);
+        nudge_muscle(rng, mu, 0.1, 0.2 * PI, false);
     }
     if rng.uniform() < 0.2 {
         l.frequency = nudge(rng, l.frequency, FREQUENCY, 0.05);
