@@ -122,7 +122,11 @@ fn ms(t: f64) -> String {
 }
 
 fn print_row(r: &Row) {
-    let rate = if r.dt == 0.0 {
+    let rate = if r.dt == 0.0 && r.particles == 0 {
+        // A row timed per item (a body evaluated, a child made): items a
+        // second.
+        format!("{}/s", si(1.0 / r.engine.median))
+    } else if r.dt == 0.0 {
         // Nothing simulated (scene-load): what was built, per second.
         format!(
             "{}/s particles built",

@@ -14,9 +14,14 @@
 //! body without contacts went nowhere; docs/BODIES.md). A force does only
 //! the work its potential gives back.
 //!
-//! Every pair of the targets is tested (the bodies it is meant for have
-//! tens of spheres), but for the pairs a spring or joint joins, given as
-//! excluded.
+//! Every pair of the targets may touch but for the pairs a spring or joint
+//! joins, given as excluded. Up to [`SWEEP_FROM`] spheres every pair is
+//! tested each step; from there a sweep along x (the spheres kept sorted by
+//! their lowest x, an insertion sort of last step's order) marks the pairs
+//! whose boxes overlap, and only those are tested, in the same order as
+//! all pairs would be: the pairs it skips are ones the test would skip, so
+//! the forces, and every bit of a run, are the same either way
+//! (`crates/engine/tests/soft_contact.rs` compares them).
 
 use crate::error::ModelError;
 use crate::force::{Force, ForceContext};
@@ -27,6 +32,9 @@ use std::collections::HashSet;
 /// The most spheres one soft contact may test (all pairs: a million).
 pub const MAX_SPHERES: usize = 1415;
 
+/// From this many spheres a sweep finds the pairs worth testing.
+pub const SWEEP_FROM: usize = 32;
+
 /// Penalty contact among a set of spheres.
 #[derive(Clone, Debug)]
 pub struct SoftContact {
@@ -34,8 +42,27 @@ pub struct SoftContact {
     pub stiffness: f64,
     /// N s/m.
     pub damping: f64,
-    /// The pairs tested, as particle indices.
+    /// The pairs that may touch, as particle indices, in the order their
+    /// forces are added.
     pairs: Vec<(u32, u32)>,
+    /// The sweep, from [`SWEEP_FROM`] spheres.
+    sweep: Option<Sweep>,
+}
+
+/// What the sweep keeps between steps.
+#[derive(Clone, Debug)]
+struct Sweep {
+    /// The spheres' particle indices.
+    spheres: Vec<u32>,
+    /// `pair_of[i * n + j]` (i < j, positions in `spheres`): the index in
+    /// `pairs` of that pair, or `u32::MAX` if it is excluded.
+    pair_of: Vec<u32>,
+    /// Positions in `spheres`, sorted by lowest x (last step's order).
+    order: Vec<u32>,
+    /// Each sphere's lowest x this step, by position in `spheres`.
+    low: Vec<f64>,
+    /// One bit a pair: marked by the sweep this step.
+    marked: Vec<u64>,
 }
 
 impl SoftContact {
@@ -70,44 +97,147 @@ impl SoftContact {
         let key =
             |a: ParticleId, b: ParticleId| (a.index().min(b.index()), a.index().max(b.index()));
         let skip: HashSet<(usize, usize)> = excluded.iter().map(|&(a, b)| key(a, b)).collect();
+        let n = spheres.len();
+        let swept = n >= SWEEP_FROM;
+        let mut pair_of = if swept {
+            vec![u32::MAX; n * n]
+        } else {
+            Vec::new()
+        };
         let mut pairs = Vec::new();
         for (i, &a) in spheres.iter().enumerate() {
-            for &b in &spheres[i + 1..] {
+            for (j, &b) in spheres.iter().enumerate().skip(i + 1) {
                 if a != b && !skip.contains(&key(a, b)) {
+                    if swept {
+                        pair_of[i * n + j] = pairs.len() as u32;
+                    }
                     pairs.push((a.index() as u32, b.index() as u32));
                 }
             }
         }
+        let sweep = swept.then(|| Sweep {
+            spheres: spheres.iter().map(|p| p.index() as u32).collect(),
+            pair_of,
+            order: (0..n as u32).collect(),
+            low: vec![0.0; n],
+            marked: vec![0; pairs.len().div_ceil(64)],
+        });
         Ok(SoftContact {
             stiffness,
             damping,
             pairs,
+            sweep,
         })
     }
 
-    /// The pairs tested.
+    /// The pairs that may touch (all but the excluded).
     pub fn pairs(&self) -> usize {
         self.pairs.len()
+    }
+
+    /// The same contact testing every pair every step, however many
+    /// spheres (the sweep's reference: the forces are the same to the bit).
+    pub fn every_pair(mut self) -> SoftContact {
+        self.sweep = None;
+        self
+    }
+
+    /// True if a sweep picks the pairs to test.
+    pub fn sweeps(&self) -> bool {
+        self.sweep.is_some()
+    }
+}
+
+impl SoftContact {
+    /// The force of pair `(a, b)` on both, if they overlap.
+    #[inline]
+    fn pair(&self, (a, b): (u32, u32), ctx: &ForceContext, forces: &mut [DVec3]) {
+        let r = &ctx.particles.radius;
+        let (a, b) = (a as usize, b as usize);
+        let d = ctx.pos[b] - ctx.pos[a];
+        let dist = d.length();
+        let overlap = r[a] + r[b] - dist;
+        if overlap <= 0.0 || dist <= 0.0 {
+            return;
+        }
+        let n = d / dist;
+        let separating = (ctx.vel[b] - ctx.vel[a]).dot(n);
+        let push = (self.stiffness * overlap - self.damping * separating).max(0.0);
+        forces[a] -= n * push;
+        forces[b] += n * push;
+    }
+}
+
+impl Sweep {
+    /// Marks every pair whose boxes overlap (with a margin, and any pair
+    /// with a coordinate that is not a number): a superset of the pairs
+    /// that touch.
+    fn mark(&mut self, ctx: &ForceContext) {
+        let r = &ctx.particles.radius;
+        let n = self.spheres.len();
+        for (k, &p) in self.spheres.iter().enumerate() {
+            let p = p as usize;
+            self.low[k] = ctx.pos[p].x - r[p];
+        }
+        // Insertion sort from last step's order: nearly sorted, so about
+        // linear. Not-a-number sorts last and is swept with everything.
+        let low = &self.low;
+        let before = |x: f64, y: f64| x < y || (y.is_nan() && !x.is_nan());
+        for i in 1..n {
+            let mut j = i;
+            while j > 0 && before(low[self.order[j] as usize], low[self.order[j - 1] as usize]) {
+                self.order.swap(j, j - 1);
+                j -= 1;
+            }
+        }
+        const MARGIN: f64 = 1.0 + 1e-9;
+        for (at, &i) in self.order.iter().enumerate() {
+            let i = i as usize;
+            let a = self.spheres[i] as usize;
+            let (pa, ra) = (ctx.pos[a], r[a]);
+            // The margin covers rounding in `low` and `high` too.
+            let high = pa.x + ra * MARGIN + 1e-12 * (1.0 + pa.x.abs());
+            for &j in &self.order[at + 1..] {
+                let j = j as usize;
+                let b = self.spheres[j] as usize;
+                // Sorted by lowest x: none further on reaches back to `a`.
+                if low[j] > high {
+                    break;
+                }
+                let reach = (ra + r[b]) * MARGIN;
+                let d = ctx.pos[b] - pa;
+                if d.y.abs() > reach || d.z.abs() > reach {
+                    continue;
+                }
+                let (lo, hi) = (i.min(j), i.max(j));
+                let pair = self.pair_of[lo * n + hi];
+                if pair != u32::MAX {
+                    self.marked[pair as usize / 64] |= 1 << (pair % 64);
+                }
+            }
+        }
     }
 }
 
 impl Force for SoftContact {
     fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
-        let r = &ctx.particles.radius;
-        for &(a, b) in &self.pairs {
-            let (a, b) = (a as usize, b as usize);
-            let d = ctx.pos[b] - ctx.pos[a];
-            let dist = d.length();
-            let overlap = r[a] + r[b] - dist;
-            if overlap <= 0.0 || dist <= 0.0 {
-                continue;
+        let Some(mut sweep) = self.sweep.take() else {
+            for k in 0..self.pairs.len() {
+                self.pair(self.pairs[k], ctx, forces);
             }
-            let n = d / dist;
-            let separating = (ctx.vel[b] - ctx.vel[a]).dot(n);
-            let push = (self.stiffness * overlap - self.damping * separating).max(0.0);
-            forces[a] -= n * push;
-            forces[b] += n * push;
+            return;
+        };
+        sweep.mark(ctx);
+        // The marked pairs in the order of `pairs`, each mark cleared.
+        for w in 0..sweep.marked.len() {
+            let mut bits = std::mem::take(&mut sweep.marked[w]);
+            while bits != 0 {
+                let k = w * 64 + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                self.pair(self.pairs[k], ctx, forces);
+            }
         }
+        self.sweep = Some(sweep);
     }
 
     fn potential_energy(&self, ctx: &ForceContext) -> f64 {
