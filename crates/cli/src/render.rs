@@ -69,13 +69,15 @@ pub struct Args {
     /// The scene file (TOML); with --zoo, the directory of an `animats
     /// evolve` run of a [morphology] scene.
     scene: PathBuf,
-    /// With --zoo, more runs' directories: each run's best body first (the
-    /// best run first), then each run's second best, and so on.
+    /// With --zoo, more runs' directories: each run's (and each lane's)
+    /// best body first, the best of them first, then each one's second
+    /// best, and so on.
     #[arg(requires = "zoo")]
     more_runs: Vec<PathBuf>,
     /// The run's best bodies side by side, each walking in its own
     /// picture captioned with its rank and fitness: this many (default 6),
-    /// the best first, from the bodies alive at the run's last checkpoint.
+    /// from the bodies alive at the run's last checkpoint: each lane's best
+    /// (the best first), then each lane's second, and so on.
     #[arg(long, num_args = 0..=1, default_missing_value = "6", value_parser = clap::value_parser!(u32).range(1..=36))]
     zoo: Option<u32>,
     /// Simulated seconds to render.
@@ -425,24 +427,34 @@ fn zoo(args: &Args) -> Result<(), Failure> {
             )));
         }
         let state = animats_evolve::checkpoint::load(&checkpoint).map_err(Failure::Input)?;
-        let bodies = state.best_bodies(count).ok_or_else(|| {
+        let bodies = state.best_bodies(usize::MAX).ok_or_else(|| {
             Failure::Input(format!(
                 "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
                 dir.display()
             ))
         })?;
         let problem = state.config.problem.build().map_err(Failure::Input)?;
-        runs.push((dir, problem, bodies));
+        // Each lane of the run on its own, best first.
+        let mut lanes: Vec<Vec<(Vec<f64>, f64, usize)>> = Vec::new();
+        for body in bodies {
+            match lanes.iter_mut().find(|l| l[0].2 == body.2) {
+                Some(l) => l.push(body),
+                None => lanes.push(vec![body]),
+            }
+        }
+        runs.push((dir, problem, lanes));
     }
-    // Rank by rank: every run's best (the best run first), then every
-    // run's second, until `count`.
+    // Rank by rank: every lane's best (the best first), then every lane's
+    // second, until `count`: as many different lineages as there are.
     let mut bodies = Vec::with_capacity(count);
     for rank in 0.. {
         let mut at_rank: Vec<_> = runs
             .iter()
-            .filter_map(|(dir, problem, list)| {
-                list.get(rank)
-                    .map(|(g, f, lane)| (*dir, problem, g.clone(), *f, *lane))
+            .flat_map(|(dir, problem, lanes)| {
+                lanes.iter().filter_map(move |list| {
+                    list.get(rank)
+                        .map(|(g, f, lane)| (*dir, problem, g.clone(), *f, *lane))
+                })
             })
             .collect();
         if at_rank.is_empty() || bodies.len() == count {

@@ -159,6 +159,39 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     assert_eq!(ranked[0].0.to_bits(), hi.to_bits(), "{listing}");
     assert_eq!(ranked[1].0.to_bits(), lo.to_bits(), "{listing}");
     assert_ne!(ranked[0].1, ranked[1].1, "one from each run: {listing}");
+    // Lanes too: each lane's best comes before any lane's second.
+    let lanes = dir.join("lanes");
+    let o = animats(&[
+        "evolve",
+        &scene,
+        "--population",
+        "4",
+        "--lanes",
+        "2",
+        "--seed",
+        "9",
+        "--generations",
+        "1",
+        "--out",
+        lanes.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o).1);
+    let z = animats(&[
+        "render",
+        lanes.to_str().unwrap(),
+        "--zoo",
+        "2",
+        "--seconds",
+        "0.2",
+        "--out",
+        dir.join("zoo3.png").to_str().unwrap(),
+    ]);
+    let (listing, err) = text(&z);
+    assert!(z.status.success(), "{err}");
+    assert!(
+        listing.contains("(lane 0)") && listing.contains("(lane 1)"),
+        "{listing}"
+    );
     // A controller's run has no bodies to show.
     let o = animats(&[
         "render",

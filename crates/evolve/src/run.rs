@@ -423,7 +423,7 @@ impl State {
             }
         }
         all.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.2.cmp(&b.2)));
-        let mut out: Vec<(Vec<f64>, f64, usize)> = Vec::with_capacity(n);
+        let mut out: Vec<(Vec<f64>, f64, usize)> = Vec::with_capacity(n.min(all.len()));
         for body in all {
             if out.len() == n {
                 break;
