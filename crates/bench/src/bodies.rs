@@ -12,7 +12,7 @@
 //!   evaluation (one run at the scene's step instead of two), on one
 //!   thread: what each costs.
 
-use crate::{measure, measure_pair, Check, Row, Timing};
+use crate::{measure, measure_pair, pool, Check, Row, Timing};
 use animats_evolve::optimiser::body_ga::BodyGa;
 use animats_evolve::problem::BodyEvolution;
 use animats_scene::morphology::MorphologyProblem;
@@ -20,13 +20,6 @@ use rayon::prelude::*;
 
 /// Bodies a timed run evaluates.
 const POPULATION: usize = 16;
-
-fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())
-}
 
 /// Runs the workload for both tasks.
 pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {

@@ -4,7 +4,7 @@
 //! efficiency); and CMA-ES's own time per generation (ask and tell) against
 //! the time its evaluations take.
 
-use crate::{measure, measure_pair, Check, Row};
+use crate::{measure, measure_pair, pool, Check, Row};
 use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 use animats_scene::evaluate::SceneProblem;
 use rayon::prelude::*;
@@ -12,13 +12,6 @@ use rayon::prelude::*;
 /// Genomes evaluated per timed run: a population of two CMA-ES
 /// generations' size, so that two threads get equal shares.
 const POPULATION: usize = 16;
-
-fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| e.to_string())
-}
 
 /// Runs the workload for the evolved walker and quadruped
 /// (`scenes/walker_evolved.toml`, `scenes/quadruped3_walk.toml`).

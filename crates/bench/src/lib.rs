@@ -43,6 +43,15 @@ pub const WORKLOADS: [&str; 10] = [
 /// Workloads run only when named (they take minutes).
 pub const ON_REQUEST: [&str; 3] = ["implicit", "contacts", "bodies"];
 
+/// A rayon pool of `threads` threads, for workloads that time one against
+/// two.
+pub(crate) fn pool(threads: usize) -> Result<rayon::ThreadPool, String> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())
+}
+
 /// True when `name` is a workload, run by default or on request.
 pub fn is_workload(name: &str) -> bool {
     WORKLOADS.contains(&name) || ON_REQUEST.contains(&name)

@@ -518,15 +518,20 @@ impl SceneProblem {
             .and_then(|a| a.get_mut(k))
             .ok_or_else(|| format!("{kind}[{k}] is not where the scene had it"))?;
         write_genome(table, &self.keys, genome)?;
-        let mut out = String::new();
-        for line in comment.lines() {
-            out.push_str("# ");
-            out.push_str(line);
-            out.push('\n');
-        }
-        out.push_str(&doc.to_string());
-        Ok(out)
+        Ok(commented(comment, &doc))
     }
+}
+
+/// `doc`'s text preceded by `comment` as `#` lines: how `best.toml` opens.
+pub(crate) fn commented(comment: &str, doc: &toml_edit::DocumentMut) -> String {
+    let mut out = String::new();
+    for line in comment.lines() {
+        out.push_str("# ");
+        out.push_str(line);
+        out.push('\n');
+    }
+    out.push_str(&doc.to_string());
+    out
 }
 
 /// Writes `genome` into a brain's `table`, key by key as the brain's

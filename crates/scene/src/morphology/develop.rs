@@ -66,10 +66,13 @@ pub fn develop(
 ) -> Result<String, String> {
     let mut doc = base.clone();
     let at = placed(body, m);
+    let names: Vec<String> = (0..body.nodes.len())
+        .map(|i| format!("{NAME}.p{i}"))
+        .collect();
     let mut particles = Vec::with_capacity(body.nodes.len());
-    for (i, (n, p)) in body.nodes.iter().zip(&at).enumerate() {
+    for ((n, p), name) in body.nodes.iter().zip(&at).zip(&names) {
         let mut t = Table::new();
-        t["name"] = value(format!("{NAME}.p{i}"));
+        t["name"] = value(name.as_str());
         t["mass"] = value(n.mass);
         t["position"] = value(floats(&[p.x, p.y, p.z]));
         t["radius"] = value(n.radius);
@@ -110,7 +113,7 @@ pub fn develop(
     match brain {
         Brain::Driven => {
             let c = if body.neural {
-                let sensors = touch_sensors(body.nodes.len());
+                let sensors = touch_sensors(&names);
                 let c = neural(body, &oscillator.0);
                 append(&mut doc, "sensor", sensors)?;
                 c
@@ -133,10 +136,7 @@ pub fn develop(
                 }
                 // The body's centre of mass, not the scene's.
                 if !evolve.contains_key("particles") {
-                    let names: Array = (0..body.nodes.len())
-                        .map(|i| format!("{NAME}.p{i}"))
-                        .collect();
-                    evolve["particles"] = value(names);
+                    evolve["particles"] = value(all(&names));
                 }
             }
         }
@@ -146,32 +146,29 @@ pub fn develop(
     }
     if m.self_contact && !doc.contains_key("contacts") {
         let mut t = Table::new();
-        let names: Array = (0..body.nodes.len())
-            .map(|i| format!("{NAME}.p{i}"))
-            .collect();
-        t["particles"] = value(names);
+        t["particles"] = value(all(&names));
         t["model"] = value("penalty");
         doc["contacts"] = Item::Table(t);
     }
-    let mut out = String::new();
-    for line in comment.lines() {
-        out.push_str("# ");
-        out.push_str(line);
-        out.push('\n');
-    }
-    out.push_str(&doc.to_string());
-    Ok(out)
+    Ok(crate::evaluate::commented(comment, &doc))
+}
+
+/// `names` as a TOML array.
+fn all(names: &[String]) -> Array {
+    names.iter().map(String::as_str).collect()
 }
 
 /// A touch sensor `body.t{i}` on every particle (any of them may reach the
 /// floor).
-fn touch_sensors(n: usize) -> Vec<Table> {
-    (0..n)
-        .map(|i| {
+fn touch_sensors(particles: &[String]) -> Vec<Table> {
+    particles
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
             let mut t = Table::new();
             t["name"] = value(format!("{NAME}.t{i}"));
             t["kind"] = value("touch");
-            t["particle"] = value(format!("{NAME}.p{i}"));
+            t["particle"] = value(p.as_str());
             t
         })
         .collect()
