@@ -22,7 +22,8 @@ pub struct Args {
     /// `roobot` only: which lane's set to take from a parameter file.
     #[arg(long)]
     lane: Option<usize>,
-    /// Print one JSON object (`fitness`, `distance`, `time`, `ended`).
+    /// Print one JSON object (`fitness`, `distance`, `time`, `ended`, and
+    /// `measures` for a scene with an `[archive]`).
     #[arg(long)]
     json: bool,
 }
@@ -69,18 +70,26 @@ pub fn run(args: Args) -> Result<(), Failure> {
 fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Failure> {
     let (fitness, distance, time, ended) = (e.fitness, e.distance, e.time, e.ended.to_string());
     if json {
-        let out = serde_json::json!({
+        let mut out = serde_json::json!({
             "fitness": fitness,
             "distance": distance,
             "time": time,
             "ended": ended,
         });
+        // A scene with an [archive] adds its measures, in order.
+        if !e.measures.is_empty() {
+            out["measures"] = serde_json::json!(e.measures);
+        }
         println!("{out}");
     } else {
         println!("fitness   {fitness}");
         println!("distance  {distance} m");
         println!("time      {time} s");
         println!("ended     {ended}");
+        if !e.measures.is_empty() {
+            let m: Vec<String> = e.measures.iter().map(|x| x.to_string()).collect();
+            println!("measures  {}", m.join(" "));
+        }
     }
     Ok(())
 }

@@ -119,6 +119,12 @@ fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
             }
         }
     }
+    if let Some(csv) = state.archive_csv() {
+        animats_files::write_atomically(&dir.join("archive.csv"), csv.as_bytes()).map_err(io)?;
+    }
+    if at_end && state.archive().is_some() {
+        save_elites(dir, state)?;
+    }
     if at_end {
         let y_label = "best fitness";
         let plot = Plot {
@@ -144,6 +150,59 @@ fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
         animats_files::write_atomically(&dir.join("fitness.png"), &png).map_err(io)?;
     }
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
+}
+
+/// A quality-diversity run's `elites/<index>.toml` (each elite as a whole
+/// scene) and `archive.png` (the heat map).
+fn save_elites(dir: &Path, state: &State) -> Result<(), Failure> {
+    let io = Failure::Other;
+    let Some(archive) = state.archive() else {
+        return Ok(());
+    };
+    let elites = dir.join("elites");
+    std::fs::create_dir_all(&elites)
+        .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", elites.display())))?;
+    for e in archive.elites() {
+        if let Some(text) = state.elite_toml(e.index).map_err(io)? {
+            let path = elites.join(format!("{}.toml", e.index));
+            animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
+        }
+    }
+    let png = animats_render::heatmap_png(&heatmap(state, archive)).map_err(io)?;
+    animats_files::write_atomically(&dir.join("archive.png"), &png).map_err(io)
+}
+
+/// The archive's heat map: the first two measures, each cell coloured by
+/// the best objective over the rest.
+pub fn heatmap(
+    state: &State,
+    archive: &animats_evolve::archive::GridArchive,
+) -> animats_render::Heatmap {
+    let g = &archive.grid;
+    let mut best: std::collections::BTreeMap<(u64, u64), f64> = Default::default();
+    for e in archive.elites() {
+        let c = archive.unravel(e.index);
+        let key = (c[0], c.get(1).copied().unwrap_or(0));
+        let f = best.entry(key).or_insert(f64::NEG_INFINITY);
+        *f = f.max(e.objective);
+    }
+    let s = archive.stats();
+    animats_render::Heatmap {
+        title: format!(
+            "{} ({}, seed {}): coverage {:.1} %, QD score {:.4e}",
+            state.config.problem.file,
+            state.config.optimiser.name(),
+            state.config.seed,
+            100.0 * s.coverage,
+            s.qd_score
+        ),
+        x_label: g.names[0].clone(),
+        y_label: g.names.get(1).cloned().unwrap_or_default(),
+        bins: (g.bins[0], g.bins.get(1).copied().unwrap_or(1)),
+        ranges: (g.ranges[0], g.ranges.get(1).copied().unwrap_or((0.0, 1.0))),
+        cells: best.into_iter().map(|((i, j), f)| (i, j, f)).collect(),
+        size: (900, 700),
+    }
 }
 
 /// Shows the best so far to the viewer.
@@ -379,11 +438,27 @@ pub fn run(args: Args) -> Result<(), Failure> {
             animats_scene::morphology::vary::RETRIES + 1
         );
     }
+    if let Some(a) = state.archive() {
+        let s = a.stats();
+        println!(
+            "  archive: {} of {} cells ({:.1} %), QD score {}, best {}",
+            s.elites,
+            a.cells(),
+            100.0 * s.coverage,
+            s.qd_score,
+            s.obj_max.unwrap_or(f64::NAN)
+        );
+    }
     println!(
-        "wrote {}/log.csv, best.toml, {}fitness.png, {CHECKPOINT}",
+        "wrote {}/log.csv, best.toml, {}{}fitness.png, {CHECKPOINT}",
         dir.display(),
         if state.config.lanes > 1 {
             "lanes/, "
+        } else {
+            ""
+        },
+        if state.archive().is_some() {
+            "archive.csv, archive.png, elites/, "
         } else {
             ""
         }

@@ -44,6 +44,10 @@ pub trait Problem: Send + Sync {
     fn stats(&self, _genome: &[f64]) -> Option<BodyStats> {
         None
     }
+    /// The scene's `[archive]` grid and settings, if it has one.
+    fn grid(&self) -> Option<&animats_scene::archive::Grid> {
+        None
+    }
     /// The whole scene with `genome` written in, preceded by `comment` as
     /// `#` lines: what `best.toml` holds.
     fn scene_toml(&self, _genome: &[f64], _comment: &str) -> Result<String, String> {
@@ -74,6 +78,9 @@ impl Problem for SceneEvolution {
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())
+    }
+    fn grid(&self) -> Option<&animats_scene::archive::Grid> {
+        self.0.grid()
     }
     fn scene_toml(&self, genome: &[f64], comment: &str) -> Result<String, String> {
         self.0.best_toml(genome, comment)
@@ -106,6 +113,9 @@ impl Problem for BodyEvolution {
     }
     fn variation(&self) -> Option<&dyn Variation> {
         Some(self)
+    }
+    fn grid(&self) -> Option<&animats_scene::archive::Grid> {
+        self.0.grid()
     }
     fn stats(&self, genome: &[f64]) -> Option<BodyStats> {
         self.0.stats(genome)

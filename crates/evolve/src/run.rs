@@ -138,18 +138,33 @@ impl Config {
         } else {
             OptimiserKind::HillClimber
         });
-        if bodies != (optimiser == OptimiserKind::BodyGa) {
-            return Err(if bodies {
-                format!(
-                    "optimiser: a [morphology] scene's bodies evolve with body-ga, not {} (its genomes change shape as bodies grow)",
-                    optimiser.name()
-                )
-            } else {
-                "optimiser: body-ga evolves bodies: give it a scene with a [morphology] table"
-                    .into()
-            });
+        let qd = optimiser.qd().is_some();
+        if bodies && !(optimiser == OptimiserKind::BodyGa || optimiser == OptimiserKind::MapElites)
+        {
+            return Err(format!(
+                "optimiser: a [morphology] scene's bodies evolve with body-ga or map-elites, not {} (its genomes change shape as bodies grow)",
+                optimiser.name()
+            ));
         }
-        if bodies && spec.log == LogName::Improvements {
+        if !bodies && optimiser == OptimiserKind::BodyGa {
+            return Err(
+                "optimiser: body-ga evolves bodies: give it a scene with a [morphology] table"
+                    .into(),
+            );
+        }
+        if qd && built.grid().is_none() {
+            return Err(format!(
+                "optimiser: {} fills an archive: the scene needs an [archive] table naming its measures, bins and ranges (docs/DIVERSITY.md)",
+                optimiser.name()
+            ));
+        }
+        if qd && choices.lanes.is_some_and(|l| l != 1) {
+            return Err(format!(
+                "lanes: a {} run fills one archive; widen it with more emitters (`[archive] emitters`) or a larger --population",
+                optimiser.name()
+            ));
+        }
+        if bodies && !qd && spec.log == LogName::Improvements {
             return Err(
                 "[evolve] log: a [morphology] scene logs generations (its genomes have no fixed columns)"
                     .into(),
@@ -162,15 +177,21 @@ impl Config {
             ));
         }
         let config = Config {
-            lanes: choices.lanes.or(spec.lanes).unwrap_or(1),
+            lanes: if qd {
+                1
+            } else {
+                choices.lanes.or(spec.lanes).unwrap_or(1)
+            },
             generations: choices.generations.unwrap_or(DEFAULT_GENERATIONS),
             seed: choices.seed.unwrap_or(1),
             optimiser,
             population: choices.population,
             restarts: choices.restarts.unwrap_or(0),
+            // A quality-diversity run logs every generation: its archive's
+            // statistics change when its best does not.
             log: match spec.log {
-                LogName::Generations => LogMode::Generations,
-                LogName::Improvements => LogMode::Improvements,
+                LogName::Improvements if !qd => LogMode::Improvements,
+                _ => LogMode::Generations,
             },
             problem,
         };
@@ -266,6 +287,22 @@ pub struct LogRow {
     /// A `[morphology]` run: variations the lane has refused so far.
     #[serde(default)]
     pub refused: Option<u64>,
+    /// A quality-diversity run: its archive after this generation.
+    #[serde(default)]
+    pub archive: Option<ArchiveRow>,
+}
+
+/// A quality-diversity run's archive after a generation (pyribs's stats).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ArchiveRow {
+    /// Elites.
+    pub elites: usize,
+    /// Occupied share of the cells.
+    pub coverage: f64,
+    /// Σ (objective − `[archive] qd_offset`) over the elites.
+    pub qd_score: f64,
+    /// The best objective ever inserted.
+    pub obj_max: f64,
 }
 
 /// The best a lane has found.
@@ -323,7 +360,11 @@ impl State {
                     lane,
                     generation: 0,
                     evaluations: 0,
-                    optimiser: AnyOptimiser::new(&config.setup(problem.as_ref(), lane))?,
+                    optimiser: AnyOptimiser::with_archive(
+                        &config.setup(problem.as_ref(), lane),
+                        problem.grid(),
+                        problem.variation().is_some(),
+                    )?,
                     best: None,
                 })
             })
@@ -509,7 +550,9 @@ impl State {
     /// The problem, built, when its bodies evolve (asking and telling need
     /// its variation and its bodies' sizes); `None` otherwise.
     fn bodies(&self) -> Result<Option<Box<dyn Problem>>, String> {
-        if self.config.optimiser == OptimiserKind::BodyGa {
+        if self.config.optimiser == OptimiserKind::BodyGa
+            || self.config.optimiser == OptimiserKind::MapElites
+        {
             self.config.problem.build().map(Some)
         } else {
             Ok(None)
@@ -625,10 +668,15 @@ impl State {
                 out.push('\n');
             }
         } else {
-            let bodies = self.config.optimiser == OptimiserKind::BodyGa;
+            let bodies = self.log.iter().any(|r| r.body.is_some())
+                || self.config.optimiser == OptimiserKind::BodyGa;
+            let qd = self.config.optimiser.qd().is_some();
             out.push_str("lane,generation,evaluations,fitness,best_fitness,time,distance,ended");
             if bodies {
                 out.push_str(",particles,springs,muscles,mass,refused");
+            }
+            if qd {
+                out.push_str(",elites,coverage,qd_score,obj_max");
             }
             out.push('\n');
             for r in &self.log {
@@ -649,10 +697,112 @@ impl State {
                     }
                     out.push_str(&format!(",{}", r.refused.unwrap_or(0)));
                 }
+                if qd {
+                    match &r.archive {
+                        Some(a) => {
+                            out.push_str(&format!(",{}", a.elites));
+                            for x in [a.coverage, a.qd_score, a.obj_max] {
+                                out.push(',');
+                                out.push_str(b.format(x));
+                            }
+                        }
+                        None => out.push_str(",,,,"),
+                    }
+                }
                 out.push('\n');
             }
         }
         out
+    }
+
+    /// The archive of a quality-diversity run (its one lane's).
+    pub fn archive(&self) -> Option<&crate::archive::GridArchive> {
+        self.lanes.first().and_then(|l| l.optimiser.archive())
+    }
+
+    /// Elite `index` of a quality-diversity run as a whole scene
+    /// (`elites/<index>.toml`): `animats evaluate` reproduces its fitness
+    /// and measures bit for bit.
+    pub fn elite_toml(&self, index: u64) -> Result<Option<String>, String> {
+        let Some(archive) = self.archive() else {
+            return Ok(None);
+        };
+        let Some(e) = archive.get(index) else {
+            return Ok(None);
+        };
+        let problem = self.config.problem.build()?;
+        let cell: Vec<String> = archive
+            .unravel(index)
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        let measures: Vec<String> = archive
+            .grid
+            .names
+            .iter()
+            .zip(&e.measures)
+            .map(|(n, m)| format!("{n} = {m}"))
+            .collect();
+        let comment = format!(
+            "{} with elite {index} (cell [{}]) of `animats evolve` ({}, seed {}, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}; measures: {}.\nReproduce it with `animats evaluate FILE --json`; watch it with `animats view FILE`.",
+            self.config.problem.file,
+            cell.join(", "),
+            self.config.optimiser.name(),
+            self.config.seed,
+            self.generation(),
+            e.objective,
+            e.distance,
+            e.time,
+            e.ended,
+            measures.join(", ")
+        );
+        problem.scene_toml(&e.genome, &comment).map(Some)
+    }
+
+    /// `archive.csv`: one row per occupied cell, in cell order, with
+    /// pyribs's columns (`index`, `objective`, `measures_0`…), then
+    /// `threshold`, `time`, `distance`, `ended` and the genome
+    /// (`solution_0`…; a body's genomes differ in length: its own).
+    pub fn archive_csv(&self) -> Option<String> {
+        let archive = self.archive()?;
+        let mut b = ryu::Buffer::new();
+        let k = archive.grid.names.len();
+        let genes = archive
+            .elites()
+            .iter()
+            .map(|e| e.genome.len())
+            .max()
+            .unwrap_or(0);
+        let mut out = String::from("index,objective");
+        for i in 0..k {
+            out.push_str(&format!(",measures_{i}"));
+        }
+        out.push_str(",threshold,time,distance,ended");
+        for i in 0..genes {
+            out.push_str(&format!(",solution_{i}"));
+        }
+        out.push('\n');
+        let mut elites: Vec<&crate::archive::Elite> = archive.elites().iter().collect();
+        elites.sort_by_key(|e| e.index);
+        for e in elites {
+            out.push_str(&e.index.to_string());
+            for x in std::iter::once(&e.objective).chain(&e.measures).chain([
+                &e.threshold,
+                &e.time,
+                &e.distance,
+            ]) {
+                out.push(',');
+                out.push_str(b.format(*x));
+            }
+            out.push(',');
+            out.push_str(&e.ended);
+            for x in &e.genome {
+                out.push(',');
+                out.push_str(b.format(*x));
+            }
+            out.push('\n');
+        }
+        Some(out)
     }
 
     /// Best fitness of each lane after each generation (a step function of
@@ -814,7 +964,7 @@ fn record(
         ));
     }
     let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
-    lane.optimiser.tell(&fitness)?;
+    lane.optimiser.tell_outcomes(outcomes)?;
     lane.generation += 1;
     lane.evaluations += population.len() as u64;
     // The generation's best (the first of equals).
@@ -857,6 +1007,15 @@ fn record(
         improved: improved.then(|| population[top].clone()),
         body,
         refused: lane.optimiser.refused(),
+        archive: lane.optimiser.archive().map(|a| {
+            let s = a.stats();
+            ArchiveRow {
+                elites: s.elites,
+                coverage: s.coverage,
+                qd_score: s.qd_score,
+                obj_max: s.obj_max.unwrap_or(f64::NAN),
+            }
+        }),
     })
 }
 

@@ -286,6 +286,7 @@ impl Evolution {
                     time: time[i],
                     distance: distance[i],
                     ended: ended[i].parse().map_err(value_error)?,
+                    measures: Vec::new(),
                 })
             })
             .collect::<PyResult<_>>()?;

@@ -15,6 +15,7 @@
 
 pub mod camera;
 pub mod gif_file;
+pub mod heatmap;
 pub mod image;
 pub mod picture;
 pub mod plot;
@@ -23,6 +24,7 @@ pub mod raster;
 pub mod video;
 
 pub use camera::Camera;
+pub use heatmap::{heatmap_png, Heatmap};
 pub use image::Image;
 pub use picture::{picture, Bell, Picture, Rod, Sphere};
 pub use plot::{step_plot_png, Plot, Series};

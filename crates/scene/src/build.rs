@@ -279,6 +279,14 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         )?),
         None => None,
     };
+    let archive = match &def.archive {
+        Some(entry) => Some(entry.get_ref().build(
+            &at(src, "archive", entry),
+            &names,
+            evolve.as_ref(),
+        )?),
+        None => None,
+    };
     let guard =
         animats_engine::DivergenceGuard::new(&world, !actors.is_empty() || !nervous.is_empty());
     let warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
@@ -295,6 +303,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         actors,
         nervous,
         evolve,
+        archive,
     })
 }
 

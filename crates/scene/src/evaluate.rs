@@ -318,6 +318,9 @@ pub struct Evaluation {
     pub time: f64,
     /// Why it ended.
     pub ended: Ended,
+    /// The scene's `[archive]` measures, in order (empty without one),
+    /// computed during this evaluation.
+    pub measures: Vec<f64>,
 }
 
 /// Runs `scene`'s `[evolve]` evaluation; `observe` sees the scene before
@@ -336,6 +339,10 @@ pub fn evaluate_with(
     let mut done = 0u64;
     let mut ended = Ended::Timeout;
     let mut last = start;
+    let archive = scene.archive.clone();
+    let mut recorder = archive.as_ref().map(|a| {
+        crate::archive::Recorder::new(a, &spec, &scene.world, scene.nervous.actuators.len())
+    });
     observe(&scene);
     if let Some(end) = spec.ending(&scene.world) {
         ended = end;
@@ -347,6 +354,9 @@ pub fn evaluate_with(
             }
             done += 1;
             observe(&scene);
+            if let Some(r) = &mut recorder {
+                r.step(&scene.world);
+            }
             let c = spec.centre(&scene.world);
             if !c.is_finite() {
                 ended = Ended::BlowUp;
@@ -364,11 +374,13 @@ pub fn evaluate_with(
     if ended == Ended::BlowUp {
         distance = distance.min(0.0);
     }
+    let measures = recorder.map_or_else(Vec::new, |r| r.finish(&scene.world, time));
     Ok(Evaluation {
         fitness: spec.time_weight * time + spec.distance_weight * distance,
         distance,
         time,
         ended,
+        measures,
     })
 }
 
@@ -406,6 +418,7 @@ pub struct SceneProblem {
     start: Vec<f64>,
     bounds: Vec<(f64, f64)>,
     keys: Vec<GenomeKey>,
+    grid: Option<crate::archive::Grid>,
 }
 
 impl SceneProblem {
@@ -434,6 +447,7 @@ impl SceneProblem {
             bounds: brain.bounds(),
             keys: brain.genome_keys(),
             spec: spec.clone(),
+            grid: scene.archive.as_ref().map(|a| a.grid.clone()),
             def,
         })
     }
@@ -441,6 +455,11 @@ impl SceneProblem {
     /// The scene's `[evolve]` table, resolved.
     pub fn spec(&self) -> &EvolveSpec {
         &self.spec
+    }
+
+    /// The `[archive]` table's grid and settings, if the scene has one.
+    pub fn grid(&self) -> Option<&crate::archive::Grid> {
+        self.grid.as_ref()
     }
 
     /// The scene's text, as given.

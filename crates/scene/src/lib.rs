@@ -23,6 +23,7 @@
 
 #![warn(missing_docs)]
 
+pub mod archive;
 pub mod build;
 pub mod def;
 pub mod entries;
@@ -66,6 +67,9 @@ pub struct Scene {
     pub nervous: animats_creatures::NervousSystem,
     /// The scene's `[evolve]` table, resolved.
     pub evolve: Option<evaluate::EvolveSpec>,
+    /// The scene's `[archive]` table, resolved: the measures each
+    /// evaluation returns.
+    pub archive: Option<archive::ArchiveSpec>,
     /// Watches for a run that diverges without going non-finite.
     pub guard: DivergenceGuard,
     /// Things that are allowed but probably not meant (a particle that

@@ -65,10 +65,58 @@ pub struct BodyGa {
 }
 
 /// One child and the refusals it took to make.
-struct Made {
-    genome: Vec<f64>,
-    refused: Vec<&'static str>,
-    kept: bool,
+pub(crate) struct Made {
+    pub(crate) genome: Vec<f64>,
+    pub(crate) refused: Vec<&'static str>,
+    pub(crate) kept: bool,
+}
+
+/// A child made by `make`, checked and retried up to `RETRIES` times;
+/// `parent` if every try is refused.
+pub(crate) fn vary(
+    variation: &dyn Variation,
+    rng: &mut Random,
+    make: impl Fn(&dyn Variation, &mut Random) -> Vec<f64>,
+    parent: &[f64],
+) -> Made {
+    let mut refused = Vec::new();
+    for _ in 0..=RETRIES {
+        let g = make(variation, rng);
+        match variation.check(&g) {
+            Ok(()) => {
+                return Made {
+                    genome: g,
+                    refused,
+                    kept: false,
+                }
+            }
+            Err(r) => refused.push(r),
+        }
+    }
+    Made {
+        genome: parent.to_vec(),
+        refused,
+        kept: true,
+    }
+}
+
+/// A random body, checked: retried up to [`RANDOM_TRIES`] times, then taken
+/// as it is (it has no parent to fall back on).
+pub(crate) fn random_body(variation: &dyn Variation, rng: &mut Random) -> Made {
+    let mut refused = Vec::new();
+    let mut genome = variation.random(rng);
+    for _ in 1..RANDOM_TRIES {
+        match variation.check(&genome) {
+            Ok(()) => break,
+            Err(r) => refused.push(r),
+        }
+        genome = variation.random(rng);
+    }
+    Made {
+        genome,
+        refused,
+        kept: false,
+    }
 }
 
 impl BodyGa {
@@ -101,8 +149,8 @@ impl BodyGa {
                         refused: Vec::new(),
                         kept: false,
                     },
-                    (Some(s), true) => self.vary(variation, &mut rng, |v, r| v.mutate(s, r), s),
-                    (None, true) => self.random(variation, &mut rng),
+                    (Some(s), true) => vary(variation, &mut rng, |v, r| v.mutate(s, r), s),
+                    (None, true) => random_body(variation, &mut rng),
                     (_, false) => self.child(variation, &mut rng),
                 }
             })
@@ -116,52 +164,6 @@ impl BodyGa {
             self.asked.push(m.genome);
         }
         self.asked.clone()
-    }
-
-    fn random(&self, variation: &dyn Variation, rng: &mut Random) -> Made {
-        let mut refused = Vec::new();
-        let mut genome = variation.random(rng);
-        for _ in 1..RANDOM_TRIES {
-            match variation.check(&genome) {
-                Ok(()) => break,
-                Err(r) => refused.push(r),
-            }
-            genome = variation.random(rng);
-        }
-        Made {
-            genome,
-            refused,
-            kept: false,
-        }
-    }
-
-    /// A child made by `make`, retried; `parent` if every try is refused.
-    fn vary(
-        &self,
-        variation: &dyn Variation,
-        rng: &mut Random,
-        make: impl Fn(&dyn Variation, &mut Random) -> Vec<f64>,
-        parent: &[f64],
-    ) -> Made {
-        let mut refused = Vec::new();
-        for _ in 0..=RETRIES {
-            let g = make(variation, rng);
-            match variation.check(&g) {
-                Ok(()) => {
-                    return Made {
-                        genome: g,
-                        refused,
-                        kept: false,
-                    }
-                }
-                Err(r) => refused.push(r),
-            }
-        }
-        Made {
-            genome: parent.to_vec(),
-            refused,
-            kept: true,
-        }
     }
 
     fn tournament(&self, rng: &mut Random) -> usize {
@@ -181,7 +183,7 @@ impl BodyGa {
         if rng.uniform() < CROSSOVER {
             let b = self.tournament(rng);
             let other = &self.parents[b].0;
-            self.vary(
+            vary(
                 variation,
                 rng,
                 |v, r| {
@@ -191,7 +193,7 @@ impl BodyGa {
                 parent,
             )
         } else {
-            self.vary(variation, rng, |v, r| v.mutate(parent, r), parent)
+            vary(variation, rng, |v, r| v.mutate(parent, r), parent)
         }
     }
 

@@ -11,13 +11,16 @@
 
 pub mod body_ga;
 pub mod cma_es;
+pub mod cma_me;
 pub mod ga;
 pub mod hill_climber;
+pub mod map_elites;
 
 use body_ga::{BodyGa, Variation};
 use cma_es::CmaEs;
 use ga::Ga;
 use hill_climber::HillClimber;
+use map_elites::{Qd, QdKind};
 use serde::{Deserialize, Serialize};
 
 pub use animats_creatures::random::Random;
@@ -84,15 +87,22 @@ pub enum OptimiserKind {
     /// A (μ + λ) GA over bodies, with the problem's own variation and
     /// checks: what a `[morphology]` scene evolves with.
     BodyGa,
+    /// MAP-Elites: an archive of elites over the scene's `[archive]`
+    /// measures, filled by varying elites.
+    MapElites,
+    /// CMA-ME: the archive filled by CMA-ES emitters.
+    CmaMe,
 }
 
 impl OptimiserKind {
     /// All kinds, in the order they are documented.
-    pub const ALL: [OptimiserKind; 4] = [
+    pub const ALL: [OptimiserKind; 6] = [
         OptimiserKind::HillClimber,
         OptimiserKind::Ga,
         OptimiserKind::CmaEs,
         OptimiserKind::BodyGa,
+        OptimiserKind::MapElites,
+        OptimiserKind::CmaMe,
     ];
 
     /// The command-line name.
@@ -102,6 +112,17 @@ impl OptimiserKind {
             OptimiserKind::Ga => "ga",
             OptimiserKind::CmaEs => "cma-es",
             OptimiserKind::BodyGa => "body-ga",
+            OptimiserKind::MapElites => "map-elites",
+            OptimiserKind::CmaMe => "cma-me",
+        }
+    }
+
+    /// The quality-diversity search this is, if it is one.
+    pub fn qd(self) -> Option<QdKind> {
+        match self {
+            OptimiserKind::MapElites => Some(QdKind::MapElites),
+            OptimiserKind::CmaMe => Some(QdKind::CmaMe),
+            _ => None,
         }
     }
 
@@ -123,6 +144,8 @@ impl OptimiserKind {
             OptimiserKind::Ga => 32,
             OptimiserKind::CmaEs => cma_default_lambda(dim),
             OptimiserKind::BodyGa => body_ga::POPULATION,
+            OptimiserKind::MapElites => map_elites::default_batch(QdKind::MapElites, dim),
+            OptimiserKind::CmaMe => map_elites::default_batch(QdKind::CmaMe, dim),
         }
     }
 }
@@ -203,14 +226,48 @@ pub enum AnyOptimiser {
     CmaEs(Box<CmaEs>),
     /// See [`BodyGa`].
     BodyGa(Box<BodyGa>),
+    /// See [`Qd`]: MAP-Elites or CMA-ME.
+    Qd(Box<Qd>),
 }
 
 impl AnyOptimiser {
     /// A fresh optimiser. A body GA starts from its problem's bodies, not
     /// from `setup.start`.
     pub fn new(setup: &Setup) -> Result<AnyOptimiser, String> {
-        if setup.kind != OptimiserKind::BodyGa {
+        AnyOptimiser::with_archive(setup, None, false)
+    }
+
+    /// A fresh optimiser; a quality-diversity one fills an archive over
+    /// `grid` (refused without one), of bodies if `bodies`.
+    pub fn with_archive(
+        setup: &Setup,
+        grid: Option<&animats_scene::archive::Grid>,
+        bodies: bool,
+    ) -> Result<AnyOptimiser, String> {
+        if !bodies {
             setup.validate()?;
+        }
+        if let Some(kind) = setup.kind.qd() {
+            let grid = grid.ok_or_else(|| {
+                format!(
+                    "optimiser: {} fills an archive: the scene needs an [archive] table naming its measures (docs/DIVERSITY.md)",
+                    setup.kind.name()
+                )
+            })?;
+            let mut grid = grid.clone();
+            if setup.sigma.is_some() && grid.sigma.is_none() {
+                grid.sigma = setup.sigma;
+            }
+            return Ok(AnyOptimiser::Qd(Box::new(Qd::new(
+                kind,
+                grid,
+                &setup.start,
+                setup.bounds.clone(),
+                setup.population,
+                setup.seed,
+                setup.lane,
+                bodies,
+            )?)));
         }
         Ok(match setup.kind {
             OptimiserKind::HillClimber => AnyOptimiser::HillClimber(HillClimber::from_setup(setup)),
@@ -221,6 +278,9 @@ impl AnyOptimiser {
                 setup.lane,
                 setup.population,
             ))),
+            OptimiserKind::MapElites | OptimiserKind::CmaMe => {
+                unreachable!("quality-diversity searches are made above")
+            }
         })
     }
 
@@ -233,6 +293,7 @@ impl AnyOptimiser {
                     .ok_or("body-ga varies bodies: it evolves a scene with a [morphology] table")?;
                 Ok(o.ask(v))
             }
+            AnyOptimiser::Qd(o) => o.ask(variation),
             other => Ok(other.ask()),
         }
     }
@@ -242,6 +303,9 @@ impl AnyOptimiser {
     pub fn refusals(&self) -> Option<(&std::collections::BTreeMap<String, u64>, u64)> {
         match self {
             AnyOptimiser::BodyGa(o) => Some((o.refused(), o.kept())),
+            AnyOptimiser::Qd(o) if !o.refused().is_empty() || o.kept() > 0 => {
+                Some((o.refused(), o.kept()))
+            }
             _ => None,
         }
     }
@@ -250,6 +314,7 @@ impl AnyOptimiser {
     pub fn refused(&self) -> Option<u64> {
         match self {
             AnyOptimiser::BodyGa(o) => Some(o.refused_total()),
+            AnyOptimiser::Qd(o) if !o.refused().is_empty() => Some(o.refused().values().sum()),
             _ => None,
         }
     }
@@ -261,6 +326,10 @@ impl AnyOptimiser {
             AnyOptimiser::Ga(_) => OptimiserKind::Ga,
             AnyOptimiser::CmaEs(_) => OptimiserKind::CmaEs,
             AnyOptimiser::BodyGa(_) => OptimiserKind::BodyGa,
+            AnyOptimiser::Qd(o) => match o.kind() {
+                QdKind::MapElites => OptimiserKind::MapElites,
+                QdKind::CmaMe => OptimiserKind::CmaMe,
+            },
         }
     }
 
@@ -270,7 +339,27 @@ impl AnyOptimiser {
             AnyOptimiser::HillClimber(o) => Some(o),
             AnyOptimiser::Ga(o) => Some(o),
             AnyOptimiser::CmaEs(o) => Some(o.as_ref()),
-            AnyOptimiser::BodyGa(_) => None,
+            AnyOptimiser::BodyGa(_) | AnyOptimiser::Qd(_) => None,
+        }
+    }
+
+    /// The archive of a quality-diversity search.
+    pub fn archive(&self) -> Option<&crate::archive::GridArchive> {
+        match self {
+            AnyOptimiser::Qd(o) => Some(&o.archive),
+            _ => None,
+        }
+    }
+
+    /// Tells whole outcomes: a quality-diversity search takes their
+    /// measures too, any other optimiser their fitness.
+    pub fn tell_outcomes(&mut self, outcomes: &[crate::problem::Outcome]) -> Result<(), String> {
+        match self {
+            AnyOptimiser::Qd(o) => o.tell(outcomes).map(|_| ()),
+            other => {
+                let fitness: Vec<f64> = outcomes.iter().map(|o| o.fitness).collect();
+                other.tell(&fitness)
+            }
         }
     }
 
@@ -279,7 +368,7 @@ impl AnyOptimiser {
             AnyOptimiser::HillClimber(o) => Some(o),
             AnyOptimiser::Ga(o) => Some(o),
             AnyOptimiser::CmaEs(o) => Some(o.as_mut()),
-            AnyOptimiser::BodyGa(_) => None,
+            AnyOptimiser::BodyGa(_) | AnyOptimiser::Qd(_) => None,
         }
     }
 }
@@ -293,18 +382,23 @@ impl Optimiser for AnyOptimiser {
     fn tell(&mut self, fitness: &[f64]) -> Result<(), String> {
         match self {
             AnyOptimiser::BodyGa(o) => o.tell(fitness),
+            AnyOptimiser::Qd(_) => {
+                Err("a quality-diversity search is told outcomes with their measures".into())
+            }
             other => other.inner_mut().map_or(Ok(()), |o| o.tell(fitness)),
         }
     }
     fn best(&self) -> Option<(&[f64], f64)> {
         match self {
             AnyOptimiser::BodyGa(o) => o.best(),
+            AnyOptimiser::Qd(o) => o.best(),
             other => other.inner().and_then(|o| o.best()),
         }
     }
     fn generation(&self) -> u64 {
         match self {
             AnyOptimiser::BodyGa(o) => o.generation(),
+            AnyOptimiser::Qd(o) => o.generation(),
             other => other.inner().map_or(0, |o| o.generation()),
         }
     }

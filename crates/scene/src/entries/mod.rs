@@ -43,6 +43,10 @@ macro_rules! entries {
             /// ([`crate::morphology`]).
             #[serde(default)]
             pub morphology: Option<Spanned<crate::morphology::MorphologyEntry>>,
+            /// `[archive]`: the measures that describe an evaluation and the
+            /// grid a quality-diversity search fills ([`crate::archive`]).
+            #[serde(default)]
+            pub archive: Option<Spanned<crate::archive::ArchiveEntry>>,
         }
 
         /// Builds every entry of the scene, in the order declared.

@@ -37,6 +37,7 @@ pub struct MorphologyProblem {
     morphology: Morphology,
     start: Option<Vec<f64>>,
     spec: EvolveSpec,
+    grid: Option<crate::archive::Grid>,
 }
 
 impl MorphologyProblem {
@@ -67,7 +68,12 @@ impl MorphologyProblem {
                 "`neural` bodies feel the floor through touch sensors, and this scene has no [floor]: use `oscillator`",
             ));
         }
-        // The rest of the scene, checked where the user wrote it.
+        // The rest of the scene, checked where the user wrote it (the
+        // archive's grid here, its measures on a developed body below).
+        let grid = match def.archive.take() {
+            Some(a) => Some(a.get_ref().grid(&at(&src, "archive", &a))?),
+            None => None,
+        };
         def.evolve = None;
         crate::build::build(&def, &src)?;
         let mut base: DocumentMut = text
@@ -112,6 +118,7 @@ impl MorphologyProblem {
             morphology,
             start,
             spec: placeholder_spec(),
+            grid,
         };
         if let Some(g) = &problem.start {
             problem.check(g).map_err(|r| {
@@ -147,6 +154,11 @@ impl MorphologyProblem {
     /// weights, lanes, robust: the same for every body).
     pub fn spec(&self) -> &EvolveSpec {
         &self.spec
+    }
+
+    /// The `[archive]` table's grid and settings, if the scene has one.
+    pub fn grid(&self) -> Option<&crate::archive::Grid> {
+        self.grid.as_ref()
     }
 
     /// The starting body's genes, if the scene names one.
