@@ -14,6 +14,7 @@
 pub mod allpairs;
 pub mod bodies;
 pub mod brains;
+pub mod diversity;
 pub mod hopper;
 pub mod mass_spring;
 pub mod nbody5;
@@ -41,7 +42,7 @@ pub const WORKLOADS: [&str; 10] = [
 ];
 
 /// Workloads run only when named (they take minutes).
-pub const ON_REQUEST: [&str; 3] = ["implicit", "contacts", "bodies"];
+pub const ON_REQUEST: [&str; 4] = ["implicit", "contacts", "bodies", "diversity"];
 
 /// A rayon pool of `threads` threads, for workloads that time one against
 /// two.
@@ -405,6 +406,7 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
         "hopper" => hopper::run(opts.quick, runs),
         "brains" => brains::run(opts.quick, runs),
         "bodies" => bodies::run(opts.quick, runs),
+        "diversity" => diversity::run(opts.quick, runs),
         "seaworld" => seaworld::run(opts.quick, runs),
         "implicit" => Ok(run_implicit(opts.quick)),
         "contacts" => Ok(pile::run(opts.quick, runs)),

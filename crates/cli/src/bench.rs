@@ -7,8 +7,9 @@ use animats_bench::{Options, Row, WORKLOADS};
 #[derive(clap::Args)]
 pub struct Args {
     /// Workloads to run (default: all of chain-64, cloth-32, cloth-128,
-    /// nbody5, allpairs-1000, hopper, brains, seaworld, stability; `implicit`,
-    /// minutes long, only when named).
+    /// nbody5, allpairs-1000, hopper, brains, seaworld, stability,
+    /// scene-load; `implicit`, `contacts`, `bodies` and `diversity` only
+    /// when named).
     workloads: Vec<String>,
     /// Shorter n-body runs (5M and 20 steps instead of 50M and 100); the
     /// implicit race on cloth-32 instead of cloth-128.

@@ -67,7 +67,7 @@ impl FromStr for CameraSpec {
 #[derive(clap::Args)]
 pub struct Args {
     /// The scene file (TOML); with --zoo, the directory of an `animats
-    /// evolve` run of a [morphology] scene.
+    /// evolve` run of a [morphology] scene or of a quality-diversity run.
     scene: PathBuf,
     /// With --zoo, more runs' directories: each run's (and each lane's)
     /// best body first, the best of them first, then each one's second
@@ -80,6 +80,12 @@ pub struct Args {
     /// (the best first), then each lane's second, and so on.
     #[arg(long, num_args = 0..=1, default_missing_value = "6", value_parser = clap::value_parser!(u32).range(1..=36))]
     zoo: Option<u32>,
+    /// With --zoo on a quality-diversity run (map-elites, cma-me): these
+    /// cells' elites (archive.csv's `index`), comma-separated; without it,
+    /// N elites spread over the map, the best first, then each time the
+    /// one farthest from those taken.
+    #[arg(long, requires = "zoo", value_delimiter = ',')]
+    elite: Option<Vec<u64>>,
     /// Simulated seconds to render.
     #[arg(long, value_parser = positive_f64)]
     seconds: f64,
@@ -412,12 +418,16 @@ pub fn run(args: Args) -> Result<(), Failure> {
 fn zoo(args: &Args) -> Result<(), Failure> {
     let format = format_of(args)?;
     let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
-    let count = args.zoo.unwrap_or(6) as usize;
+    let count = args
+        .elite
+        .as_ref()
+        .map_or(args.zoo.unwrap_or(6) as usize, Vec::len);
     let dirs: Vec<&PathBuf> = std::iter::once(&args.scene)
         .chain(&args.more_runs)
         .collect();
     // Each run's best bodies, best first.
     let mut runs = Vec::with_capacity(dirs.len());
+    let mut cells = false;
     for dir in &dirs {
         let checkpoint = dir.join("checkpoint.json");
         if !checkpoint.exists() {
@@ -427,6 +437,32 @@ fn zoo(args: &Args) -> Result<(), Failure> {
             )));
         }
         let state = animats_evolve::checkpoint::load(&checkpoint).map_err(Failure::Input)?;
+        if let Some(archive) = state.archive() {
+            // A quality-diversity run: elites from all over its map (or
+            // the cells asked for), each its own "lane", named by its cell.
+            let picked = match &args.elite {
+                Some(cells) => cells
+                    .iter()
+                    .map(|&i| {
+                        archive.get(i).ok_or_else(|| {
+                            Failure::Input(format!(
+                                "--elite {i}: {} has no elite in cell {i} (archive.csv lists them)",
+                                dir.display()
+                            ))
+                        })
+                    })
+                    .collect::<Result<Vec<_>, _>>()?,
+                None => spread(archive, count),
+            };
+            let problem = state.config.problem.build().map_err(Failure::Input)?;
+            let lanes = picked
+                .into_iter()
+                .map(|e| vec![(e.genome.clone(), e.objective, e.index as usize)])
+                .collect();
+            runs.push((dir, problem, lanes));
+            cells = true;
+            continue;
+        }
         let bodies = state.best_bodies(usize::MAX).ok_or_else(|| {
             Failure::Input(format!(
                 "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
@@ -489,13 +525,14 @@ fn zoo(args: &Args) -> Result<(), Failure> {
                 .map(|s| {
                     let mut picture = picture(drawing, &s.positions, &s.bells);
                     picture.caption = Some(format!(
-                        "#{} {}(lane {lane}): {fitness:.2}{}",
+                        "#{} {}({} {lane}): {fitness:.2}{}",
                         k + 1,
                         if several {
                             format!("{} ", run_name(run))
                         } else {
                             String::new()
                         },
+                        if cells { "cell" } else { "lane" },
                         if args.no_caption {
                             String::new()
                         } else {
@@ -533,16 +570,62 @@ fn zoo(args: &Args) -> Result<(), Failure> {
     );
     for (k, (run, _, _, fitness, lane)) in bodies.iter().enumerate() {
         println!(
-            "  #{}: fitness {fitness} ({}lane {lane})",
+            "  #{}: fitness {fitness} ({}{} {lane})",
             k + 1,
             if several {
                 format!("{}, ", run.display())
             } else {
                 String::new()
-            }
+            },
+            if cells { "cell" } else { "lane" }
         );
     }
     Ok(())
+}
+
+/// `n` elites spread over the archive: the best first, then each time the
+/// elite farthest (in cells, each measure's bins scaled to one) from those
+/// already taken, the better among equals: the corners of a map come
+/// early.
+fn spread(archive: &animats_evolve::archive::GridArchive, n: usize) -> Vec<&animats_evolve::archive::Elite> {
+    let bins = &archive.grid.bins;
+    let at = |e: &animats_evolve::archive::Elite| -> Vec<f64> {
+        archive
+            .unravel(e.index)
+            .iter()
+            .zip(bins)
+            .map(|(&c, &b)| (c as f64 + 0.5) / b as f64)
+            .collect()
+    };
+    let mut left: Vec<&animats_evolve::archive::Elite> = archive.elites().iter().collect();
+    left.sort_by(|a, b| b.objective.total_cmp(&a.objective).then(a.index.cmp(&b.index)));
+    let mut taken: Vec<&animats_evolve::archive::Elite> = Vec::new();
+    while taken.len() < n && !left.is_empty() {
+        let k = if taken.is_empty() {
+            0
+        } else {
+            let d = |e: &animats_evolve::archive::Elite| {
+                let x = at(e);
+                taken
+                    .iter()
+                    .map(|t| at(t).iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum::<f64>())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            // `left` is best first: the first of the farthest is the best.
+            let mut best = 0;
+            let mut far = d(left[0]);
+            for (i, e) in left.iter().enumerate().skip(1) {
+                let di = d(e);
+                if di > far {
+                    far = di;
+                    best = i;
+                }
+            }
+            best
+        };
+        taken.push(left.remove(k));
+    }
+    taken
 }
 
 /// A run directory's last component, for a caption.

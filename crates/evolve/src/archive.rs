@@ -106,7 +106,9 @@ pub struct GridArchive {
     pub grid: Grid,
     /// Elites in the order their cells were first occupied.
     elites: Vec<Elite>,
-    /// Cell → position in `elites`.
+    /// Cell → position in `elites` (as pairs: a checkpoint is JSON, whose
+    /// keys are strings).
+    #[serde(with = "pairs")]
     cells: BTreeMap<u64, usize>,
     /// Σ objective over the elites.
     objective_sum: f64,
@@ -115,6 +117,19 @@ pub struct GridArchive {
     /// The best elite ever inserted (it may since have been replaced, when
     /// α < 1).
     best: Option<Elite>,
+}
+
+mod pairs {
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    use std::collections::BTreeMap;
+
+    pub fn serialize<S: Serializer>(m: &BTreeMap<u64, usize>, s: S) -> Result<S::Ok, S::Error> {
+        m.iter().collect::<Vec<_>>().serialize(s)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<u64, usize>, D::Error> {
+        Ok(Vec::<(u64, usize)>::deserialize(d)?.into_iter().collect())
+    }
 }
 
 impl GridArchive {
@@ -128,6 +143,22 @@ impl GridArchive {
             obj_max: None,
             best: None,
         }
+    }
+
+    /// Checks an archive read back from a checkpoint: every elite in its
+    /// own cell, once, with as many measures as the grid has.
+    pub fn validate(&self) -> Result<(), String> {
+        let k = self.grid.bins.len();
+        if self.cells.len() != self.elites.len()
+            || self.cells.iter().any(|(&i, &at)| {
+                self.elites.get(at).is_none_or(|e| {
+                    e.index != i || e.measures.len() != k || self.index_of(&e.measures) != i
+                })
+            })
+        {
+            return Err("the archive's cells and elites disagree".into());
+        }
+        Ok(())
     }
 
     /// Cells in all.

@@ -426,6 +426,9 @@ impl State {
             if l.generation > 0 && l.best.is_none() {
                 return Err(format!("lane {i} has generations but no best"));
             }
+            if let Some(a) = l.optimiser.archive() {
+                a.validate().map_err(|e| format!("lane {i}: {e}"))?;
+            }
         }
         if self.log.iter().any(|r| r.lane >= self.lanes.len()) {
             return Err("a log row names a lane that does not exist".into());

@@ -5,7 +5,7 @@
 use crate::scene::{no_evolve, Scene};
 use crate::{on, pool, runtime_error, scene_error, value_error};
 use animats_evolve::{Outcome, Problem, ProblemSpec};
-use numpy::{PyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
@@ -142,21 +142,50 @@ fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
 
 /// Fitness of each row of a `(P, D)` float64 array of genomes under a
 /// scene's `[evolve]` evaluation (or the roobot's), in parallel.
+/// With `measures`, a tuple: the fitness and the `(P, k)` array of the
+/// scene's `[archive]` measures.
 #[pyfunction]
-#[pyo3(signature = (scene, genomes, threads = None))]
+#[pyo3(signature = (scene, genomes, threads = None, measures = false))]
 pub fn evaluate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     genomes: &Bound<'py, PyAny>,
     threads: Option<usize>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    measures: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     let problem = build(&problem_spec(scene)?)?;
+    if measures && problem.grid().is_none() {
+        return Err(value_error(
+            "measures=True: the scene has no [archive] table naming its measures",
+        ));
+    }
     let pool = pool(threads)?;
     let o = outcomes(py, problem.as_ref(), genomes, &pool)?;
-    Ok(PyArray1::from_vec(
-        py,
-        o.iter().map(|o| o.fitness).collect(),
-    ))
+    let fitness = PyArray1::from_vec(py, o.iter().map(|o| o.fitness).collect());
+    if measures {
+        let k = problem.grid().map_or(0, |g| g.names.len());
+        let m = measure_array(py, &o, k)?;
+        Ok((fitness, m).into_pyobject(py)?.into_any())
+    } else {
+        Ok(fitness.into_any())
+    }
+}
+
+/// The outcomes' measures as a `(P, k)` array.
+fn measure_array<'py>(
+    py: Python<'py>,
+    o: &[Outcome],
+    k: usize,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    let flat: Vec<f64> = o
+        .iter()
+        .flat_map(|o| {
+            let mut m = o.measures.clone();
+            m.resize(k, f64::NAN);
+            m
+        })
+        .collect();
+    PyArray1::from_vec(py, flat).reshape([o.len(), k])
 }
 
 /// A problem built once and evaluated many times (a Ray actor holds one).
@@ -237,5 +266,19 @@ pub(crate) fn outcome_dict<'py>(py: Python<'py>, o: &[Outcome]) -> PyResult<Boun
         "ended",
         o.iter().map(|o| o.ended.to_string()).collect::<Vec<_>>(),
     )?;
+    // Scenes with an [archive]: their measures, a (P, k) array when every
+    // scene has k of them, else one array per scene.
+    let k = o.first().map_or(0, |o| o.measures.len());
+    if o.iter().all(|x| x.measures.len() == k) {
+        if k > 0 {
+            d.set_item("measures", measure_array(py, o, k)?)?;
+        }
+    } else {
+        let list: Vec<Bound<'py, PyArray1<f64>>> = o
+            .iter()
+            .map(|x| PyArray1::from_vec(py, x.measures.clone()))
+            .collect();
+        d.set_item("measures", list)?;
+    }
     Ok(d)
 }

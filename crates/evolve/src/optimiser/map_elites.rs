@@ -88,6 +88,8 @@ impl Emitter {
 /// A quality-diversity search's whole state: what a checkpoint holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Qd {
+    /// (Not `kind`: [`super::AnyOptimiser`]'s tag.)
+    #[serde(rename = "search")]
     kind: QdKind,
     seed: u64,
     lane: usize,

@@ -10,6 +10,8 @@ evaluation, the optimisers and whole evolution runs, and environments.
     >>> animats.evaluate(scene, scene.start())  # its own parameters' fitness
     >>> animats.evaluate("roobot", np.tile(animats.ROOBOT_INITIAL, (8, 1)))
     >>> animats.evaluate_scenes([open("scenes/walker.toml").read()])
+    >>> f, m = animats.evaluate("scenes/hop_map.toml", g, measures=True)
+    >>> animats.Archive("hopmap")               # a map-elites run's archive
 
 ``import animats.gym`` registers the Gymnasium environments
 ``animats/Roobot-v0`` and ``animats/Scene-v0``; ``animats.distributed``
@@ -24,6 +26,7 @@ import os
 import numpy as np
 
 from . import _animats
+from .archive import Archive
 from ._animats import (
     Env,
     Evaluator,
@@ -39,6 +42,7 @@ from ._animats import (
 )
 
 __all__ = [
+    "Archive",
     "Env",
     "Evaluator",
     "Evolution",
@@ -64,7 +68,7 @@ ROOBOT_BOUNDS = np.array(_animats.ROOBOT_BOUNDS, dtype=np.float64)
 SceneLike = Union[Scene, str, "os.PathLike[str]"]
 
 
-def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None) -> np.ndarray:
+def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None, measures: bool = False):
     """Fitness of each row of ``genomes`` under ``scene``'s ``[evolve]``
     evaluation (``"roobot"``: the thesis's hopping gait).
 
@@ -72,23 +76,29 @@ def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None) -> np.nda
     fitness in a ``(1,)`` array). The evaluations run in parallel on
     ``threads`` threads (default: every core) with the GIL released, and
     each is bit-identical to ``animats evaluate`` on the same parameters.
+    With ``measures=True`` (a scene with an ``[archive]`` table), a tuple:
+    the fitness and the ``(P, k)`` array of its measures, computed in the
+    same evaluations (what a pyribs ``Scheduler.tell`` takes).
     """
     if isinstance(genomes, list):
         # Bodies ([morphology] scenes): genomes differ in length.
-        return _animats.evaluate(scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads)
+        return _animats.evaluate(
+            scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads, measures
+        )
     g = np.ascontiguousarray(genomes, dtype=np.float64)
     if g.ndim == 1:
         g = g[None, :]
     if g.ndim != 2:
         raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
-    return _animats.evaluate(scene, g, threads)
+    return _animats.evaluate(scene, g, threads, measures)
 
 
 def evaluate_scenes(texts, threads: Optional[int] = None) -> dict:
     """Each complete scene text in ``texts`` scored by its own ``[evolve]``
     table, in parallel on ``threads`` threads (default: every core) with the
     GIL released: a dict of arrays ``fitness``, ``distance``, ``time`` and
-    the list ``ended``, one entry per text, each bit-identical to
+    the list ``ended`` (and ``measures``, ``(P, k)``, for scenes with an
+    ``[archive]``), one entry per text, each bit-identical to
     ``animats evaluate`` on that text as a file. For encodings of your own
     (CPPNs, grammars, learned decoders): write the body your genome
     describes as ``[[particle]]``, ``[[spring]]``, ``[[actuator]]`` and a

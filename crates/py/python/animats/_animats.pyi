@@ -1,7 +1,7 @@
 """Type stubs of the compiled core (crates/py/src)."""
 
 from os import PathLike
-from typing import Dict, List, Optional, Sequence, Tuple, Union
+from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -51,7 +51,10 @@ class World:
 
 Genomes = Union[F64, List[F64]]
 
-def evaluate(scene: SceneLike, genomes: Genomes, threads: Optional[int] = None) -> F64: ...
+@overload
+def evaluate(scene: SceneLike, genomes: Genomes, threads: Optional[int] = None, measures: Literal[False] = False) -> F64: ...
+@overload
+def evaluate(scene: SceneLike, genomes: Genomes, threads: Optional[int], measures: Literal[True]) -> Tuple[F64, F64]: ...
 
 Outcomes = Dict[str, Union[F64, List[str]]]
 

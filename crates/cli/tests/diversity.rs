@@ -1,0 +1,101 @@
+//! Quality-diversity runs through the real binary, on the thesis's roobot
+//! (scenes/hop_map.toml): archive.csv with pyribs's columns, every elite a
+//! scene that `evaluate` reproduces bit for bit (fitness and measures), the
+//! same archive on 1 and 2 threads and after a resume, log.csv's archive
+//! columns, and bad requests refused with exit 2.
+
+mod common;
+use common::*;
+
+const HOP_MAP: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/hop_map.toml");
+
+fn evolve(optimiser: &str, generations: &str, threads: &str, name: &str) -> std::path::PathBuf {
+    let dir = scratch(name);
+    let o = animats(&[
+        "evolve",
+        HOP_MAP,
+        "--optimiser",
+        optimiser,
+        "--generations",
+        generations,
+        "--population",
+        "12",
+        "--threads",
+        threads,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (_, err) = text(&o);
+    assert!(o.status.success(), "{optimiser}: {err}");
+    dir
+}
+
+fn read(dir: &std::path::Path, file: &str) -> String {
+    std::fs::read_to_string(dir.join(file)).unwrap()
+}
+
+#[test]
+fn elites_reproduce_and_archives_do_not_depend_on_threads_or_resume() {
+    for optimiser in ["map-elites", "cma-me"] {
+        let dir = evolve(optimiser, "4", "2", &format!("qd-{optimiser}-2"));
+        let csv = read(&dir, "archive.csv");
+        let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        assert_eq!(
+            header[..8],
+            ["index", "objective", "measures_0", "measures_1", "threshold", "time", "distance", "ended"]
+        );
+        let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+        assert!(!rows.is_empty(), "{optimiser}: an empty archive");
+        // Every elite: a scene file that evaluates to its row, bit for bit.
+        for row in rows.iter().take(3) {
+            let scene = dir.join("elites").join(format!("{}.toml", row[0]));
+            let o = animats(&["evaluate", scene.to_str().unwrap(), "--json"]);
+            let (json, err) = text(&o);
+            assert!(o.status.success(), "{err}");
+            let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+            let objective: f64 = row[1].parse().unwrap();
+            assert_eq!(v["fitness"].as_f64(), Some(objective), "{json}");
+            for k in 0..2 {
+                let m: f64 = row[2 + k].parse().unwrap();
+                assert_eq!(v["measures"][k].as_f64(), Some(m), "{json}");
+            }
+            // Only whole 20 s runs enter this map (min_time = 20).
+            assert_eq!(row[5], "20.0");
+        }
+        assert_eq!(
+            std::fs::read_dir(dir.join("elites")).unwrap().count(),
+            rows.len()
+        );
+        assert!(dir.join("archive.png").exists());
+        let log = read(&dir, "log.csv");
+        assert!(log.lines().next().unwrap().ends_with(",elites,coverage,qd_score,obj_max"));
+        let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
+        assert_eq!(last[last.len() - 4], rows.len().to_string());
+        // One thread: the same bits.
+        let one = evolve(optimiser, "4", "1", &format!("qd-{optimiser}-1"));
+        assert_eq!(read(&one, "archive.csv"), csv, "{optimiser}: 1 thread against 2");
+        assert_eq!(read(&one, "log.csv"), log);
+        // Two generations, then resumed to four: the same bits.
+        let part = evolve(optimiser, "2", "2", &format!("qd-{optimiser}-part"));
+        let o = animats(&["evolve", "--resume", part.to_str().unwrap(), "--generations", "4"]);
+        assert!(o.status.success(), "{}", text(&o).1);
+        assert_eq!(read(&part, "archive.csv"), csv, "{optimiser}: resumed");
+        assert_eq!(read(&part, "log.csv"), log);
+    }
+}
+
+#[test]
+fn bad_requests_are_refused() {
+    let dir = scratch("qd-bad");
+    let d = dir.to_str().unwrap();
+    let walker = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/walker.toml");
+    for (args, says) in [
+        (vec!["evolve", walker, "--optimiser", "map-elites", "--out", d], "[archive]"),
+        (vec!["evolve", HOP_MAP, "--optimiser", "cma-me", "--lanes", "3", "--out", d], "lanes"),
+    ] {
+        let o = animats(&args);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+}

@@ -1,0 +1,47 @@
+"""Quality-diversity from Python (issue 40): measures beside the fitness,
+the same bits as `animats evaluate --json`; an archive written by the
+command line read back by `animats.Archive`, each elite reproduced."""
+
+import json
+
+import numpy as np
+import pytest
+
+import animats
+from conftest import ROOT
+
+HOP_MAP = ROOT / "scenes" / "hop_map.toml"
+
+
+def test_measures_match_the_command_line(cli):
+    genomes = np.tile(animats.ROOBOT_INITIAL, (3, 1))
+    genomes[1, 0] *= 1.1
+    fitness, measures = animats.evaluate(str(HOP_MAP), genomes, measures=True)
+    assert measures.shape == (3, 2)
+    one = json.loads(cli("evaluate", HOP_MAP, "--json"))
+    assert fitness[0] == one["fitness"]
+    assert list(measures[0]) == one["measures"]
+    # evaluate_scenes: the same, from the text.
+    out = animats.evaluate_scenes([HOP_MAP.read_text()])
+    assert out["measures"].shape == (1, 2)
+    assert list(out["measures"][0]) == one["measures"]
+    # Without an [archive], measures=True is refused.
+    with pytest.raises(ValueError, match=r"\[archive\]"):
+        animats.evaluate(str(ROOT / "scenes" / "walker.toml"), animats.load(str(ROOT / "scenes" / "walker.toml")).start(), measures=True)
+
+
+def test_an_archive_reads_back_and_its_elites_reproduce(cli, tmp_path):
+    out = tmp_path / "map"
+    cli("evolve", HOP_MAP, "--optimiser", "map-elites", "--generations", 3, "--population", 8, "--out", out)
+    a = animats.Archive(out)
+    assert len(a) > 0 and a.measures.shape == (len(a), 2)
+    assert a.stats["elites"] == len(a)
+    assert np.all(a.time == 20.0)
+    best = int(np.argmax(a.objective))
+    f, m = animats.evaluate(str(HOP_MAP), a.solutions[best], measures=True)
+    assert f[0] == a.objective[best]
+    assert np.array_equal(m[0], a.measures[best])
+    scene = json.loads(cli("evaluate", a.scene_path(a.index[best]), "--json"))
+    assert scene["fitness"] == a.objective[best]
+    with pytest.raises(FileNotFoundError):
+        animats.Archive(tmp_path)
