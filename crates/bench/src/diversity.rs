@@ -57,9 +57,8 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let n = genomes.len();
     let with = SceneEvolution(SceneProblem::parse(&text, PATH).map_err(|e| e.to_string())?);
     let start = text.find("[archive]").ok_or("no [archive] table")?;
-    let bare = SceneEvolution(
-        SceneProblem::parse(&text[..start], PATH).map_err(|e| e.to_string())?,
-    );
+    let bare =
+        SceneEvolution(SceneProblem::parse(&text[..start], PATH).map_err(|e| e.to_string())?);
     let evaluate = |p: &SceneEvolution| -> Result<Vec<Outcome>, String> {
         one.install(|| genomes.par_iter().map(|g| p.evaluate(g)).collect())
     };

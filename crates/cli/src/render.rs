@@ -587,7 +587,10 @@ fn zoo(args: &Args) -> Result<(), Failure> {
 /// elite farthest (in cells, each measure's bins scaled to one) from those
 /// already taken, the better among equals: the corners of a map come
 /// early.
-fn spread(archive: &animats_evolve::archive::GridArchive, n: usize) -> Vec<&animats_evolve::archive::Elite> {
+fn spread(
+    archive: &animats_evolve::archive::GridArchive,
+    n: usize,
+) -> Vec<&animats_evolve::archive::Elite> {
     let bins = &archive.grid.bins;
     let at = |e: &animats_evolve::archive::Elite| -> Vec<f64> {
         archive
@@ -598,7 +601,11 @@ fn spread(archive: &animats_evolve::archive::GridArchive, n: usize) -> Vec<&anim
             .collect()
     };
     let mut left: Vec<&animats_evolve::archive::Elite> = archive.elites().iter().collect();
-    left.sort_by(|a, b| b.objective.total_cmp(&a.objective).then(a.index.cmp(&b.index)));
+    left.sort_by(|a, b| {
+        b.objective
+            .total_cmp(&a.objective)
+            .then(a.index.cmp(&b.index))
+    });
     let mut taken: Vec<&animats_evolve::archive::Elite> = Vec::new();
     while taken.len() < n && !left.is_empty() {
         let k = if taken.is_empty() {
@@ -608,7 +615,13 @@ fn spread(archive: &animats_evolve::archive::GridArchive, n: usize) -> Vec<&anim
                 let x = at(e);
                 taken
                     .iter()
-                    .map(|t| at(t).iter().zip(&x).map(|(a, b)| (a - b) * (a - b)).sum::<f64>())
+                    .map(|t| {
+                        at(t)
+                            .iter()
+                            .zip(&x)
+                            .map(|(a, b)| (a - b) * (a - b))
+                            .sum::<f64>()
+                    })
                     .fold(f64::INFINITY, f64::min)
             };
             // `left` is best first: the first of the farthest is the best.

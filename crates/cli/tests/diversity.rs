@@ -42,9 +42,22 @@ fn elites_reproduce_and_archives_do_not_depend_on_threads_or_resume() {
         let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
         assert_eq!(
             header[..8],
-            ["index", "objective", "measures_0", "measures_1", "threshold", "time", "distance", "ended"]
+            [
+                "index",
+                "objective",
+                "measures_0",
+                "measures_1",
+                "threshold",
+                "time",
+                "distance",
+                "ended"
+            ]
         );
-        let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+        let rows: Vec<Vec<&str>> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect())
+            .collect();
         assert!(!rows.is_empty(), "{optimiser}: an empty archive");
         // Every elite: a scene file that evaluates to its row, bit for bit.
         for row in rows.iter().take(3) {
@@ -68,16 +81,30 @@ fn elites_reproduce_and_archives_do_not_depend_on_threads_or_resume() {
         );
         assert!(dir.join("archive.png").exists());
         let log = read(&dir, "log.csv");
-        assert!(log.lines().next().unwrap().ends_with(",elites,coverage,qd_score,obj_max"));
+        assert!(log
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",elites,coverage,qd_score,obj_max"));
         let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
         assert_eq!(last[last.len() - 4], rows.len().to_string());
         // One thread: the same bits.
         let one = evolve(optimiser, "4", "1", &format!("qd-{optimiser}-1"));
-        assert_eq!(read(&one, "archive.csv"), csv, "{optimiser}: 1 thread against 2");
+        assert_eq!(
+            read(&one, "archive.csv"),
+            csv,
+            "{optimiser}: 1 thread against 2"
+        );
         assert_eq!(read(&one, "log.csv"), log);
         // Two generations, then resumed to four: the same bits.
         let part = evolve(optimiser, "2", "2", &format!("qd-{optimiser}-part"));
-        let o = animats(&["evolve", "--resume", part.to_str().unwrap(), "--generations", "4"]);
+        let o = animats(&[
+            "evolve",
+            "--resume",
+            part.to_str().unwrap(),
+            "--generations",
+            "4",
+        ]);
         assert!(o.status.success(), "{}", text(&o).1);
         assert_eq!(read(&part, "archive.csv"), csv, "{optimiser}: resumed");
         assert_eq!(read(&part, "log.csv"), log);
@@ -90,8 +117,23 @@ fn bad_requests_are_refused() {
     let d = dir.to_str().unwrap();
     let walker = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/walker.toml");
     for (args, says) in [
-        (vec!["evolve", walker, "--optimiser", "map-elites", "--out", d], "[archive]"),
-        (vec!["evolve", HOP_MAP, "--optimiser", "cma-me", "--lanes", "3", "--out", d], "lanes"),
+        (
+            vec!["evolve", walker, "--optimiser", "map-elites", "--out", d],
+            "[archive]",
+        ),
+        (
+            vec![
+                "evolve",
+                HOP_MAP,
+                "--optimiser",
+                "cma-me",
+                "--lanes",
+                "3",
+                "--out",
+                d,
+            ],
+            "lanes",
+        ),
     ] {
         let o = animats(&args);
         let (_, err) = text(&o);

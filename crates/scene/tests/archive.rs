@@ -234,3 +234,34 @@ fn bad_archives_are_refused_naming_the_field() {
         "{e}"
     );
 }
+
+/// A body map's bodies pass the same checks as without the table (the
+/// settle check's scene has no [evolve], and once refused every body for
+/// the [archive] that needs one), and each developed body returns the
+/// body measures of what was built.
+#[test]
+fn bodies_of_a_map_are_checked_and_measured_as_bodies() {
+    use animats_creatures::random::Random;
+    use animats_scene::morphology::MorphologyProblem;
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/bodies_map.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let bare = &text[..text.find("[archive]").unwrap()];
+    let map = MorphologyProblem::parse(&text, "bodies_map.toml").unwrap();
+    let plain = MorphologyProblem::parse(bare, "bodies_walk.toml").unwrap();
+    assert!(map.grid().is_some() && plain.grid().is_none());
+    let mut passed = 0;
+    for k in 0..12 {
+        let g = map.random(&mut Random::for_entry(7, k));
+        let (a, b) = (map.check(&g), plain.check(&g));
+        assert_eq!(a, b, "body {k}");
+        if a.is_ok() {
+            passed += 1;
+            let scene = animats_scene::parse(&map.develop(&g, "").unwrap(), "b.toml").unwrap();
+            let stats = map.stats(&g).unwrap();
+            let size = scene.archive.as_ref().map(|a| a.measures.len());
+            assert_eq!(size, Some(2));
+            assert_eq!(stats.particles, scene.world.len());
+        }
+    }
+    assert!(passed >= 3, "{passed} of 12 random bodies passed");
+}

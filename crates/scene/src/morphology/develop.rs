@@ -50,8 +50,8 @@ pub fn placed(body: &Body, m: &Morphology) -> Vec<DVec3> {
 pub enum Brain {
     /// The oscillator and the scene's `[evolve]` table: the creature.
     Driven,
-    /// No controller and no `[evolve]`: the muscles hold their built
-    /// lengths (the settle check's scene).
+    /// No controller, no `[evolve]` and no `[archive]`: the muscles hold
+    /// their built lengths (the settle check's scene).
     Held,
 }
 
@@ -142,6 +142,7 @@ pub fn develop(
         }
         Brain::Held => {
             doc.remove("evolve");
+            doc.remove("archive");
         }
     }
     if m.self_contact && !doc.contains_key("contacts") {
