@@ -45,7 +45,8 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         spec,
         &Choices {
             optimiser: Some(OptimiserKind::MapElites),
-            generations: Some(50),
+            // 50 to grow the archive, one more to time.
+            generations: Some(51),
             ..Choices::default()
         },
     )?;
@@ -55,6 +56,9 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let generation = state.ask()?;
     let genomes: Vec<Vec<f64>> = generation.genomes().map(<[f64]>::to_vec).collect();
     let n = genomes.len();
+    if n == 0 {
+        return Err("diversity: the run asked for no candidates".into());
+    }
     let with = SceneEvolution(SceneProblem::parse(&text, PATH).map_err(|e| e.to_string())?);
     let start = text.find("[archive]").ok_or("no [archive] table")?;
     let bare =

@@ -21,11 +21,14 @@ pub struct Args {
     /// A scene file with an `[evolve]` table; without one, the thesis's
     /// roobot (scenes/hop_evolver.toml, built in).
     scene: Option<PathBuf>,
-    /// The optimiser of every lane (default: the thesis's hill climber).
+    /// The optimiser of every lane (default: the thesis's hill climber; a
+    /// [morphology] scene's: body-ga). map-elites and cma-me fill the
+    /// scene's [archive] (one lane; docs/DIVERSITY.md).
     #[arg(long, value_parser = optimiser_names())]
     optimiser: Option<OptimiserKind>,
     /// Candidates per generation per lane (default: hill-climber 1, ga 32,
-    /// cma-es 4 + 3 ln n).
+    /// cma-es 4 + 3 ln n, body-ga 16); map-elites and cma-me: per emitter
+    /// (36, 4 + 3 ln n).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     population: Option<u64>,
     /// CMA-ES only: start again with twice the population, up to this many
@@ -190,7 +193,12 @@ pub fn heatmap(
     animats_render::Heatmap {
         title: format!(
             "{} ({}, seed {}): coverage {:.1} %, QD score {:.4e}",
-            state.config.problem.file,
+            Path::new(&state.config.problem.file)
+                .file_name()
+                .map_or_else(
+                    || state.config.problem.file.clone(),
+                    |n| n.to_string_lossy().into_owned()
+                ),
             state.config.optimiser.name(),
             state.config.seed,
             100.0 * s.coverage,

@@ -269,6 +269,8 @@ struct Cameras {
     start: DVec3,
     period: f64,
     fov: f64,
+    /// Also follow up and down (in the same whole periods): hoppers.
+    vertical: bool,
 }
 
 impl Cameras {
@@ -300,6 +302,7 @@ impl Cameras {
             // same in every frame, which also keeps GIFs small.
             period: 2.0 * describe.drawing.floor.unwrap_or(0.5),
             fov: args.fov,
+            vertical: false,
         }
     }
 
@@ -308,7 +311,8 @@ impl Cameras {
         let c = match &self.spec {
             CameraSpec::Auto | CameraSpec::Follow if self.follows => {
                 let moved = centre_of(&self.watched, &s.positions) - self.start;
-                let shift = (DVec3::new(moved.x, 0.0, moved.z) / self.period).round() * self.period;
+                let up = if self.vertical { moved.y.max(0.0) } else { 0.0 };
+                let shift = (DVec3::new(moved.x, up, moved.z) / self.period).round() * self.period;
                 Camera {
                     eye: base.eye + shift,
                     target: base.target + shift,
@@ -514,12 +518,18 @@ fn zoo(args: &Args) -> Result<(), Failure> {
                 .map_err(|e| Failure::Other(e.to_string()))?;
             let mut stage = SceneStage::from_scene(name, scene, None).map_err(Failure::Other)?;
             let mut describe = stage.describe();
-            // Closer than a scene's framing: a tile shows one small body.
-            describe.distance = describe.distance.min(1.1);
+            // An evolved body: closer than a scene's framing, as a tile
+            // shows one small body. A controller's creature (a map of
+            // roobots) keeps its scene's framing.
+            if problem.variation().is_some() {
+                describe.distance = describe.distance.min(1.1);
+            }
             let drawing = &describe.drawing;
             let at_start = snapshot(&stage, drawing);
             let snapshots = shoot(args, &mut stage, drawing, &times)?;
-            let cameras = Cameras::new(args, &stage, &describe, &at_start);
+            let mut cameras = Cameras::new(args, &stage, &describe, &at_start);
+            // A controller's creature on a map (roobots) may hop high.
+            cameras.vertical = problem.variation().is_none();
             Ok(snapshots
                 .iter()
                 .map(|s| {
@@ -555,7 +565,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
     write(args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
     println!(
-        "{}{}: the {} best bodies, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
+        "{}{}: {} {}, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
         dir.display(),
         if several {
             format!(" and {} more runs", dirs.len() - 1)
@@ -563,6 +573,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
             String::new()
         },
         bodies.len(),
+        if cells { "elites" } else { "best bodies" },
         frames.len(),
         if frames.len() == 1 { "" } else { "s" },
         start.elapsed().as_secs_f64(),

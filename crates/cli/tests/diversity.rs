@@ -140,4 +140,47 @@ fn bad_requests_are_refused() {
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
     }
+    // A malformed [archive]: evaluate and evolve both refuse it, naming
+    // the file and the field.
+    let good = std::fs::read_to_string(HOP_MAP).unwrap();
+    for (from, to, says) in [
+        (
+            "ranges = [[0.3, 1.0], [-1.0, 3.0]]",
+            "ranges = [[0.3, 1.0], [3.0, 3.0]]",
+            "archive.ranges[1]",
+        ),
+        ("bins = [20, 20]", "bins = [20]", "archive.bins"),
+        (
+            "bins = [20, 20]",
+            "bins = [20000, 20000]",
+            "at most 10000000",
+        ),
+        (
+            r#"{ kind = "speed" }"#,
+            r#"{ kind = "grace" }"#,
+            "archive.measures[1]",
+        ),
+    ] {
+        assert!(good.contains(from), "{from}");
+        let bad = write(&dir, "bad.toml", &good.replace(from, to));
+        for args in [
+            vec!["evaluate", bad.as_str()],
+            vec![
+                "evolve",
+                bad.as_str(),
+                "--optimiser",
+                "map-elites",
+                "--out",
+                d,
+            ],
+        ] {
+            let o = animats(&args);
+            let (_, err) = text(&o);
+            assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+            assert!(
+                err.contains("bad.toml") && err.contains(says),
+                "{args:?}: {err}"
+            );
+        }
+    }
 }

@@ -194,7 +194,7 @@ fn a_body_run_refuses_what_does_not_fit_it() {
         ..Choices::default()
     };
     let e = Config::new(spec.clone(), &cma).unwrap_err();
-    assert!(e.contains("body-ga, not cma-es"), "{e}");
+    assert!(e.contains("body-ga or map-elites, not cma-es"), "{e}");
     let improvements = GRAPH.replace("[evolve]\n", "[evolve]\nlog = \"improvements\"\n");
     let e = Config::new(
         ProblemSpec {

@@ -162,3 +162,90 @@ fn a_checkpointed_search_resumes_to_the_same_bits() {
         assert!(a.archive.len() > 50, "{} elites", a.archive.len());
     }
 }
+
+/// 100 − |x − 2|², measured by the sums of each half of x.
+fn shifted_sphere(asked: &[Vec<f64>]) -> Vec<Outcome> {
+    asked
+        .iter()
+        .map(|x| {
+            let half = x.len() / 2;
+            Outcome {
+                fitness: 100.0 - x.iter().map(|v| (v - 2.0) * (v - 2.0)).sum::<f64>(),
+                distance: 0.0,
+                time: 0.0,
+                ended: Ended::Timeout,
+                measures: vec![x[..half].iter().sum(), x[half..].iter().sum()],
+            }
+        })
+        .collect()
+}
+
+/// The iso-line emitter and CMA-MAE's archive on a bounded sphere: every
+/// candidate stays within the bounds, every CMA-MAE threshold lies between
+/// `threshold_min` and its elite's objective (each is a running mean of
+/// objectives that beat it), and both are pure functions of their seed.
+#[test]
+fn iso_line_and_cma_mae_keep_their_invariants() {
+    use animats_evolve::optimiser::Bounds;
+    let bounds = Bounds {
+        lo: vec![-1.0; 10],
+        hi: vec![3.0; 10],
+    };
+    for (kind, emitter, lr, tmin) in [
+        (
+            QdKind::MapElites,
+            EmitterName::IsoLine,
+            1.0,
+            f64::NEG_INFINITY,
+        ),
+        (QdKind::CmaMe, EmitterName::Gaussian, 0.01, 0.0),
+    ] {
+        let make = || {
+            let mut g = grid(3);
+            g.ranges = vec![(-5.0, 15.0); 2];
+            g.bins = vec![20, 20];
+            g.emitter = emitter;
+            g.learning_rate = lr;
+            g.threshold_min = tmin;
+            g.sigma = None;
+            Qd::new(
+                kind,
+                g,
+                &[0.5; 10],
+                Some(bounds.clone()),
+                Some(12),
+                3,
+                0,
+                false,
+            )
+            .unwrap()
+        };
+        let mut a = make();
+        for _ in 0..30 {
+            let asked = a.ask(None).unwrap();
+            for x in &asked {
+                assert!(
+                    x.iter().all(|v| (-1.0..=3.0).contains(v)),
+                    "{kind:?}: {x:?}"
+                );
+            }
+            let outcomes = shifted_sphere(&asked);
+            a.tell(&outcomes).unwrap();
+        }
+        assert!(a.archive.len() > 20, "{kind:?}: {} elites", a.archive.len());
+        for e in a.archive.elites() {
+            assert!(e.threshold <= e.objective, "{kind:?}: {e:?}");
+            if lr < 1.0 {
+                assert!(e.threshold >= tmin && e.threshold < e.objective, "{e:?}");
+            } else {
+                assert_eq!(e.threshold, e.objective);
+            }
+        }
+        let mut b = make();
+        for _ in 0..30 {
+            let asked = b.ask(None).unwrap();
+            b.tell(&shifted_sphere(&asked)).unwrap();
+        }
+        assert_eq!(a, b, "{kind:?}");
+    }
+}

@@ -250,8 +250,9 @@ impl Evolution {
     }
 
     /// The outcomes of the last `ask()`'s rows: a dict with `fitness`,
-    /// `time`, `distance` (arrays) and `ended` (strings), as
-    /// `Evaluator.outcomes` gives.
+    /// `time`, `distance` (arrays) and `ended` (strings), and for a
+    /// quality-diversity run `measures` (`(P, k)`), as `Evaluator.outcomes`
+    /// gives.
     fn tell(&mut self, outcomes: &Bound<'_, PyDict>) -> PyResult<()> {
         let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
             outcomes
@@ -262,7 +263,22 @@ impl Evolution {
         let time: Vec<f64> = get("time")?.extract()?;
         let distance: Vec<f64> = get("distance")?.extract()?;
         let ended: Vec<String> = get("ended")?.extract()?;
+        let measures: Vec<Vec<f64>> = match outcomes.get_item("measures")? {
+            None => Vec::new(),
+            Some(m) => match m.extract::<numpy::PyReadonlyArray2<f64>>() {
+                Ok(a) => a
+                    .as_array()
+                    .rows()
+                    .into_iter()
+                    .map(|r| r.to_vec())
+                    .collect(),
+                Err(_) => m.extract()?,
+            },
+        };
         let n = fitness.len();
+        if !measures.is_empty() && measures.len() != n {
+            return Err(value_error("measures and fitness differ in length"));
+        }
         if time.len() != n || distance.len() != n || ended.len() != n {
             return Err(value_error(
                 "fitness, time, distance and ended differ in length",
@@ -286,7 +302,7 @@ impl Evolution {
                     time: time[i],
                     distance: distance[i],
                     ended: ended[i].parse().map_err(value_error)?,
-                    measures: Vec::new(),
+                    measures: measures.get(i).cloned().unwrap_or_default(),
                 })
             })
             .collect::<PyResult<_>>()?;
@@ -401,6 +417,11 @@ impl Evolution {
             .map_err(|e| io(std::io::Error::other(e.to_string())))?;
         if let Some(b) = self.best_toml()? {
             animats_files::write_atomically(&directory.join("best.toml"), b.as_bytes())
+                .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        }
+        // A quality-diversity run: its archive, as `animats evolve` writes it.
+        if let Some(csv) = self.state.archive_csv() {
+            animats_files::write_atomically(&directory.join("archive.csv"), csv.as_bytes())
                 .map_err(|e| io(std::io::Error::other(e.to_string())))?;
         }
         Ok(())

@@ -45,3 +45,22 @@ def test_an_archive_reads_back_and_its_elites_reproduce(cli, tmp_path):
     assert scene["fitness"] == a.objective[best]
     with pytest.raises(FileNotFoundError):
         animats.Archive(tmp_path)
+
+
+def test_an_ask_tell_map_matches_the_command_line(cli, tmp_path):
+    cli("evolve", HOP_MAP, "--optimiser", "cma-me", "--generations", 2, "--population", 6, "--out", tmp_path / "cli")
+    run = animats.Evolution(str(HOP_MAP), optimiser="cma-me", population=6, generations=2)
+    ev = animats.Evaluator(str(HOP_MAP))
+    while not run.done:
+        genomes, _ = run.ask()
+        run.tell(ev.outcomes(genomes))
+    run.save(tmp_path / "py")
+    for f in ("log.csv", "archive.csv"):
+        assert (tmp_path / "py" / f).read_text() == (tmp_path / "cli" / f).read_text(), f
+    # Outcomes without their measures are refused by an archive.
+    run = animats.Evolution(str(HOP_MAP), optimiser="map-elites", population=4, generations=1)
+    genomes, _ = run.ask()
+    o = ev.outcomes(genomes)
+    del o["measures"]
+    with pytest.raises(ValueError, match="measures"):
+        run.tell(o)

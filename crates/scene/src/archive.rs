@@ -501,11 +501,7 @@ impl<'a> Recorder<'a> {
         let on_floor = |p: ParticleId| world.position(p).y - radius[p.index()] <= self.tolerance;
         for (m, sum) in self.measures.iter().zip(&mut self.sums) {
             match m {
-                Measure::ContactFraction(p) => {
-                    if on_floor(*p) {
-                        *sum += 1.0;
-                    }
-                }
+                Measure::ContactFraction(p) if on_floor(*p) => *sum += 1.0,
                 Measure::Feet => {
                     let inv = &world.particles().inv_mass;
                     *sum += world

@@ -229,8 +229,8 @@ impl CmaEmitter {
                 .map(|i| (0..n).map(|j| self.invsqrt[i * n + j] * y[j]).sum())
                 .collect();
             let kps = (cs * (2.0 - cs) * mueff).sqrt();
-            for i in 0..n {
-                self.ps[i] = (1.0 - cs) * self.ps[i] + kps * z[i];
+            for (p, zi) in self.ps.iter_mut().zip(&z) {
+                *p = (1.0 - cs) * *p + kps * zi;
             }
             let ps2: f64 = self.ps.iter().map(|v| v * v).sum();
             let gens = self.current_eval as f64 / self.batch as f64;
@@ -241,8 +241,8 @@ impl CmaEmitter {
                 0.0
             };
             let kpc = hsig * (cc * (2.0 - cc) * mueff).sqrt();
-            for i in 0..n {
-                self.pc[i] = (1.0 - cc) * self.pc[i] + kpc * y[i];
+            for (p, yi) in self.pc.iter_mut().zip(&y) {
+                *p = (1.0 - cc) * *p + kpc * yi;
             }
             let c1a = c1 * (1.0 - (1.0 - hsig * hsig) * cc * (2.0 - cc));
             let wsum: f64 = w.iter().sum();
