@@ -104,14 +104,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let candidates: Vec<animats_evolve::archive::Candidate> = genomes
         .iter()
         .zip(&outcomes)
-        .map(|(g, o)| animats_evolve::archive::Candidate {
-            genome: g,
-            objective: o.fitness,
-            measures: &o.measures,
-            time: o.time,
-            distance: o.distance,
-            ended: o.ended.to_string(),
-        })
+        .map(|(g, o)| animats_evolve::archive::Candidate::new(g, o))
         .collect();
     let (ta, _) = measure(
         runs.max(20),

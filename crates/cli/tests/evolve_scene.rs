@@ -125,7 +125,9 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
     let err = text(&o).1;
     assert!(
         err.contains("invalid value 'annealing' for '--optimiser")
-            && err.contains("[possible values: hill-climber, ga, cma-es, body-ga, map-elites, cma-me]"),
+            && err.contains(
+                "[possible values: hill-climber, ga, cma-es, body-ga, map-elites, cma-me]"
+            ),
         "{err}"
     );
 }

@@ -82,6 +82,20 @@ pub struct Candidate<'a> {
     pub ended: String,
 }
 
+impl<'a> Candidate<'a> {
+    /// `genome` as its evaluation `o` describes it.
+    pub fn new(genome: &'a [f64], o: &'a crate::problem::Outcome) -> Candidate<'a> {
+        Candidate {
+            genome,
+            objective: o.fitness,
+            measures: &o.measures,
+            time: o.time,
+            distance: o.distance,
+            ended: o.ended.to_string(),
+        }
+    }
+}
+
 /// The archive's statistics, as pyribs's `ArchiveStats`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Stats {

@@ -380,14 +380,7 @@ impl Qd {
         let batch: Vec<Candidate> = asked
             .iter()
             .zip(outcomes)
-            .map(|(g, o)| Candidate {
-                genome: g,
-                objective: o.fitness,
-                measures: &o.measures,
-                time: o.time,
-                distance: o.distance,
-                ended: o.ended.to_string(),
-            })
+            .map(|(g, o)| Candidate::new(g, o))
             .collect();
         let added = self.archive.add(&batch);
         let (seed, lane, generation) = (self.seed, self.lane, self.generation);
