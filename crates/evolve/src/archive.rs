@@ -163,6 +163,25 @@ impl GridArchive {
     /// own cell, once, with as many measures as the grid has.
     pub fn validate(&self) -> Result<(), String> {
         let k = self.grid.bins.len();
+        let cells = self
+            .grid
+            .bins
+            .iter()
+            .try_fold(1u64, |n, &b| n.checked_mul(b))
+            .unwrap_or(u64::MAX);
+        if k == 0
+            || self.grid.bins.contains(&0)
+            || cells > animats_scene::archive::MAX_CELLS
+            || self.grid.ranges.len() != k
+            || self.grid.names.len() != k
+            || self
+                .grid
+                .ranges
+                .iter()
+                .any(|(a, b)| !(a.is_finite() && b.is_finite() && a < b))
+        {
+            return Err("the archive's grid is malformed".into());
+        }
         if self.cells.len() != self.elites.len()
             || self.cells.iter().any(|(&i, &at)| {
                 self.elites.get(at).is_none_or(|e| {
@@ -464,6 +483,21 @@ mod tests {
         let r = a.add(&[cand(&g, f64::NAN, &[0.5]), cand(&g, 9.0, &[f64::NAN])]);
         assert!(r.iter().all(|x| x.status == 0));
         assert_eq!(a.len(), 2);
+    }
+
+    /// An archive read back from a checkpoint is checked: an elite out of
+    /// its cell, or a grid of zero bins, is refused, not trusted.
+    #[test]
+    fn a_tampered_archive_is_refused() {
+        let mut a = GridArchive::new(grid(vec![10], vec![(0.0, 1.0)], 1.0, f64::NEG_INFINITY));
+        a.add(&[cand(&[0.0], 1.0, &[0.55])]);
+        assert_eq!(a.validate(), Ok(()));
+        let text = serde_json::to_string(&a).unwrap();
+        let moved: GridArchive = serde_json::from_str(&text.replace("[[5,0]]", "[[6,0]]")).unwrap();
+        assert!(moved.validate().is_err());
+        let mut zero = a.clone();
+        zero.grid.bins = vec![0];
+        assert!(zero.validate().is_err());
     }
 
     /// CMA-MAE's batch threshold: with α = 0.1 and threshold_min 0, two
