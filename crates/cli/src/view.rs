@@ -1,4 +1,5 @@
-//! `animats view SCENE`: run a scene live and watch it in the browser.
+//! `animats view SCENE`: run a scene live and watch it in the browser (a
+//! run's directory: its best, or `--elite CELL` of its map).
 
 use crate::{positive_f64, Failure};
 use animats_viewer::{Options, SceneStage, Server};
@@ -45,8 +46,13 @@ impl Serving {
 /// Arguments of `animats view`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The scene file (TOML).
+    /// The scene file (TOML), or the directory of an `animats evolve` run:
+    /// its best.toml, or with --elite one elite of its map.
     scene: PathBuf,
+    /// With a quality-diversity run's directory: the elite of this cell
+    /// (archive.csv's `index`; the heat map is archive.png).
+    #[arg(long)]
+    elite: Option<u64>,
     #[command(flatten)]
     serving: Serving,
     /// Real-time factor to start at (simulated seconds per wall second;
@@ -60,6 +66,38 @@ pub struct Args {
     follow: Option<String>,
 }
 
+/// The scene to watch: a file as given; a run's directory's best.toml, or
+/// its elite of cell `elite`.
+fn scene_of(path: &std::path::Path, elite: Option<u64>) -> Result<PathBuf, Failure> {
+    if !path.is_dir() {
+        return match elite {
+            Some(_) => Err(Failure::Input(format!(
+                "--elite picks from a quality-diversity run's directory; {} is a file",
+                path.display()
+            ))),
+            None => Ok(path.to_path_buf()),
+        };
+    }
+    let file = match elite {
+        Some(i) => path.join("elites").join(format!("{i}.toml")),
+        None => path.join("best.toml"),
+    };
+    if file.exists() {
+        Ok(file)
+    } else {
+        Err(Failure::Input(match elite {
+            Some(i) => format!(
+                "{}: no elite in cell {i} (archive.csv lists the cells; archive.png shows them)",
+                path.display()
+            ),
+            None => format!(
+                "{}: not the directory of an `animats evolve` run (no best.toml)",
+                path.display()
+            ),
+        }))
+    }
+}
+
 /// Runs the command: serves until Ctrl-C.
 pub fn run(args: Args) -> Result<(), Failure> {
     if !args.speed.is_finite() || args.speed < 0.0 {
@@ -68,9 +106,10 @@ pub fn run(args: Args) -> Result<(), Failure> {
             args.speed
         )));
     }
-    let stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
-        .map_err(Failure::Input)?;
-    crate::warn(&args.scene, stage.warnings());
+    let scene = scene_of(&args.scene, args.elite)?;
+    let stage =
+        SceneStage::following(scene.clone(), args.follow.as_deref()).map_err(Failure::Input)?;
+    crate::warn(&scene, stage.warnings());
     let server = args.serving.bind(args.speed)?;
     let stop = Arc::new(AtomicBool::new(false));
     {

@@ -88,6 +88,10 @@ fn elites_reproduce_and_archives_do_not_depend_on_threads_or_resume() {
             .ends_with(",elites,coverage,qd_score,obj_max"));
         let last: Vec<&str> = log.lines().last().unwrap().split(',').collect();
         assert_eq!(last[last.len() - 4], rows.len().to_string());
+        // `view DIR --elite CELL` serves that elite (Ctrl-C stops it).
+        if optimiser == "map-elites" {
+            watch_elite(&dir, rows[0][0]);
+        }
         // One thread: the same bits.
         let one = evolve(optimiser, "4", "1", &format!("qd-{optimiser}-1"));
         assert_eq!(
@@ -109,6 +113,37 @@ fn elites_reproduce_and_archives_do_not_depend_on_threads_or_resume() {
         assert_eq!(read(&part, "archive.csv"), csv, "{optimiser}: resumed");
         assert_eq!(read(&part, "log.csv"), log);
     }
+}
+
+/// Starts `animats view DIR --elite CELL` on a free port, waits for its
+/// address, and stops it with Ctrl-C: exit 0 with a summary.
+fn watch_elite(dir: &std::path::Path, cell: &str) {
+    use std::io::{BufRead, BufReader, Read};
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_animats"))
+        .args([
+            "view",
+            dir.to_str().unwrap(),
+            "--elite",
+            cell,
+            "--port",
+            "0",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    assert!(line.contains("http://127.0.0.1:"), "{line}");
+    std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let status = child.wait().unwrap();
+    let mut rest = String::new();
+    out.read_to_string(&mut rest).unwrap();
+    assert_eq!(status.code(), Some(0), "{rest}");
 }
 
 #[test]
@@ -133,6 +168,30 @@ fn bad_requests_are_refused() {
                 d,
             ],
             "lanes",
+        ),
+    ] {
+        let o = animats(&args);
+        let (_, err) = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    // An elite that is not in the map; --elite on a file.
+    let run = evolve("map-elites", "1", "2", "qd-bad-view");
+    for (args, says) in [
+        (
+            vec![
+                "view",
+                run.to_str().unwrap(),
+                "--elite",
+                "987654",
+                "--port",
+                "0",
+            ],
+            "no elite in cell 987654",
+        ),
+        (
+            vec!["view", HOP_MAP, "--elite", "3", "--port", "0"],
+            "is a file",
         ),
     ] {
         let o = animats(&args);
