@@ -279,7 +279,7 @@ impl AnyOptimiser {
                 setup.population,
             ))),
             OptimiserKind::MapElites | OptimiserKind::CmaMe => {
-                unreachable!("quality-diversity searches are made above")
+                return Err("a quality-diversity search needs its archive's grid".into())
             }
         })
     }
