@@ -51,19 +51,7 @@ fn evaluate_all(p: &BodyEvolution, bodies: &[Vec<f64>], threads: &rayon::ThreadP
 }
 
 fn row(name: &str, variant: String, per: Timing, checks: Vec<Check>) -> Row {
-    Row {
-        workload: "bodies".into(),
-        variant: format!("{name}: {variant}"),
-        particles: 0,
-        springs: 0,
-        steps: 0,
-        dt: 0.0,
-        evaluations: 1,
-        pairs: 0,
-        engine: per,
-        baseline: None,
-        checks,
-    }
+    Row::per_item("bodies", format!("{name}: {variant}"), per, checks)
 }
 
 fn task(name: &str, path: &str, text: &str, runs: usize) -> Result<Vec<Row>, String> {

@@ -17,19 +17,7 @@ use rayon::prelude::*;
 const PATH: &str = "scenes/hop_map.toml";
 
 fn row(variant: String, per: Timing, checks: Vec<Check>) -> Row {
-    Row {
-        workload: "diversity".into(),
-        variant,
-        particles: 0,
-        springs: 0,
-        steps: 0,
-        dt: 0.0,
-        evaluations: 1,
-        pairs: 0,
-        engine: per,
-        baseline: None,
-        checks,
-    }
+    Row::per_item("diversity", variant, per, checks)
 }
 
 /// Runs the workload.

@@ -262,6 +262,24 @@ pub struct Row {
 }
 
 impl Row {
+    /// A row timed per item (an evaluation, a body), with no particle
+    /// counts and no baseline.
+    pub fn per_item(workload: &str, variant: String, per: Timing, checks: Vec<Check>) -> Row {
+        Row {
+            workload: workload.into(),
+            variant,
+            particles: 0,
+            springs: 0,
+            steps: 0,
+            dt: 0.0,
+            evaluations: 1,
+            pairs: 0,
+            engine: per,
+            baseline: None,
+            checks,
+        }
+    }
+
     /// How many threads the measurement used, and how: `"one sim"` (one
     /// world, on one thread or split among several) or `"independent sims"`
     /// (a world or evaluation per thread). Read from the variant, which

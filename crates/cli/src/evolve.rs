@@ -165,11 +165,9 @@ fn save_elites(dir: &Path, state: &State) -> Result<(), Failure> {
     let elites = dir.join("elites");
     std::fs::create_dir_all(&elites)
         .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", elites.display())))?;
-    for e in archive.elites() {
-        if let Some(text) = state.elite_toml(e.index).map_err(io)? {
-            let path = elites.join(format!("{}.toml", e.index));
-            animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
-        }
+    for (index, text) in state.elite_tomls().map_err(io)? {
+        let path = elites.join(format!("{index}.toml"));
+        animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
     }
     let png = animats_render::heatmap_png(&heatmap(state, archive)).map_err(io)?;
     animats_files::write_atomically(&dir.join("archive.png"), &png).map_err(io)

@@ -723,43 +723,46 @@ impl State {
         self.lanes.first().and_then(|l| l.optimiser.archive())
     }
 
-    /// Elite `index` of a quality-diversity run as a whole scene
-    /// (`elites/<index>.toml`): `animats evaluate` reproduces its fitness
-    /// and measures bit for bit.
-    pub fn elite_toml(&self, index: u64) -> Result<Option<String>, String> {
+    /// Every elite of a quality-diversity run as a whole scene
+    /// (`elites/<index>.toml`), with its cell index, in the order the
+    /// cells were first filled: `animats evaluate` reproduces each one's
+    /// fitness and measures bit for bit. Empty for any other run.
+    pub fn elite_tomls(&self) -> Result<Vec<(u64, String)>, String> {
         let Some(archive) = self.archive() else {
-            return Ok(None);
+            return Ok(Vec::new());
         };
-        let Some(e) = archive.get(index) else {
-            return Ok(None);
-        };
+        // Built once for all the elites.
         let problem = self.config.problem.build()?;
-        let cell: Vec<String> = archive
-            .unravel(index)
+        archive
+            .elites()
             .iter()
-            .map(|c| c.to_string())
-            .collect();
-        let measures: Vec<String> = archive
-            .grid
-            .names
-            .iter()
-            .zip(&e.measures)
-            .map(|(n, m)| format!("{n} = {m}"))
-            .collect();
-        let comment = format!(
-            "{} with elite {index} (cell [{}]) of `animats evolve` ({}, seed {}, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}; measures: {}.\nReproduce it with `animats evaluate FILE --json`; watch it with `animats view FILE`.",
-            self.config.problem.file,
-            cell.join(", "),
-            self.config.optimiser.name(),
-            self.config.seed,
-            self.generation(),
-            e.objective,
-            e.distance,
-            e.time,
-            e.ended,
-            measures.join(", ")
-        );
-        problem.scene_toml(&e.genome, &comment).map(Some)
+            .map(|e| {
+                let cell: Vec<String> =
+                    archive.unravel(e.index).iter().map(|c| c.to_string()).collect();
+                let measures: Vec<String> = archive
+                    .grid
+                    .names
+                    .iter()
+                    .zip(&e.measures)
+                    .map(|(n, m)| format!("{n} = {m}"))
+                    .collect();
+                let comment = format!(
+                    "{} with elite {} (cell [{}]) of `animats evolve` ({}, seed {}, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}; measures: {}.\nReproduce it with `animats evaluate FILE --json`; watch it with `animats view FILE`.",
+                    self.config.problem.file,
+                    e.index,
+                    cell.join(", "),
+                    self.config.optimiser.name(),
+                    self.config.seed,
+                    self.generation(),
+                    e.objective,
+                    e.distance,
+                    e.time,
+                    e.ended,
+                    measures.join(", ")
+                );
+                Ok((e.index, problem.scene_toml(&e.genome, &comment)?))
+            })
+            .collect()
     }
 
     /// `archive.csv`: one row per occupied cell, in cell order, with

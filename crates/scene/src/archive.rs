@@ -21,7 +21,7 @@
 use crate::build::{At, Names};
 use crate::def::Typed;
 use crate::error::SceneError;
-use crate::evaluate::EvolveSpec;
+use crate::evaluate::{centre_of as centre, EvolveSpec};
 use animats_engine::{DVec3, ParticleId, World};
 use serde::Deserialize;
 
@@ -411,24 +411,6 @@ impl MeasureEntry {
             MeasureEntry::Mass {} => "mass".into(),
             MeasureEntry::Size {} => "size".into(),
         }
-    }
-}
-
-/// Centre of mass of `ids` (one particle: its position).
-fn centre(world: &World, ids: &[ParticleId]) -> DVec3 {
-    if let [p] = ids {
-        return world.position(*p);
-    }
-    let (mut sum, mut m) = (DVec3::ZERO, 0.0);
-    let mass = &world.particles().mass;
-    for p in ids {
-        sum += world.position(*p) * mass[p.index()];
-        m += mass[p.index()];
-    }
-    if m > 0.0 {
-        sum / m
-    } else {
-        sum / ids.len().max(1) as f64
     }
 }
 

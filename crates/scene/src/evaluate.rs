@@ -229,20 +229,7 @@ impl EvolveSpec {
     /// The centre of mass of the particles that count (of one particle:
     /// its position, exactly).
     pub fn centre(&self, world: &World) -> DVec3 {
-        if let [p] = self.particles[..] {
-            return world.position(p);
-        }
-        let (mut sum, mut m) = (DVec3::ZERO, 0.0);
-        let mass = &world.particles().mass;
-        for p in &self.particles {
-            sum += world.position(*p) * mass[p.index()];
-            m += mass[p.index()];
-        }
-        if m > 0.0 {
-            sum / m
-        } else {
-            sum / self.particles.len().max(1) as f64
-        }
+        centre_of(world, &self.particles)
     }
 
     /// The end rule that holds now, if any: the first of `fail_on_touch`
@@ -260,6 +247,25 @@ impl EvolveSpec {
             .iter()
             .find(|s| (world.position(s.a) - world.position(s.b)).length() >= s.length)
             .map(|s| Ended::Stretch(s.name.clone()))
+    }
+}
+
+/// The centre of mass of `ids` (of one particle: its position, exactly;
+/// of massless ones: their mean position).
+pub fn centre_of(world: &World, ids: &[ParticleId]) -> DVec3 {
+    if let [p] = ids {
+        return world.position(*p);
+    }
+    let (mut sum, mut m) = (DVec3::ZERO, 0.0);
+    let mass = &world.particles().mass;
+    for p in ids {
+        sum += world.position(*p) * mass[p.index()];
+        m += mass[p.index()];
+    }
+    if m > 0.0 {
+        sum / m
+    } else {
+        sum / ids.len().max(1) as f64
     }
 }
 
