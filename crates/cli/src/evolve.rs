@@ -262,6 +262,14 @@ fn start(args: &Args) -> Result<(PathBuf, State), Failure> {
         },
         None => ProblemSpec::thesis(),
     };
+    if let Some(path) = &args.scene {
+        // What `simulate` and `evaluate` would warn of (an unstable step, a
+        // particle inside the floor, an actuator that jumps at t = 0); a
+        // [morphology] scene's bodies are checked as they develop.
+        if let Ok(scene) = animats_scene::parse(&problem.text, &problem.file) {
+            crate::warn(path, &scene.warnings);
+        }
+    }
     let config = Config::new(problem, &choices).map_err(input)?;
     let state = State::new(config).map_err(input)?;
     writable(&dir)?;

@@ -56,7 +56,7 @@ impl At<'_> {
     pub(crate) fn err(&self, field: &str, message: impl Into<String>) -> SceneError {
         SceneError {
             file: self.src.file.to_string(),
-            line: Some(self.src.line_of(self.offset)),
+            line: Some(self.src.field_line(self.offset, field)),
             entry: Some(self.entry.clone()),
             field: (!field.is_empty()).then(|| field.to_string()),
             message: message.into(),
@@ -258,6 +258,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .recommended_dt(world.integrator())
             .map_or(most, |r| r.min(most))
     });
+    let mut actuator_warnings = Vec::new();
     crate::nervous::build(
         def,
         src,
@@ -266,6 +267,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         &mut world,
         &mut nervous,
         &mut origins,
+        &mut actuator_warnings,
     )?;
     let evolve = match &def.evolve {
         Some(entry) => Some(crate::evaluate::EvolveSpec::build(
@@ -289,7 +291,8 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     };
     let guard =
         animats_engine::DivergenceGuard::new(&world, !actors.is_empty() || !nervous.is_empty());
-    let warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
+    let mut warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
+    warnings.extend(actuator_warnings);
     Ok(Scene {
         world,
         guard,

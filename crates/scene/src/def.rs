@@ -207,8 +207,10 @@ pub struct ActuatorEntry {
     pub min: f64,
     /// The value at level 1.
     pub max: f64,
-    /// The initial level, default 0.5.
-    pub level: f64,
+    /// The initial level; default: the level that gives the target's
+    /// value as built (0.5 when that is the middle of the range), or 0.5
+    /// with a warning when the built value lies outside [min, max].
+    pub level: Option<f64>,
     /// The most the level may change per second (a muscle's top speed);
     /// default: no limit.
     pub rate: Option<f64>,
@@ -241,8 +243,7 @@ struct ActuatorKeys {
     constant_force: Option<String>,
     min: f64,
     max: f64,
-    #[serde(default = "default_level")]
-    level: f64,
+    level: Option<f64>,
     rate: Option<f64>,
     gate: Option<GateEntry>,
 }
@@ -282,10 +283,6 @@ pub struct GateEntry {
     pub above: Option<f64>,
     /// Open while the level is at most this.
     pub at_most: Option<f64>,
-}
-
-fn default_level() -> f64 {
-    0.5
 }
 
 /// `[evolve]`: what `animats evolve SCENE` tunes and how an evaluation

@@ -7,7 +7,7 @@ use crate::build::{at, check_name, At, Names};
 use crate::def::*;
 use crate::error::SceneError;
 use crate::source::Source;
-use animats_creatures::actuator::Actuator;
+use animats_creatures::actuator::{Actuated, Actuator};
 use animats_creatures::actuators::{
     AnyActuator, ForceScale, JointRestAngle, JointTorque, SpringRestLength,
 };
@@ -71,8 +71,9 @@ pub(crate) fn build(
     world: &mut World,
     ns: &mut NervousSystem,
     origins: &mut Vec<(&'static str, usize)>,
+    warnings: &mut Vec<String>,
 ) -> Result<(), SceneError> {
-    let gated = actuators(def, src, handles, world, ns)?;
+    let gated = actuators(def, src, handles, world, ns, warnings)?;
     for (k, entry) in def.sensor.iter().enumerate() {
         let at = at(src, format!("sensor[{k}]"), entry);
         let e = entry.get_ref().get().map_err(|(f, m)| at.err(f, m))?;
@@ -110,12 +111,13 @@ fn actuators<'d, 's>(
     handles: &Handles,
     world: &mut World,
     ns: &mut NervousSystem,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<(usize, At<'s>, &'d GateEntry)>, SceneError> {
     let mut gated = Vec::new();
     for (k, entry) in def.actuator.iter().enumerate() {
         let at = at(src, format!("actuator[{k}]"), entry);
         let e = entry.get_ref().get().map_err(|(f, m)| at.err(f, m))?;
-        let a = actuator(&at, e, handles, world)?;
+        let a = actuator(&at, e, handles, world, warnings)?;
         if ns.actuator(&e.name).is_some() {
             return Err(at.err("name", format!("duplicate actuator name `{}`", e.name)));
         }
@@ -195,18 +197,54 @@ fn controllers(
     Ok(())
 }
 
+/// An actuator's starting level: the one written, else the one that gives
+/// the target's value as built (`built`) — exactly 0.5 when the middle of
+/// the range is that value to 0.1 % of the range (a range written with
+/// rounded numbers around the built length: the level would differ from
+/// 0.5 by less than 0.001) — else, when `built` lies
+/// outside [min, max], 0.5 and a warning: the parameter jumps at t = 0.
+fn default_level(
+    a: &ActuatorEntry,
+    min: f64,
+    max: f64,
+    built: f64,
+    warnings: &mut Vec<String>,
+) -> f64 {
+    if let Some(level) = a.level {
+        return level;
+    }
+    let span = max - min;
+    let middle = min + 0.5 * span;
+    if (middle - built).abs() <= 1e-3 * span.abs() {
+        return 0.5;
+    }
+    let (lo, hi) = (min.min(max), min.max(max));
+    if (lo..=hi).contains(&built) && span != 0.0 {
+        return (built - min) / span;
+    }
+    warnings.push(format!(
+        "actuator `{}`: its target is built at {built} but its range is [{min}, {max}]; with no `level` it starts at 0.5 ({middle}), a jump at t = 0 — give `level`, or a range that holds {built}",
+        a.name
+    ));
+    0.5
+}
+
 fn actuator(
     at: &At,
     a: &ActuatorEntry,
     h: &Handles,
     world: &mut World,
+    warnings: &mut Vec<String>,
 ) -> Result<AnyActuator, SceneError> {
     check_name(at, &a.name)?;
     let (min, max) = (at.finite("min", a.min)?, at.finite("max", a.max)?);
-    let level = at.finite("level", a.level)?;
-    if !(0.0..=1.0).contains(&level) {
-        return Err(at.err("level", format!("must be in [0, 1], got {level}")));
+    if let Some(level) = a.level {
+        let level = at.finite("level", level)?;
+        if !(0.0..=1.0).contains(&level) {
+            return Err(at.err("level", format!("must be in [0, 1], got {level}")));
+        }
     }
+    let mut level = |built: f64| default_level(a, min, max, built, warnings);
     Ok(match &a.target {
         Target::Spring(n) => {
             let id = lookup(&h.springs, at, "spring", "spring", n)?;
@@ -217,6 +255,7 @@ fn actuator(
                 ));
             }
             let target = SpringRestLength(id);
+            let level = level(target.get(world));
             AnyActuator::Spring(Actuator::with_level(target, min, max, level, world))
         }
         Target::AngleJoint(n) => {
@@ -227,11 +266,13 @@ fn actuator(
                 }
             }
             let target = JointRestAngle(id);
+            let level = level(target.get(world));
             AnyActuator::AngleJoint(Actuator::with_level(target, min, max, level, world))
         }
         Target::TorqueJoint(n) => {
             let id = lookup(&h.torque_joints, at, "torque_joint", "torque joint", n)?;
             let target = JointTorque(id);
+            let level = level(target.get(world));
             AnyActuator::TorqueJoint(Actuator::with_level(target, min, max, level, world))
         }
         Target::ConstantForce(n) => {
@@ -243,6 +284,7 @@ fn actuator(
                 n,
             )?;
             let target = ForceScale { force, base };
+            let level = level(target.get(world));
             AnyActuator::ConstantForce(Actuator::with_level(target, min, max, level, world))
         }
     })

@@ -19,6 +19,28 @@ impl Source<'_> {
             + 1
     }
 
+    /// 1-based line where `field` of the entry starting at byte `offset`
+    /// is written: the first line from there, before the next table
+    /// header, that assigns its first component (`gate` of `gate.above`)
+    /// as `key =`, inline tables included; the entry's own line when the
+    /// field is not written (a default) or not found.
+    pub fn field_line(&self, offset: usize, field: &str) -> usize {
+        let first = self.line_of(offset);
+        let key = field.split(['.', '[']).next().unwrap_or("");
+        if key.is_empty() {
+            return first;
+        }
+        for (i, line) in self.text.lines().enumerate().skip(first - 1) {
+            if i + 1 > first && header(line).is_some() {
+                break;
+            }
+            if assigns(line, key) {
+                return i + 1;
+            }
+        }
+        first
+    }
+
     /// The table entry that encloses byte `offset`: `name[k]` for the k-th
     /// (0-based) `[[name]]` header before it, `name` for a `[name]` table, or
     /// `None` at top level.
@@ -67,6 +89,27 @@ impl Source<'_> {
                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
         ok.then(|| key.to_string())
     }
+}
+
+/// Whether `line` assigns `key` (`key = ...`, `{ key = ...`, `, key = ...`),
+/// outside a comment.
+fn assigns(line: &str, key: &str) -> bool {
+    let code = line.split('#').next().unwrap_or("");
+    let bytes = code.as_bytes();
+    let mut from = 0;
+    while let Some(i) = code[from..].find(key).map(|i| i + from) {
+        let before = code[..i].trim_end();
+        let starts = before.is_empty() || before.ends_with('{') || before.ends_with(',');
+        let after = code[i + key.len()..].trim_start();
+        let word_ends = bytes
+            .get(i + key.len())
+            .is_none_or(|b| !(b.is_ascii_alphanumeric() || *b == b'_' || *b == b'-'));
+        if starts && word_ends && after.starts_with('=') && !after.starts_with("==") {
+            return true;
+        }
+        from = i + key.len();
+    }
+    false
 }
 
 /// The table a header line opens: `([[name]]` → `(name, true)`, `[name]` →

@@ -25,15 +25,22 @@ fn every_shipped_scene_builds_and_runs_a_second() {
 }
 
 #[test]
-fn errors_name_the_line_of_the_entry() {
+fn errors_name_the_line_of_the_field() {
     let text = "[world]\ndt = 0.01\n\n[[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0, 0, 0]\nradius = 0.1\n\n[[particle]]\nname = \"b\"\nmass = -1.0\nposition = [1, 0, 0]\nradius = 0.1\n";
     let e = animats_scene::parse(text, "x.toml").err().unwrap();
-    assert_eq!(e.line, Some(10));
+    assert_eq!(e.line, Some(12), "the line of `mass`, not of [[particle]]");
     assert_eq!(e.entry.as_deref(), Some("particle[1]"));
     assert_eq!(e.field.as_deref(), Some("mass"));
     assert_eq!(
         e.to_string(),
-        "x.toml:10: particle[1].mass: must be > 0, got -1"
+        "x.toml:12: particle[1].mass: must be > 0, got -1"
+    );
+    // A field after a line whose comment names it: the assignment counts.
+    let text = "[[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0, 0, 0]\nradius = 0.1\n[[particle]]\nname = \"b\"\nmass = 1.0\nposition = [1, 0, 0]\nradius = 0.1\n[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 10.0 # rest_length = 1\nrest_length = -2.0\n";
+    let e = animats_scene::parse(text, "y.toml").err().unwrap();
+    assert_eq!(
+        (e.line, e.field.as_deref()),
+        (Some(15), Some("rest_length"))
     );
 }
 
