@@ -258,8 +258,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
             .recommended_dt(world.integrator())
             .map_or(most, |r| r.min(most))
     });
-    let mut actuator_warnings = Vec::new();
-    crate::nervous::build(
+    let actuator_warnings = crate::nervous::build(
         def,
         src,
         &names,
@@ -267,7 +266,6 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         &mut world,
         &mut nervous,
         &mut origins,
-        &mut actuator_warnings,
     )?;
     let evolve = match &def.evolve {
         Some(entry) => Some(crate::evaluate::EvolveSpec::build(

@@ -294,6 +294,9 @@ pub struct EvolveEntry {
     /// The controller whose parameters form the genome (a `[morphology]`
     /// scene's is its body's own, `body`: left out).
     pub controller: Option<String>,
+    /// Several controllers evolved at once, their genomes end to end in
+    /// this order (instead of `controller`).
+    pub controllers: Option<Vec<String>>,
     /// Seconds per evaluation; default 20.
     #[serde(default = "default_eval_duration")]
     pub duration: f64,

@@ -39,6 +39,10 @@ pub struct EvolveSpec {
     pub controller: Option<String>,
     /// Its index in [`NervousSystem::controllers`].
     pub index: Option<usize>,
+    /// Every controller evolved (`controllers`, or the one `controller`):
+    /// its index in [`NervousSystem::controllers`] and the table it was
+    /// written in; the genome is theirs end to end, in this order.
+    pub evolved: Vec<(usize, (&'static str, usize))>,
     /// Seconds per evaluation.
     pub duration: f64,
     /// Whose centre of mass counts.
@@ -99,14 +103,37 @@ impl EvolveSpec {
         world: &World,
         dt: f64,
     ) -> Result<EvolveSpec, SceneError> {
-        let index = match e.controller.as_deref() {
-            None => None,
-            Some(c) => Some(
-                nervous
-                    .controller(c)
-                    .ok_or_else(|| at.err("controller", format!("no controller named `{c}`")))?,
-            ),
+        let (field, names_evolved): (&str, Vec<&String>) = match (&e.controller, &e.controllers) {
+            (Some(_), Some(_)) => {
+                return Err(at.err(
+                    "controllers",
+                    "give `controller` (one) or `controllers` (several), not both",
+                ))
+            }
+            (Some(c), None) => ("controller", vec![c]),
+            (None, Some(list)) if list.is_empty() => {
+                return Err(at.err("controllers", "name at least one controller"))
+            }
+            (None, Some(list)) => ("controllers", list.iter().collect()),
+            (None, None) => ("controller", Vec::new()),
         };
+        let mut evolved = Vec::new();
+        for c in &names_evolved {
+            let i = nervous
+                .controller(c)
+                .ok_or_else(|| at.err(field, format!("no controller named `{c}`")))?;
+            if evolved.iter().any(|(j, _)| *j == i) {
+                return Err(at.err(field, format!("controller `{c}` is named twice")));
+            }
+            if nervous.controllers[i].brain.genome().is_empty() {
+                return Err(at.err(
+                    field,
+                    format!("controller `{c}` has no parameters to evolve"),
+                ));
+            }
+            evolved.push((i, origins[i]));
+        }
+        let index = evolved.first().map(|(i, _)| *i);
         let duration = Self::duration(at, e, dt)?;
         let particles = match &e.particles {
             None => world.particle_ids().collect(),
@@ -130,14 +157,6 @@ impl EvolveSpec {
             touch_tolerance,
             fail_on_stretch,
         } = Self::end_rules(at, e, names)?;
-        if let (Some(i), Some(c)) = (index, &e.controller) {
-            if nervous.controllers[i].brain.genome().is_empty() {
-                return Err(at.err(
-                    "controller",
-                    format!("controller `{c}` has no parameters to evolve"),
-                ));
-            }
-        }
         let lanes = match e.lanes {
             Some(l) if !(1..=crate::evaluate::MAX_LANES).contains(&l) => {
                 return Err(at.err(
@@ -148,7 +167,7 @@ impl EvolveSpec {
             other => other,
         };
         Ok(EvolveSpec {
-            controller: e.controller.clone(),
+            controller: names_evolved.first().map(|c| c.to_string()),
             index,
             duration,
             particles,
@@ -158,7 +177,8 @@ impl EvolveSpec {
             fail_on_touch,
             touch_tolerance,
             fail_on_stretch,
-            table: index.map(|i| origins[i]),
+            table: evolved.first().map(|(_, t)| *t),
+            evolved,
             mutation: e.mutation,
             log: e.log,
             lanes,
@@ -423,7 +443,8 @@ pub struct SceneProblem {
     spec: EvolveSpec,
     start: Vec<f64>,
     bounds: Vec<(f64, f64)>,
-    keys: Vec<GenomeKey>,
+    /// Per evolved controller, in genome order: its genome's keys.
+    keys: Vec<Vec<GenomeKey>>,
     grid: Option<crate::archive::Grid>,
 }
 
@@ -439,19 +460,25 @@ impl SceneProblem {
                 "the scene has no [evolve] table: add one naming the controller to evolve (docs/SCENES.md)",
             )
         })?;
-        let index = spec.index.ok_or_else(|| {
-            SceneError::file(
+        if spec.evolved.is_empty() {
+            return Err(SceneError::file(
                 file,
                 "[evolve] names no controller: the scene can be evaluated as it is, not evolved; add `controller = \"NAME\"` (docs/SCENES.md)",
-            )
-        })?;
-        let brain = &scene.nervous.controllers[index].brain;
+            ));
+        }
+        let (mut start, mut bounds, mut keys) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, _) in &spec.evolved {
+            let brain = &scene.nervous.controllers[*i].brain;
+            start.extend(brain.genome());
+            bounds.extend(brain.bounds());
+            keys.push(brain.genome_keys());
+        }
         Ok(SceneProblem {
             file: file.to_string(),
             text: text.to_string(),
-            start: brain.genome(),
-            bounds: brain.bounds(),
-            keys: brain.genome_keys(),
+            start,
+            bounds,
+            keys,
             spec: spec.clone(),
             grid: scene.archive.as_ref().map(|a| a.grid.clone()),
             def,
@@ -507,11 +534,21 @@ impl SceneProblem {
     /// The scene built afresh with `genome` in its `[evolve]` controller.
     pub fn scene(&self, genome: &[f64]) -> Result<Scene, String> {
         let mut scene = self.fresh()?;
-        let index = self
-            .spec
-            .index
-            .ok_or("the scene names no controller to evolve")?;
-        scene.nervous.controllers[index].brain.set_genome(genome)?;
+        if genome.len() != self.start.len() {
+            return Err(format!(
+                "a genome for this scene has {} numbers, got {}",
+                self.start.len(),
+                genome.len()
+            ));
+        }
+        let mut at = 0;
+        for ((i, _), keys) in self.spec.evolved.iter().zip(&self.keys) {
+            let n: usize = keys.iter().map(GenomeKey::genes).sum();
+            scene.nervous.controllers[*i]
+                .brain
+                .set_genome(&genome[at..at + n])?;
+            at += n;
+        }
         Ok(scene)
     }
 
@@ -533,16 +570,24 @@ impl SceneProblem {
             .text
             .parse()
             .map_err(|e| format!("{}: {e}", self.file))?;
-        let (kind, k) = self
-            .spec
-            .table
-            .ok_or("the scene names no controller to evolve")?;
-        let table = doc
-            .get_mut(kind)
-            .and_then(|c| c.as_array_of_tables_mut())
-            .and_then(|a| a.get_mut(k))
-            .ok_or_else(|| format!("{kind}[{k}] is not where the scene had it"))?;
-        write_genome(table, &self.keys, genome)?;
+        if genome.len() != self.start.len() {
+            return Err(format!(
+                "a genome of {} numbers for a scene whose controllers hold {}",
+                genome.len(),
+                self.start.len()
+            ));
+        }
+        let mut at = 0;
+        for ((_, (kind, k)), keys) in self.spec.evolved.iter().zip(&self.keys) {
+            let table = doc
+                .get_mut(kind)
+                .and_then(|c| c.as_array_of_tables_mut())
+                .and_then(|a| a.get_mut(*k))
+                .ok_or_else(|| format!("{kind}[{k}] is not where the scene had it"))?;
+            let n: usize = keys.iter().map(GenomeKey::genes).sum();
+            write_genome(table, keys, &genome[at..at + n])?;
+            at += n;
+        }
         Ok(commented(comment, &doc))
     }
 }

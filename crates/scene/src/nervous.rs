@@ -62,7 +62,8 @@ fn lookup<T: Copy>(
 
 /// Builds every actuator, sensor and controller of the scene into `ns`,
 /// which holds what creatures brought; `origins` says, for each controller,
-/// the table it was written in, and gains the scene's own.
+/// the table it was written in, and gains the scene's own. Returns the
+/// warnings: actuators whose range misses their target's built value.
 pub(crate) fn build(
     def: &SceneDef,
     src: &Source,
@@ -71,9 +72,9 @@ pub(crate) fn build(
     world: &mut World,
     ns: &mut NervousSystem,
     origins: &mut Vec<(&'static str, usize)>,
-    warnings: &mut Vec<String>,
-) -> Result<(), SceneError> {
-    let gated = actuators(def, src, handles, world, ns, warnings)?;
+) -> Result<Vec<String>, SceneError> {
+    let mut warnings = Vec::new();
+    let gated = actuators(def, src, handles, world, ns, &mut warnings)?;
     for (k, entry) in def.sensor.iter().enumerate() {
         let at = at(src, format!("sensor[{k}]"), entry);
         let e = entry.get_ref().get().map_err(|(f, m)| at.err(f, m))?;
@@ -99,7 +100,8 @@ pub(crate) fn build(
             above,
         });
     }
-    controllers(def, src, ns, origins)
+    controllers(def, src, ns, origins)?;
+    Ok(warnings)
 }
 
 /// The scene's `[[actuator]]` entries, into `ns`; returns those with a

@@ -539,10 +539,16 @@ fn every_brain_kind_writes_its_genes_back_where_it_reads_them() {
         "kind = \"neural\"\ninputs = [\"gap\", \"bend\"]\noutputs = [\"m\"]\nhidden = [3]\nclock = 1.5",
         1,
     ) + "\n[evolve]\ncontroller = \"osc\"\nduration = 0.5\n";
+    let ctrnn = PAIR.replacen(
+        "kind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 2.0\namplitude = [0.3]\nphase = [0.5]\noffset = [0.4]",
+        "kind = \"ctrnn\"\ninputs = [\"gap\"]\noutputs = [\"m\"]\nneurons = 3\nclock = 1.0",
+        1,
+    ) + "\n[evolve]\ncontroller = \"osc\"\nduration = 0.5\n";
     let raibert = animats_scene::HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
     let cases = [
         ("fsm", pogo.as_str()),
         ("neural", neural.as_str()),
+        ("ctrnn", ctrnn.as_str()),
         ("oscillator", COAST),
         ("hop", animats_scene::HOP_EVOLVER),
         ("raibert", raibert.as_str()),
@@ -567,5 +573,73 @@ fn every_brain_kind_writes_its_genes_back_where_it_reads_them() {
         let written = p.best_toml(&g, "").unwrap();
         let back = SceneProblem::parse(&written, "best.toml").unwrap();
         assert_eq!(back.start(), g, "{kind}:\n{written}");
+    }
+}
+
+#[test]
+fn several_controllers_evolve_as_one_genome() {
+    // PAIR with a second muscle (b–c) that a CTRNN drives beside the
+    // oscillator: `controllers = ["osc", "net"]` evolves both, the
+    // oscillator's genes first.
+    let two = PAIR.to_string()
+        + r#"
+[[spring]]
+name = "upper"
+a = "b"
+b = "c"
+stiffness = 100.0
+
+[[actuator]]
+name = "m2"
+spring = "upper"
+min = 0.3
+max = 0.5
+
+[[controller]]
+name = "net"
+kind = "ctrnn"
+inputs = ["gap"]
+outputs = ["m2"]
+neurons = 2
+clock = 1.0
+"#;
+    let text = two.clone() + "\n[evolve]\ncontrollers = [\"osc\", \"net\"]\nduration = 0.5\n";
+    let p = SceneProblem::parse(&text, "two.toml").unwrap_or_else(|e| panic!("{e}"));
+    // Oscillator: 1 + 3 genes; CTRNN of 2 neurons, 1 sensor + 2 clock
+    // inputs: 3·2 + 2·2 + 2·3 = 16.
+    assert_eq!(p.start().len(), 4 + 16);
+    let g: Vec<f64> = p
+        .start()
+        .iter()
+        .enumerate()
+        .map(|(i, x)| x + 0.01 * (i as f64 + 1.0))
+        .collect();
+    let written = p.best_toml(&g, "").unwrap();
+    let back = SceneProblem::parse(&written, "best.toml").unwrap();
+    assert_eq!(back.start(), g, "{written}");
+    // The evaluation of the genome is that of its scene written out.
+    let direct = p.evaluate(&g).unwrap();
+    let again = evaluate(animats_scene::parse(&written, "best.toml").unwrap()).unwrap();
+    assert_eq!(direct.fitness.to_bits(), again.fitness.to_bits());
+    // Each controller's genes land in its own brain.
+    let scene = p.scene(&g).unwrap();
+    let spec = scene.evolve.as_ref().unwrap();
+    let osc = &scene.nervous.controllers[spec.evolved[0].0].brain;
+    let net = &scene.nervous.controllers[spec.evolved[1].0].brain;
+    assert_eq!((osc.kind(), net.kind()), ("oscillator", "ctrnn"));
+    assert_eq!(osc.genome(), g[..4]);
+    assert_eq!(net.genome(), g[4..]);
+    for (evolve, field) in [
+        (
+            "controller = \"osc\"\ncontrollers = [\"net\"]",
+            "controllers",
+        ),
+        ("controllers = [\"osc\", \"osc\"]", "controllers"),
+        ("controllers = [\"osc\", \"nope\"]", "controllers"),
+        ("controllers = []", "controllers"),
+    ] {
+        let text = two.clone() + "\n[evolve]\n" + evolve + "\nduration = 0.5\n";
+        let e = animats_scene::parse(&text, "two.toml").err().unwrap();
+        assert_eq!(e.field.as_deref(), Some(field), "{evolve}: {e}");
     }
 }

@@ -4,10 +4,12 @@
 //! `build`). Adding a kind: a file here, and its variant of
 //! [`ControllerEntry`] below.
 
+pub mod ctrnn;
 pub mod fsm;
 pub mod neural;
 pub mod oscillator;
 
+pub use ctrnn::{Ctrnn, CtrnnEntry};
 pub use fsm::{Condition, Fsm, FsmEntry, FsmState, StateEntry, Transition, TransitionEntry};
 pub use neural::{Neural, NeuralEntry};
 pub use oscillator::{Oscillator, OscillatorEntry};
@@ -27,6 +29,8 @@ pub enum ControllerEntry {
     Neural(NeuralEntry),
     /// A finite-state machine.
     Fsm(FsmEntry),
+    /// A continuous-time recurrent network.
+    Ctrnn(CtrnnEntry),
 }
 
 impl ControllerEntry {
@@ -36,6 +40,7 @@ impl ControllerEntry {
             ControllerEntry::Oscillator(e) => &e.name,
             ControllerEntry::Neural(e) => &e.name,
             ControllerEntry::Fsm(e) => &e.name,
+            ControllerEntry::Ctrnn(e) => &e.name,
         }
     }
 
@@ -45,6 +50,7 @@ impl ControllerEntry {
             ControllerEntry::Oscillator(_) => &[],
             ControllerEntry::Neural(e) => &e.inputs,
             ControllerEntry::Fsm(e) => &e.inputs,
+            ControllerEntry::Ctrnn(e) => &e.inputs,
         }
     }
 
@@ -54,6 +60,7 @@ impl ControllerEntry {
             ControllerEntry::Oscillator(e) => &e.outputs,
             ControllerEntry::Neural(e) => &e.outputs,
             ControllerEntry::Fsm(e) => &e.outputs,
+            ControllerEntry::Ctrnn(e) => &e.outputs,
         }
     }
 
@@ -63,6 +70,7 @@ impl ControllerEntry {
             ControllerEntry::Oscillator(e) => Box::new(e.build()?),
             ControllerEntry::Neural(e) => Box::new(e.build()?),
             ControllerEntry::Fsm(e) => Box::new(e.build(levels)?),
+            ControllerEntry::Ctrnn(e) => Box::new(e.build()?),
         })
     }
 }

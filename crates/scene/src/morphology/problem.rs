@@ -258,6 +258,7 @@ fn placeholder_spec() -> EvolveSpec {
     EvolveSpec {
         controller: Some(NAME.into()),
         index: None,
+        evolved: Vec::new(),
         duration: 1.0,
         particles: Vec::new(),
         axis: DVec3::X,
