@@ -21,29 +21,31 @@ pub struct Args {
     /// A scene file with an `[evolve]` table; without one, the thesis's
     /// roobot (scenes/hop_evolver.toml, built in).
     scene: Option<PathBuf>,
-    /// The optimiser of every lane (default: the thesis's hill climber; a
-    /// [morphology] scene's: body-ga). map-elites and cma-me fill the
+    /// The optimiser of every lane [default: the scene's `[evolve]
+    /// optimiser`, else cma-es; a [morphology] scene's: body-ga; the
+    /// thesis's roobot: hill-climber]. map-elites and cma-me fill the
     /// scene's [archive] (one lane; docs/DIVERSITY.md).
     #[arg(long, value_parser = optimiser_names())]
     optimiser: Option<OptimiserKind>,
-    /// Candidates per generation per lane (default: hill-climber 1, ga 32,
-    /// cma-es 4 + 3 ln n, body-ga 16); map-elites and cma-me: per emitter
-    /// (36, 4 + 3 ln n).
+    /// Candidates per generation per lane [default: hill-climber 1, ga 32,
+    /// cma-es 4 + 3 ln n, body-ga 16; map-elites and cma-me: per emitter
+    /// 36 and 4 + 3 ln n].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     population: Option<u64>,
     /// CMA-ES only: start again with twice the population, up to this many
-    /// times, when a run converges or stagnates (IPOP).
+    /// times, when a run converges or stagnates (IPOP) [default: 0].
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=20))]
     restarts: Option<u32>,
-    /// Generations per lane (a resumed run can be given a new total).
+    /// Generations per lane (a resumed run can be given a new total)
+    /// [default: 100].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=100_000_000))]
     generations: Option<u64>,
-    /// Independent lanes (default: the scene's `[evolve] lanes`, else 1;
-    /// the thesis's roobot: 6); the hill climber's lane k mutates by up to
+    /// Independent lanes [default: the scene's `[evolve] lanes`, else 1;
+    /// the thesis's roobot: 6]; the hill climber's lane k mutates by up to
     /// ±25 (k + 1) % where the scene says `mutation = "relative"`.
     #[arg(long)]
     lanes: Option<usize>,
-    /// Seed of every random choice.
+    /// Seed of every random choice [default: 1].
     #[arg(long)]
     seed: Option<u64>,
     /// Directory to write log.csv, best.toml (the best lane's scene),
@@ -53,7 +55,7 @@ pub struct Args {
     /// Continue the run in this directory from its checkpoint.
     #[arg(long, conflicts_with = "out")]
     resume: Option<PathBuf>,
-    /// Worker threads (default: every core).
+    /// Worker threads [default: every core].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
     /// Seconds between checkpoints (0: after every batch of generations).

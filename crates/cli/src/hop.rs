@@ -137,7 +137,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
     );
     println!("upright:    {:.3} s", e.time);
     println!("distance:   {:.4} m", e.distance);
-    println!("hops:       {hops}");
+    println!(
+        "hops:       {hops} (landings the brain counted: its FSM going from flight to stance)"
+    );
     let speed = if e.time > 0.0 {
         e.distance / e.time
     } else {
@@ -156,7 +158,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         (gait.contact_summary(), gait.slide_summary())
     {
         println!(
-            "contacts:   {} (foot on the floor, s: min {lo:.3}, median {mid:.3}, max {hi:.3}; slide median {:.1} mm, max {:.1} mm)",
+            "contacts:   {} (times the foot came down on the floor, as the physics saw it; fewer than hops when the brain's flight ends without the foot leaving the floor. On the floor, s: min {lo:.3}, median {mid:.3}, max {hi:.3}; slide median {:.1} mm, max {:.1} mm)",
             gait.contacts.len(),
             slide_mid * 1e3,
             slide_max * 1e3

@@ -40,8 +40,9 @@ enum Command {
     Simulate(simulate::Args),
     /// Simulate one hopping roobot with a parameter set and report its fitness.
     Hop(hop::Args),
-    /// Evolve hopping gaits (no scene) or a scene's [evolve] controller,
-    /// with the hill climber, a GA or CMA-ES, lanes in parallel.
+    /// Evolve hopping gaits (no scene), a scene's [evolve] controllers, or
+    /// bodies and brains ([morphology]); CMA-ES unless the scene or
+    /// --optimiser says otherwise, lanes in parallel.
     Evolve(evolve::Args),
     /// Run a scene's [evolve] evaluation once and print its fitness.
     Evaluate(evaluate::Args),

@@ -170,6 +170,8 @@ struct Snapshot {
     t: f64,
     positions: Vec<DVec3>,
     bells: Vec<Option<BellShape>>,
+    /// The actuators' levels (muscles are coloured by them).
+    levels: Vec<f64>,
 }
 
 fn snapshot(stage: &SceneStage, drawing: &Drawing) -> Snapshot {
@@ -179,6 +181,7 @@ fn snapshot(stage: &SceneStage, drawing: &Drawing) -> Snapshot {
         t: stage.time(),
         positions,
         bells,
+        levels: stage.scene().nervous.actuator_levels(),
     }
 }
 
@@ -259,6 +262,86 @@ fn shoot(
     animats_engine::on_pool_if(pooled, run)
 }
 
+/// Where the creature started, marked by a post on the ground, and how far
+/// it has gone: along the scene's `[evolve]` axis for its `[evolve]`
+/// particles' centre of mass (what fitness counts), else across the
+/// ground for the watched particles' centre.
+struct Course {
+    /// Particles and their masses whose centre counts.
+    ids: Vec<(usize, f64)>,
+    /// The axis (unit), or `None`: horizontal distance.
+    axis: Option<DVec3>,
+    /// The centre at t = 0.
+    start: DVec3,
+    /// The post: its foot and height, m.
+    post: (DVec3, f64),
+}
+
+impl Course {
+    fn new(stage: &SceneStage, watched: &[usize], at_start: &Snapshot) -> Option<Course> {
+        let scene = stage.scene();
+        let mass = &scene.world.particles().mass;
+        let (ids, axis): (Vec<usize>, _) = match &scene.evolve {
+            Some(e) => (
+                e.particles.iter().map(|p| p.index()).collect(),
+                Some(e.axis),
+            ),
+            None if !watched.is_empty() => (watched.to_vec(), None),
+            None => return None,
+        };
+        let ids: Vec<(usize, f64)> = ids.into_iter().map(|i| (i, mass[i])).collect();
+        let start = Course::centre(&ids, &at_start.positions);
+        let radius = &scene.world.particles().radius;
+        let top = watched
+            .iter()
+            .map(|&i| at_start.positions[i].y + radius[i])
+            .fold(0.0f64, f64::max);
+        let height = (0.6 * top).clamp(0.05, 1.0);
+        Some(Course {
+            ids,
+            axis,
+            start,
+            post: (DVec3::new(start.x, 0.0, start.z), height),
+        })
+    }
+
+    fn centre(ids: &[(usize, f64)], positions: &[DVec3]) -> DVec3 {
+        let (mut sum, mut m) = (DVec3::ZERO, 0.0);
+        for &(i, mass) in ids {
+            sum += positions[i] * mass;
+            m += mass;
+        }
+        if m > 0.0 {
+            sum / m
+        } else {
+            DVec3::ZERO
+        }
+    }
+
+    /// Draws the start post into `picture`; the distance gone by `s`, m.
+    fn mark(&self, picture: &mut animats_render::Picture, s: &Snapshot) -> f64 {
+        let (foot, h) = self.post;
+        let colour = animats_render::picture::hex(0xf2c14e);
+        picture.rods.push(animats_render::Rod {
+            a: foot,
+            b: foot + DVec3::Y * h,
+            radius: (0.03 * h).max(0.002),
+            colour,
+        });
+        picture.spheres.push(animats_render::Sphere {
+            centre: foot + DVec3::Y * h,
+            radius: (0.08 * h).max(0.005),
+            colour,
+            shadow: true,
+        });
+        let moved = Course::centre(&self.ids, &s.positions) - self.start;
+        match self.axis {
+            Some(axis) => moved.dot(axis),
+            None => DVec3::new(moved.x, 0.0, moved.z).length(),
+        }
+    }
+}
+
 /// The camera of each frame: the opening framing (`base`), moved with what
 /// is `watched` (from where it was at the start) as `--camera` says.
 struct Cameras {
@@ -304,6 +387,34 @@ impl Cameras {
             fov: args.fov,
             vertical: false,
         }
+    }
+
+    /// Frames the watched creature snugly (`render`'s default camera on a
+    /// creature): its extent at the start fills 40 % of the frame's width,
+    /// or 60 % of its height if that is the tighter, seen from the usual
+    /// direction — so a 0.3 m walker is not a speck in a 2 m frame.
+    fn snug(&mut self, args: &Args, stage: &SceneStage, at_start: &Snapshot) {
+        if !matches!(args.camera, CameraSpec::Auto | CameraSpec::Follow) || self.watched.is_empty()
+        {
+            return;
+        }
+        let radius = &stage.scene().world.particles().radius;
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for &i in &self.watched {
+            let (p, r) = (at_start.positions[i], radius[i]);
+            lo = lo.min(p - DVec3::splat(r));
+            hi = hi.max(p + DVec3::splat(r));
+        }
+        let extent = hi - lo;
+        let across = DVec3::new(extent.x, 0.0, extent.z).length().max(0.05);
+        let tall = extent.y.max(0.05);
+        let tan = (0.5 * args.fov.to_radians()).tan();
+        let aspect = f64::from(args.width) / f64::from(args.height.max(1));
+        let distance = (across / (0.4 * 2.0 * tan * aspect))
+            .max(tall / (0.6 * 2.0 * tan))
+            .max(0.3);
+        let centre = 0.5 * (lo + hi);
+        self.base = Camera::framing(DVec3::new(centre.x, centre.y.max(0.0), centre.z), distance);
     }
 
     fn of(&self, s: &Snapshot) -> Camera {
@@ -389,13 +500,19 @@ pub fn run(args: Args) -> Result<(), Failure> {
     // drawn may be later: a PNG draws only the last).
     let at_start = snapshot(&stage, drawing);
     let snapshots = shoot(&args, &mut stage, drawing, &times)?;
-    let cameras = Cameras::new(&args, &stage, &describe, &at_start);
+    let mut cameras = Cameras::new(&args, &stage, &describe, &at_start);
+    cameras.snug(&args, &stage, &at_start);
+    let course = Course::new(&stage, &cameras.watched, &at_start);
     let frames: Vec<Image> = snapshots
         .par_iter()
         .map(|s| {
-            let mut picture = picture(drawing, &s.positions, &s.bells);
+            let mut picture = picture(drawing, &s.positions, &s.bells, &s.levels);
+            let gone = course.as_ref().map(|c| c.mark(&mut picture, s));
             if !args.no_caption {
-                picture.caption = Some(format!("t = {:.2} s", s.t));
+                picture.caption = Some(match gone {
+                    Some(d) => format!("t = {:.2} s   distance {d:.2} m", s.t),
+                    None => format!("t = {:.2} s", s.t),
+                });
             }
             render(&picture, &cameras.of(s), args.width, args.height)
         })
@@ -533,7 +650,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
             Ok(snapshots
                 .iter()
                 .map(|s| {
-                    let mut picture = picture(drawing, &s.positions, &s.bells);
+                    let mut picture = picture(drawing, &s.positions, &s.bells, &s.levels);
                     picture.caption = Some(format!(
                         "#{} {}({} {lane}): {fitness:.2}{}",
                         k + 1,

@@ -113,7 +113,8 @@ pub struct Choices {
     pub generations: Option<u64>,
     /// Seed (default 1).
     pub seed: Option<u64>,
-    /// Optimiser (default the hill climber).
+    /// Optimiser (default: the scene's `[evolve] optimiser`, else CMA-ES;
+    /// body-ga for a `[morphology]` scene).
     pub optimiser: Option<OptimiserKind>,
     /// Candidates per generation (default: the optimiser's).
     pub population: Option<usize>,
@@ -133,10 +134,16 @@ impl Config {
             .spec()
             .ok_or("the problem is not a scene with an [evolve] table")?;
         let bodies = built.variation().is_some();
-        let optimiser = choices.optimiser.unwrap_or(if bodies {
+        let written = match &spec.optimiser {
+            Some(name) => {
+                Some(OptimiserKind::parse(name).map_err(|e| format!("[evolve] optimiser: {e}"))?)
+            }
+            None => None,
+        };
+        let optimiser = choices.optimiser.or(written).unwrap_or(if bodies {
             OptimiserKind::BodyGa
         } else {
-            OptimiserKind::HillClimber
+            OptimiserKind::CmaEs
         });
         let qd = optimiser.qd().is_some();
         if bodies && !(optimiser == OptimiserKind::BodyGa || optimiser == OptimiserKind::MapElites)

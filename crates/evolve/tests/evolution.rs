@@ -376,13 +376,31 @@ fn a_runs_defaults_and_checks_are_the_librarys() {
     let thesis = Config::new(ProblemSpec::thesis(), &Choices::default()).unwrap();
     assert_eq!(thesis, Config::thesis(6, 100, 1));
     assert_eq!(thesis.log, LogMode::Improvements);
-    // A scene that says nothing: one lane, a row per generation.
+    // A scene that says nothing: CMA-ES, one lane, a row per generation.
     let crawler = ProblemSpec {
         file: "crawler.toml".into(),
         text: include_str!("../../cli/tests/crawler.toml").into(),
     };
     let c = Config::new(crawler.clone(), &Choices::default()).unwrap();
-    assert_eq!((c.lanes, c.log), (1, LogMode::Generations));
+    assert_eq!(
+        (c.lanes, c.log, c.optimiser),
+        (1, LogMode::Generations, OptimiserKind::CmaEs)
+    );
+    // One that names its optimiser gets it; a name it misspells is refused.
+    let said = |name: &str| ProblemSpec {
+        file: "crawler.toml".into(),
+        text: format!(
+            "{}optimiser = \"{name}\"\n",
+            include_str!("../../cli/tests/crawler.toml")
+        ),
+    };
+    let c = Config::new(said("ga"), &Choices::default()).unwrap();
+    assert_eq!(c.optimiser, OptimiserKind::Ga);
+    let e = Config::new(said("annealing"), &Choices::default()).unwrap_err();
+    assert!(
+        e.starts_with("[evolve] optimiser: unknown optimiser `annealing`"),
+        "{e}"
+    );
     let chosen = Choices {
         lanes: Some(3),
         optimiser: Some(OptimiserKind::CmaEs),
@@ -399,6 +417,7 @@ fn a_runs_defaults_and_checks_are_the_librarys() {
         (
             Choices {
                 restarts: Some(1),
+                optimiser: Some(OptimiserKind::Ga),
                 ..Choices::default()
             },
             "restarts",

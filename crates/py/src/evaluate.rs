@@ -75,14 +75,49 @@ pub(crate) fn rows(problem: &dyn Problem, genomes: &Bound<'_, PyAny>) -> PyResul
     Ok(rows)
 }
 
+/// Holds each row to the problem's bounds: an error naming the first gene
+/// outside them, or (`clip`) every such gene moved to its nearer bound.
+fn within_bounds(problem: &dyn Problem, rows: &mut [Vec<f64>], clip: bool) -> PyResult<()> {
+    if problem.relative_mutation() {
+        return Ok(());
+    }
+    let Some(b) = problem.bounds() else {
+        return Ok(());
+    };
+    for (k, row) in rows.iter_mut().enumerate() {
+        for (i, x) in row.iter_mut().enumerate() {
+            let (lo, hi) = (b.lo[i], b.hi[i]);
+            if *x >= lo && *x <= hi {
+                continue;
+            }
+            if clip {
+                *x = x.clamp(lo, hi);
+            } else {
+                return Err(value_error(format!(
+                    "genome {k}, gene {i} = {x} is outside its bounds [{lo}, {hi}] (scene.bounds()); pass clip=True to clip genes into their bounds"
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Evaluates each of `genomes` ([`rows`]) on `pool`.
+/// `clip`: `None` for genomes a run made itself (not checked); else genes
+/// outside the problem's bounds are refused (`Some(false)`) or clipped
+/// into them (`Some(true)`). A problem that mutates by a fraction of each
+/// gene (the thesis's hill climber) has no bounds to hold genes to.
 pub(crate) fn outcomes(
     py: Python<'_>,
     problem: &dyn Problem,
     genomes: &Bound<'_, PyAny>,
     pool: &Option<rayon::ThreadPool>,
+    clip: Option<bool>,
 ) -> PyResult<Vec<Outcome>> {
-    let rows = rows(problem, genomes)?;
+    let mut rows = rows(problem, genomes)?;
+    if let Some(clip) = clip {
+        within_bounds(problem, &mut rows, clip)?;
+    }
     if rows.is_empty() {
         return Ok(Vec::new());
     }
@@ -145,13 +180,14 @@ fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
 /// With `measures`, a tuple: the fitness and the `(P, k)` array of the
 /// scene's `[archive]` measures.
 #[pyfunction]
-#[pyo3(signature = (scene, genomes, threads = None, measures = false))]
+#[pyo3(signature = (scene, genomes, threads = None, measures = false, clip = false))]
 pub fn evaluate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
     genomes: &Bound<'py, PyAny>,
     threads: Option<usize>,
     measures: bool,
+    clip: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
     let problem = build(&problem_spec(scene)?)?;
     if measures && problem.grid().is_none() {
@@ -160,7 +196,7 @@ pub fn evaluate<'py>(
         ));
     }
     let pool = pool(threads)?;
-    let o = outcomes(py, problem.as_ref(), genomes, &pool)?;
+    let o = outcomes(py, problem.as_ref(), genomes, &pool, Some(clip))?;
     let fitness = PyArray1::from_vec(py, o.iter().map(|o| o.fitness).collect());
     if measures {
         let k = problem.grid().map_or(0, |g| g.names.len());
@@ -223,13 +259,16 @@ impl Evaluator {
         self.roobot
     }
 
-    /// Fitness of each row of `genomes`.
+    /// Fitness of each row of `genomes`; genes outside the bounds are
+    /// refused, or clipped with `clip=True`.
+    #[pyo3(signature = (genomes, clip = false))]
     fn evaluate<'py>(
         &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
+        clip: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool, Some(clip))?;
         Ok(PyArray1::from_vec(
             py,
             o.iter().map(|o| o.fitness).collect(),
@@ -238,12 +277,14 @@ impl Evaluator {
 
     /// Every outcome of each row: a dict of arrays `fitness`, `time`,
     /// `distance` and the list `ended` (what `Evolution.tell` takes).
+    #[pyo3(signature = (genomes, clip = false))]
     fn outcomes<'py>(
         &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
+        clip: bool,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool, Some(clip))?;
         outcome_dict(py, &o)
     }
 }

@@ -318,7 +318,7 @@ impl Evolution {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pool = pool(threads)?;
-        let o = outcomes(py, self.problem.as_ref(), genomes, &pool)?;
+        let o = outcomes(py, self.problem.as_ref(), genomes, &pool, None)?;
         outcome_dict(py, &o)
     }
 

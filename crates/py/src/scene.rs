@@ -97,12 +97,49 @@ pub fn parse(text: String, file: String) -> PyResult<Scene> {
 
 #[pymethods]
 impl Scene {
-    /// A fresh world built from the scene, at its start.
-    fn world(&self) -> PyResult<World> {
-        let scene = animats_scene::parse(&self.text, &self.file).map_err(scene_error)?;
+    /// A fresh world built from the scene, at its start; with `genome`, the
+    /// scene's `[evolve]` controllers (or, for a `[morphology]` scene, the
+    /// body and brain) as that genome makes them: the creature an
+    /// evolution found, to step and inspect.
+    #[pyo3(signature = (genome = None))]
+    fn world(&self, genome: Option<Vec<f64>>) -> PyResult<World> {
+        let scene = match genome {
+            None => animats_scene::parse(&self.text, &self.file).map_err(scene_error)?,
+            Some(g) => {
+                let text = self.best_toml(g)?;
+                animats_scene::parse(&text, &self.file).map_err(scene_error)?
+            }
+        };
         Ok(World {
             scene: Mutex::new(scene),
         })
+    }
+
+    /// The scene's text with `genome` written in: the `[evolve]`
+    /// controllers' keys hold its genes (a `[morphology]` scene: the body
+    /// it develops into, as ordinary entries) — what `animats evolve`
+    /// writes as `best.toml`, for a genome from `Optimiser.best()` or
+    /// anywhere else. Write it to a file and `animats evaluate` it.
+    fn best_toml(&self, genome: Vec<f64>) -> PyResult<String> {
+        if self.evolve.is_none() {
+            return Err(no_evolve(&self.file));
+        }
+        if let Some(x) = genome.iter().find(|x| !x.is_finite()) {
+            return Err(value_error(format!(
+                "genome has a gene that is not finite: {x}"
+            )));
+        }
+        let spec = animats_evolve::ProblemSpec {
+            file: self.file.clone(),
+            text: self.text.clone(),
+        };
+        let problem = spec.build().map_err(scene_error)?;
+        animats_evolve::Problem::scene_toml(
+            problem.as_ref(),
+            &genome,
+            "written by animats.Scene.best_toml",
+        )
+        .map_err(value_error)
     }
 
     /// The scene file's name.
@@ -220,6 +257,46 @@ impl Snapshot {
 }
 
 impl World {
+    /// Sets one vector per particle from an `(N, 3)` array, all or none.
+    fn set_vec3s(
+        &self,
+        a: numpy::PyReadonlyArray2<'_, f64>,
+        what: &str,
+        set: impl Fn(
+            &mut animats_engine::World,
+            animats_engine::ParticleId,
+            animats_engine::DVec3,
+        ) -> Result<(), animats_engine::ModelError>,
+    ) -> PyResult<()> {
+        let mut s = self.lock()?;
+        let n = s.world.len();
+        if a.shape() != [n, 3] {
+            return Err(value_error(format!(
+                "{what} must be an ({n}, 3) array, got {:?}",
+                a.shape()
+            )));
+        }
+        let flat = crate::elements(&a);
+        if let Some(k) = flat.iter().position(|x| !x.is_finite()) {
+            return Err(value_error(format!(
+                "{what}[{}, {}] is not finite: {}",
+                k / 3,
+                k % 3,
+                flat[k]
+            )));
+        }
+        let ids: Vec<_> = s.world.particle_ids().collect();
+        for (p, v) in ids.into_iter().zip(flat.chunks(3)) {
+            set(
+                &mut s.world,
+                p,
+                animats_engine::DVec3::new(v[0], v[1], v[2]),
+            )
+            .map_err(|e| value_error(format!("{what}: {e}")))?;
+        }
+        Ok(())
+    }
+
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, animats_scene::Scene>> {
         self.scene
             .lock()
@@ -324,6 +401,91 @@ impl World {
     /// scene).
     fn restore(&self, snapshot: &Snapshot) -> PyResult<()> {
         self.lock()?.restore(&snapshot.inner).map_err(value_error)
+    }
+
+    /// Each particle's mass, kg: an `(N,)` array (a fixed particle's is
+    /// the mass it was given).
+    fn masses<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(
+            py,
+            self.lock()?.world.particles().mass.clone(),
+        ))
+    }
+
+    /// Each particle's radius, m: an `(N,)` array.
+    fn radii<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(PyArray1::from_vec(
+            py,
+            self.lock()?.world.particles().radius.clone(),
+        ))
+    }
+
+    /// The springs now: a dict of arrays `a`, `b` (the ends' particle
+    /// indices), `length` (m, now), `rest_length` (m; a muscle's moves),
+    /// `stiffness` (N/m) and `damping` (N s/m), one entry per spring.
+    fn springs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let s = self.lock()?;
+        let pos = &s.world.state().pos;
+        let (mut a, mut b, mut length, mut rest, mut k, mut c) = (
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        );
+        for spring in s.world.forces().springs.iter() {
+            let (i, j) = spring.ends();
+            a.push(i.index() as i64);
+            b.push(j.index() as i64);
+            length.push((pos[j.index()] - pos[i.index()]).length());
+            rest.push(spring.rest_length);
+            k.push(spring.stiffness);
+            c.push(spring.damping);
+        }
+        let d = pyo3::types::PyDict::new(py);
+        d.set_item("a", PyArray1::from_vec(py, a))?;
+        d.set_item("b", PyArray1::from_vec(py, b))?;
+        d.set_item("length", PyArray1::from_vec(py, length))?;
+        d.set_item("rest_length", PyArray1::from_vec(py, rest))?;
+        d.set_item("stiffness", PyArray1::from_vec(py, k))?;
+        d.set_item("damping", PyArray1::from_vec(py, c))?;
+        Ok(d)
+    }
+
+    /// Which particles touch the floor now: an `(N,)` bool array, true
+    /// where a particle's lowest point is within `tolerance` m of y = 0
+    /// (all false in a scene without a `[floor]`).
+    #[pyo3(signature = (tolerance = 1e-6))]
+    fn contacts<'py>(
+        &self,
+        py: Python<'py>,
+        tolerance: f64,
+    ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        let s = self.lock()?;
+        let floor = s.world.forces().floor().is_some();
+        let r = &s.world.particles().radius;
+        let on: Vec<bool> = s
+            .world
+            .state()
+            .pos
+            .iter()
+            .zip(r)
+            .map(|(p, r)| floor && p.y - r <= tolerance)
+            .collect();
+        Ok(PyArray1::from_vec(py, on))
+    }
+
+    /// Sets every particle's position, m, from an `(N, 3)` array
+    /// (velocities and everything else kept).
+    fn set_positions(&self, positions: numpy::PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        self.set_vec3s(positions, "positions", |w, p, x| w.set_position(p, x))
+    }
+
+    /// Sets every particle's velocity, m/s, from an `(N, 3)` array (a fixed
+    /// particle's stays 0).
+    fn set_velocities(&self, velocities: numpy::PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        self.set_vec3s(velocities, "velocities", |w, p, v| w.set_velocity(p, v))
     }
 
     /// Total energy (kinetic + potential), J.

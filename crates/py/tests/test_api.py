@@ -17,7 +17,7 @@ def test_a_bad_scene_raises_scene_error_naming_file_line_entry_and_field(tmp_pat
     with pytest.raises(animats.SceneError) as e:
         animats.load(bad)
     msg = str(e.value)
-    assert "bad.toml:3" in msg and "particle[0].mass" in msg, msg
+    assert "bad.toml:5" in msg and "particle[0].mass" in msg, msg  # the line of `mass`
     assert isinstance(e.value, ValueError)
     with pytest.raises(animats.SceneError, match="cannot read"):
         animats.load(tmp_path / "missing.toml")

@@ -77,9 +77,15 @@ pub struct Picture {
 }
 
 /// The picture of `drawing` (`animats_view::Drawing`, the one drawing
-/// model) with the particles at `positions` and its bells shaped as
-/// `bells` says.
-pub fn picture(drawing: &Drawing, positions: &[DVec3], bells: &[Option<BellShape>]) -> Picture {
+/// model) with the particles at `positions`, its bells shaped as `bells`
+/// says and its muscles coloured by the actuators' `levels` (scene order;
+/// empty: every rod its own colour).
+pub fn picture(
+    drawing: &Drawing,
+    positions: &[DVec3],
+    bells: &[Option<BellShape>],
+    levels: &[f64],
+) -> Picture {
     let at = |i: usize| positions.get(i).copied().unwrap_or(DVec3::ZERO);
     let spheres = drawing
         .balls
@@ -95,11 +101,12 @@ pub fn picture(drawing: &Drawing, positions: &[DVec3], bells: &[Option<BellShape
     let rods = drawing
         .rods
         .iter()
-        .map(|r| Rod {
+        .zip(drawing.rod_colours(levels))
+        .map(|(r, colour)| Rod {
             a: at(r.a),
             b: at(r.b),
             radius: r.radius,
-            colour: hex(r.colour),
+            colour: hex(colour),
         })
         .collect();
     let bells = drawing

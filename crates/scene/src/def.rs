@@ -335,6 +335,10 @@ pub struct EvolveEntry {
     /// Score each evaluation at the scene's step and at half of it and
     /// keep the worse; default false (true in a `[morphology]` scene).
     pub robust: Option<bool>,
+    /// The optimiser `animats evolve` uses unless told (`hill-climber`,
+    /// `cma-es`, ...); default `cma-es` (`body-ga` in a `[morphology]`
+    /// scene).
+    pub optimiser: Option<String>,
 }
 
 /// `fail_on_stretch = [{ a = "...", b = "...", length = 1.0 }]`.

@@ -71,6 +71,9 @@ pub struct EvolveSpec {
     /// Each evaluation runs at the scene's step and at half of it; the
     /// worse counts.
     pub robust: bool,
+    /// The optimiser to use unless told, by its command-line name
+    /// (checked by whoever runs the evolution).
+    pub optimiser: Option<String>,
 }
 
 /// An `[evolve]` table's end rules, resolved.
@@ -183,6 +186,7 @@ impl EvolveSpec {
             log: e.log,
             lanes,
             robust: e.robust.unwrap_or(false),
+            optimiser: e.optimiser.clone(),
         })
     }
 

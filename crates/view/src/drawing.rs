@@ -46,8 +46,34 @@ pub struct Rod {
     pub b: usize,
     /// m: 0.3 of the thinner end's radius, within [1.5 mm, 12 mm].
     pub radius: f64,
-    /// 0xRRGGBB: its first end's colour, darkened.
+    /// 0xRRGGBB: its first end's colour, darkened (a muscle's colour at
+    /// each instant is [`muscle_colour`] of its actuator's level).
     pub colour: u32,
+    /// The actuator that drives its rest length (a muscle), by its index
+    /// among the scene's actuators; `None` for a passive spring.
+    pub muscle: Option<usize>,
+}
+
+/// A muscle's colour at `level` (its actuator's level: 0 at the shortest
+/// rest length, 1 at the longest): red when contracted, purple when
+/// relaxed, through pale grey at the middle.
+pub fn muscle_colour(level: f64) -> u32 {
+    let l = if level.is_finite() {
+        level.clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
+    let (red, mid, purple) = ([0xd7, 0x30, 0x27], [0xe8, 0xe4, 0xdc], [0x7b, 0x32, 0x94]);
+    let mix = |a: [u32; 3], b: [u32; 3], t: f64| {
+        let ch =
+            |k: usize| (f64::from(a[k]) + (f64::from(b[k]) - f64::from(a[k])) * t).round() as u32;
+        (ch(0) << 16) | (ch(1) << 8) | ch(2)
+    };
+    if l < 0.5 {
+        mix(red, mid, 2.0 * l)
+    } else {
+        mix(mid, purple, 2.0 * l - 1.0)
+    }
 }
 
 /// A jellyfish's bell: which masses it wraps.
@@ -126,18 +152,31 @@ impl Drawing {
                 }
             })
             .collect();
+        // Which actuator, if any, drives each spring's rest length.
+        let mut muscles = vec![None; w.forces().springs.len()];
+        for (k, (_, a)) in scene.nervous.actuators.iter().enumerate() {
+            if let animats_creatures::actuators::AnyActuator::Spring(a) = a {
+                if let Some(m) = muscles.get_mut(a.target().0.index()) {
+                    *m = Some(k);
+                }
+            }
+        }
         let rods = w
             .forces()
             .springs
             .iter()
-            .map(|s| {
+            .zip(muscles)
+            .map(|(s, muscle)| {
                 let (a, b) = s.ends();
                 let (a, b) = (a.index(), b.index());
+                let thin = (0.3 * radius[a].min(radius[b])).clamp(0.0015, 0.012);
                 Rod {
                     a,
                     b,
-                    radius: (0.3 * radius[a].min(radius[b])).clamp(0.0015, 0.012),
+                    // A muscle is drawn thicker than a passive spring.
+                    radius: if muscle.is_some() { 1.6 * thin } else { thin },
                     colour: dim(colour(a), 0.8),
+                    muscle,
                 }
             })
             .collect();
@@ -169,6 +208,18 @@ impl Drawing {
                 .first()
                 .is_some_and(|f| f.density > WATER_DENSITY),
         }
+    }
+
+    /// Each rod's colour with the actuators at `levels` (scene order): a
+    /// muscle's from its level, a passive spring's its own.
+    pub fn rod_colours(&self, levels: &[f64]) -> Vec<u32> {
+        self.rods
+            .iter()
+            .map(|r| match r.muscle.and_then(|k| levels.get(k)) {
+                Some(&l) => muscle_colour(l),
+                None => r.colour,
+            })
+            .collect()
     }
 
     /// Every bell's shape with the particles at `positions` and the

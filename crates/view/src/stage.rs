@@ -26,6 +26,11 @@ pub trait Stage: Send {
     fn positions(&self, out: &mut Vec<f32>);
     /// Every creature's state.
     fn creatures(&self) -> Vec<CreatureState>;
+    /// The actuators' levels now, in scene order (muscles are coloured by
+    /// them).
+    fn levels(&self) -> Vec<f64> {
+        Vec::new()
+    }
     /// A point the camera may follow.
     fn focus(&self) -> Option<[f64; 3]> {
         None
@@ -243,6 +248,10 @@ impl Stage for SceneStage {
         for p in &self.scene.world.state().pos {
             out.extend([p.x as f32, p.y as f32, p.z as f32]);
         }
+    }
+
+    fn levels(&self) -> Vec<f64> {
+        self.scene.nervous.actuator_levels()
     }
 
     fn creatures(&self) -> Vec<CreatureState> {

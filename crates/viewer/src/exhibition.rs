@@ -131,6 +131,10 @@ impl Stage for Exhibition {
         self.stage.creatures()
     }
 
+    fn levels(&self) -> Vec<f64> {
+        self.stage.levels()
+    }
+
     fn focus(&self) -> Option<[f64; 3]> {
         self.stage.focus()
     }

@@ -39,6 +39,10 @@ pub struct Frame {
     /// Each jellyfish's bell now, in the order of the scene's
     /// `drawing.bells` (`null` where its dome is degenerate).
     pub bells: Vec<Option<BellShape>>,
+    /// Each rod's colour now (0xRRGGBB, in the order of the scene's
+    /// `drawing.rods`): muscles by their activation; empty when the scene
+    /// has no muscles (the rods keep their drawn colours).
+    pub rods: Vec<u32>,
     /// A point the camera may follow (the creature an evolution shows).
     pub focus: Option<[f64; 3]>,
     /// Why the simulation stopped, if it failed (it is paused until reset).

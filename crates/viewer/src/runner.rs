@@ -287,6 +287,11 @@ impl Runner {
             p: std::mem::take(&mut self.positions),
             creatures,
             bells,
+            rods: if self.drawing.rods.iter().any(|r| r.muscle.is_some()) {
+                self.drawing.rod_colours(&self.stage.levels())
+            } else {
+                Vec::new()
+            },
             focus: self.stage.focus(),
             error: self.error.clone(),
             note: self.stage.note(),

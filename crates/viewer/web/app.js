@@ -221,6 +221,7 @@ const w = new THREE.Vector3();
 const s3 = new THREE.Vector3();
 const UP = new THREE.Vector3(0, 1, 0);
 const ONE = new THREE.Quaternion();
+const tint = new THREE.Color();
 
 function at(p, i, out) { return out.set(p[3 * i] ?? 0, p[3 * i + 1] ?? 0, p[3 * i + 2] ?? 0); }
 
@@ -247,6 +248,11 @@ function draw(frame) {
       mesh.setMatrixAt(k, m4.compose(v, q, s3));
     });
     mesh.instanceMatrix.needsUpdate = true;
+    // Muscles coloured by their activation now (the server's colours).
+    if (frame.rods && frame.rods.length === rods.length) {
+      frame.rods.forEach((c, k) => mesh.setColorAt(k, tint.setHex(c)));
+      if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
+    }
   }
   drawn.domes.forEach((d, k) => {
     const b = (frame.bells ?? [])[k];

@@ -4,9 +4,12 @@ The Rust core, without a copy of its logic: scenes and worlds, parallel
 evaluation, the optimisers and whole evolution runs, and environments.
 
     >>> import animats, numpy as np
-    >>> scene = animats.load("scenes/walker.toml")
+    >>> scene = animats.load("scenes/walker.toml")   # or animats.parse(text)
     >>> world = scene.world(); world.step(100)
     >>> world.positions()                       # (N, 3) float64
+    >>> world.masses(), world.springs(), world.contacts()
+    >>> scene.world(genome)                     # the creature a genome makes
+    >>> scene.best_toml(genome)                 # ... as a scene file's text
     >>> animats.evaluate(scene, scene.start())  # its own parameters' fitness
     >>> animats.evaluate("roobot", np.tile(animats.ROOBOT_INITIAL, (8, 1)))
     >>> animats.evaluate_scenes([open("scenes/walker.toml").read()])
@@ -24,6 +27,7 @@ from typing import Optional, Union
 import os
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _animats
 from .archive import Archive
@@ -40,6 +44,9 @@ from ._animats import (
     load,
     parse,
 )
+
+#: The version of the compiled core (the Rust crates').
+__version__: str = _animats.__version__
 
 __all__ = [
     "Archive",
@@ -61,14 +68,16 @@ __all__ = [
 ]
 
 #: Appendix B's initial roobot parameters (the hill climber's start).
-ROOBOT_INITIAL = np.array(_animats.ROOBOT_INITIAL, dtype=np.float64)
+ROOBOT_INITIAL: npt.NDArray[np.float64] = np.array(_animats.ROOBOT_INITIAL, dtype=np.float64)
 #: The roobot parameters' bounds, ``(14, 2)``.
-ROOBOT_BOUNDS = np.array(_animats.ROOBOT_BOUNDS, dtype=np.float64)
+ROOBOT_BOUNDS: npt.NDArray[np.float64] = np.array(_animats.ROOBOT_BOUNDS, dtype=np.float64)
 
 SceneLike = Union[Scene, str, "os.PathLike[str]"]
 
 
-def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None, measures: bool = False):
+def evaluate(
+    scene: SceneLike, genomes, threads: Optional[int] = None, measures: bool = False, clip: bool = False
+):
     """Fitness of each row of ``genomes`` under ``scene``'s ``[evolve]``
     evaluation (``"roobot"``: the thesis's hopping gait).
 
@@ -78,19 +87,22 @@ def evaluate(scene: SceneLike, genomes, threads: Optional[int] = None, measures:
     each is bit-identical to ``animats evaluate`` on the same parameters.
     With ``measures=True`` (a scene with an ``[archive]`` table), a tuple:
     the fitness and the ``(P, k)`` array of its measures, computed in the
-    same evaluations (what a pyribs ``Scheduler.tell`` takes).
+    same evaluations (what a pyribs ``Scheduler.tell`` takes). A gene
+    outside the scene's bounds (``scene.bounds()``) raises ``ValueError``
+    naming it, unless ``clip=True`` clips genes into their bounds (the
+    roobot's genes, mutated by a fraction of their value, have none).
     """
     if isinstance(genomes, list):
         # Bodies ([morphology] scenes): genomes differ in length.
         return _animats.evaluate(
-            scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads, measures
+            scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads, measures, clip
         )
     g = np.ascontiguousarray(genomes, dtype=np.float64)
     if g.ndim == 1:
         g = g[None, :]
     if g.ndim != 2:
         raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
-    return _animats.evaluate(scene, g, threads, measures)
+    return _animats.evaluate(scene, g, threads, measures, clip)
 
 
 def evaluate_scenes(texts, threads: Optional[int] = None) -> dict:

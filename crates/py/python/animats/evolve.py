@@ -17,7 +17,11 @@ def main(argv: "list[str] | None" = None) -> int:
         description="Evolve the roobot or a scene's [evolve] controller, locally or on Ray.",
     )
     p.add_argument("scene", nargs="?", default="roobot", help="a scene file with [evolve] (default: the roobot)")
-    p.add_argument("--optimiser", choices=["hill-climber", "ga", "cma-es", "body-ga"], help="default: hill-climber, or body-ga for a [morphology] scene")
+    p.add_argument(
+        "--optimiser",
+        choices=["hill-climber", "ga", "cma-es", "body-ga", "map-elites", "cma-me"],
+        help="default: the scene's [evolve] optimiser, else cma-es (body-ga for a [morphology] scene; the roobot: hill-climber)",
+    )
     p.add_argument("--population", type=int)
     p.add_argument("--restarts", type=int, default=0)
     p.add_argument("--generations", type=int, default=100)

@@ -272,6 +272,7 @@ fn placeholder_spec() -> EvolveSpec {
         log: Default::default(),
         lanes: None,
         robust: false,
+        optimiser: None,
     }
 }
 

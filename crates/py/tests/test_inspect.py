@@ -1,0 +1,90 @@
+"""Inspecting creatures from Python: a genome's world and scene text,
+masses, springs and contacts, setting the state, genes held to their
+bounds, and the version."""
+
+import re
+
+import numpy as np
+import pytest
+
+import animats
+
+
+def test_the_version_is_the_crates(root):
+    cargo = (root / "crates" / "py" / "Cargo.toml").read_text()
+    assert re.search(r'version = "([^"]+)"', cargo).group(1) == animats.__version__
+
+
+def test_a_genome_becomes_a_world_and_a_scene_text(root):
+    scene = animats.load(root / "scenes" / "walker.toml")
+    lo, hi = scene.bounds().T
+    g = lo + 0.37 * (hi - lo)
+    text = scene.best_toml(g)
+    back = animats.parse(text, "best.toml")
+    assert np.array_equal(back.start(), g)
+    # The world of the genome is the world of its text, step for step.
+    a, b = scene.world(g), back.world()
+    a.step(500)
+    b.step(500)
+    assert np.array_equal(a.positions(), b.positions())
+    # ... and not the scene's own brain's.
+    c = scene.world()
+    c.step(500)
+    assert not np.array_equal(a.positions(), c.positions())
+    # Its evaluation is animats.evaluate's of the genome, to the bit.
+    assert animats.evaluate(back, back.start())[0] == animats.evaluate(scene, g)[0]
+
+
+def test_masses_springs_and_contacts_of_the_walker(root):
+    w = animats.load(root / "scenes" / "walker.toml").world()
+    m = w.masses()
+    assert m.shape == (len(w.names),)
+    hips = [w.names.index("hip_f"), w.names.index("hip_b")]
+    assert np.all(m[hips] == 0.3)
+    s = w.springs()
+    # Built at rest: every spring's length is its rest length (muscles at
+    # the middle of their range within 0.1 % of it).
+    assert np.allclose(s["length"], s["rest_length"], rtol=2e-3)
+    assert s["a"].dtype == np.int64 and s["a"].max() < len(w.names)
+    assert np.all(s["stiffness"] > 0)
+    # The feet (radius 0.02 m at y = 0.02 m) stand on the floor, the hips not.
+    on = w.contacts()
+    feet = [i for i, n in enumerate(w.names) if n.startswith("foot")]
+    assert on.dtype == np.bool_ and on[feet].all() and not on[hips].any()
+
+
+def test_positions_and_velocities_can_be_set(tmp_path):
+    s = tmp_path / "ball.toml"
+    s.write_text(
+        "[world]\ndt = 0.001\nintegrator = \"symplectic\"\ngravity = [0.0, 0.0, 0.0]\n"
+        "[[particle]]\nname = \"ball\"\nmass = 1.0\nposition = [0.0, 1.0, 0.0]\nradius = 0.1\n"
+    )
+    w = animats.load(s).world()
+    w.set_positions(np.array([[1.0, 2.0, 3.0]]))
+    w.set_velocities(np.array([[0.5, 0.0, -1.0]]))
+    w.step(1000)
+    # Uniform motion for 1 s.
+    assert np.allclose(w.positions(), [[1.5, 2.0, 2.0]], atol=1e-12)
+    with pytest.raises(ValueError, match=r"\(1, 3\)"):
+        w.set_positions(np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="not finite"):
+        w.set_velocities(np.array([[np.nan, 0.0, 0.0]]))
+
+
+def test_genes_outside_their_bounds_are_refused_unless_clipped(root):
+    scene = animats.load(root / "scenes" / "walker.toml")
+    lo, hi = scene.bounds().T
+    g = scene.start().copy()
+    g[0] = hi[0] + 1.0
+    with pytest.raises(ValueError, match="gene 0 .* outside its bounds"):
+        animats.evaluate(scene, g)
+    clipped = animats.evaluate(scene, g, clip=True)
+    inside = g.copy()
+    inside[0] = hi[0]
+    assert clipped[0] == animats.evaluate(scene, inside)[0]
+    with pytest.raises(ValueError, match="outside its bounds"):
+        animats.Evaluator(scene).evaluate(g[None, :])
+    # The roobot's genes are mutated by a fraction of their value: no bounds
+    # hold them (Appendix B), so they are not refused.
+    far = animats.ROOBOT_INITIAL * 3.0
+    assert np.isfinite(animats.evaluate("roobot", far)[0])
