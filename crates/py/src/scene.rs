@@ -2,7 +2,7 @@
 
 use crate::{runtime_error, scene_error, value_error};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -294,6 +294,7 @@ impl World {
             )
             .map_err(|e| value_error(format!("{what}: {e}")))?;
         }
+        s.rearm_guard();
         Ok(())
     }
 

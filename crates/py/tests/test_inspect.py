@@ -11,8 +11,10 @@ import animats
 
 
 def test_the_version_is_the_crates(root):
-    cargo = (root / "crates" / "py" / "Cargo.toml").read_text()
-    assert re.search(r'version = "([^"]+)"', cargo).group(1) == animats.__version__
+    # The workspace's [workspace.package] version, which every crate takes.
+    cargo = (root / "Cargo.toml").read_text()
+    package = cargo[cargo.index("[workspace.package]"):]
+    assert re.search(r'^version = "([^"]+)"', package, re.M).group(1) == animats.__version__
 
 
 def test_a_genome_becomes_a_world_and_a_scene_text(root):

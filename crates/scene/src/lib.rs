@@ -208,6 +208,13 @@ impl Scene {
         self.world.restore(&s.world).map_err(|e| e.to_string())
     }
 
+    /// The state was set by hand (positions, velocities): the divergence
+    /// guard measures the world's energy from here on, not from the build.
+    pub fn rearm_guard(&mut self) {
+        let driven = !self.actors.is_empty() || !self.nervous.is_empty();
+        self.guard = animats_engine::DivergenceGuard::new(&self.world, driven);
+    }
+
     fn advance(&mut self, dt: f64) -> Result<StepReport, SimError> {
         for a in &mut self.actors {
             a.act(&mut self.world, dt);
