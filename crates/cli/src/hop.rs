@@ -84,8 +84,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
     })?;
     // The roobot whose brain is evolved: its controller has its name.
     let roobot = || {
-        let controller = spec.index?;
-        (spec.table?.0 == "roobot").then_some(())?;
+        let controller = spec.index()?;
+        (spec.table()?.0 == "roobot").then_some(())?;
         let foot = scene.particle(&format!("{}.foot", spec.controller.as_deref()?))?;
         Some((controller, foot))
     };

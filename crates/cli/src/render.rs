@@ -7,6 +7,7 @@ use animats_engine::DVec3;
 use animats_render::gif_file::encode_gif;
 use animats_render::video::{encode_mp4, ffmpeg_available};
 use animats_render::{picture, render, Camera, Image};
+use animats_scene::evaluate::centre_at;
 use animats_view::{BellShape, Describe, Drawing};
 use animats_view::{SceneStage, Stage};
 use rayon::prelude::*;
@@ -267,8 +268,10 @@ fn shoot(
 /// particles' centre of mass (what fitness counts), else across the
 /// ground for the watched particles' centre.
 struct Course {
-    /// Particles and their masses whose centre counts.
-    ids: Vec<(usize, f64)>,
+    /// Particles whose centre counts.
+    ids: Vec<animats_engine::ParticleId>,
+    /// Every particle's mass, kg.
+    mass: Vec<f64>,
     /// The axis (unit), or `None`: horizontal distance.
     axis: Option<DVec3>,
     /// The centre at t = 0.
@@ -280,17 +283,16 @@ struct Course {
 impl Course {
     fn new(stage: &SceneStage, watched: &[usize], at_start: &Snapshot) -> Option<Course> {
         let scene = stage.scene();
-        let mass = &scene.world.particles().mass;
-        let (ids, axis): (Vec<usize>, _) = match &scene.evolve {
-            Some(e) => (
-                e.particles.iter().map(|p| p.index()).collect(),
-                Some(e.axis),
-            ),
-            None if !watched.is_empty() => (watched.to_vec(), None),
+        let (ids, axis) = match &scene.evolve {
+            Some(e) => (e.particles.clone(), Some(e.axis)),
+            None if !watched.is_empty() => {
+                let all: Vec<_> = scene.world.particle_ids().collect();
+                (watched.iter().map(|&i| all[i]).collect(), None)
+            }
             None => return None,
         };
-        let ids: Vec<(usize, f64)> = ids.into_iter().map(|i| (i, mass[i])).collect();
-        let start = Course::centre(&ids, &at_start.positions);
+        let mass = scene.world.particles().mass.clone();
+        let start = centre_at(&at_start.positions, &mass, &ids);
         let radius = &scene.world.particles().radius;
         let top = watched
             .iter()
@@ -299,23 +301,11 @@ impl Course {
         let height = (0.6 * top).clamp(0.05, 1.0);
         Some(Course {
             ids,
+            mass,
             axis,
             start,
             post: (DVec3::new(start.x, 0.0, start.z), height),
         })
-    }
-
-    fn centre(ids: &[(usize, f64)], positions: &[DVec3]) -> DVec3 {
-        let (mut sum, mut m) = (DVec3::ZERO, 0.0);
-        for &(i, mass) in ids {
-            sum += positions[i] * mass;
-            m += mass;
-        }
-        if m > 0.0 {
-            sum / m
-        } else {
-            DVec3::ZERO
-        }
     }
 
     /// Draws the start post into `picture`; the distance gone by `s`, m.
@@ -334,7 +324,7 @@ impl Course {
             colour,
             shadow: true,
         });
-        let moved = Course::centre(&self.ids, &s.positions) - self.start;
+        let moved = centre_at(&s.positions, &self.mass, &self.ids) - self.start;
         match self.axis {
             Some(axis) => moved.dot(axis),
             None => DVec3::new(moved.x, 0.0, moved.z).length(),

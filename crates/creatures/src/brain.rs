@@ -157,3 +157,17 @@ pub fn per_output(
         }
     }
 }
+
+/// A network's inputs into `x`: each sensor level mapped from [0, 1] onto
+/// [−1, 1] (`2x − 1`, so 0.5 is no signal), then, with a clock of
+/// frequency `clock` Hz, `sin 2πft` and `cos 2πft` (libm: the same bits on
+/// every platform).
+pub fn network_inputs(x: &mut Vec<f64>, inputs: &[f64], clock: Option<f64>, t: f64) {
+    x.clear();
+    x.extend(inputs.iter().map(|v| 2.0 * v - 1.0));
+    if let Some(f) = clock {
+        let w = std::f64::consts::TAU * f * t;
+        x.push(libm::sin(w));
+        x.push(libm::cos(w));
+    }
+}

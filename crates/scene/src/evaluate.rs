@@ -37,8 +37,6 @@ pub struct EvolveSpec {
     /// The controller evolved, if the table names one (a scene whose
     /// `[evolve]` names none is scored as it is, and cannot be evolved).
     pub controller: Option<String>,
-    /// Its index in [`NervousSystem::controllers`].
-    pub index: Option<usize>,
     /// Every controller evolved (`controllers`, or the one `controller`):
     /// its index in [`NervousSystem::controllers`] and the table it was
     /// written in; the genome is theirs end to end, in this order.
@@ -59,9 +57,6 @@ pub struct EvolveSpec {
     pub touch_tolerance: f64,
     /// The evaluation ends when these two are at least this far apart, m.
     pub fail_on_stretch: Vec<Stretch>,
-    /// The table the controller was written in (`controller`, 2), where its
-    /// genes are written back.
-    pub table: Option<(&'static str, usize)>,
     /// How the hill climber mutates.
     pub mutation: MutationName,
     /// What `log.csv` holds.
@@ -97,6 +92,18 @@ pub struct Stretch {
 }
 
 impl EvolveSpec {
+    /// The (first) evolved controller's index in
+    /// [`NervousSystem::controllers`].
+    pub fn index(&self) -> Option<usize> {
+        self.evolved.first().map(|(i, _)| *i)
+    }
+
+    /// The table the (first) evolved controller was written in
+    /// (`controller`, 2), where its genes are written back.
+    pub fn table(&self) -> Option<(&'static str, usize)> {
+        self.evolved.first().map(|(_, t)| *t)
+    }
+
     pub(crate) fn build(
         at: &At,
         e: &EvolveEntry,
@@ -136,7 +143,6 @@ impl EvolveSpec {
             }
             evolved.push((i, origins[i]));
         }
-        let index = evolved.first().map(|(i, _)| *i);
         let duration = Self::duration(at, e, dt)?;
         let particles = match &e.particles {
             None => world.particle_ids().collect(),
@@ -171,7 +177,6 @@ impl EvolveSpec {
         };
         Ok(EvolveSpec {
             controller: names_evolved.first().map(|c| c.to_string()),
-            index,
             duration,
             particles,
             axis: axis.normalize(),
@@ -180,7 +185,6 @@ impl EvolveSpec {
             fail_on_touch,
             touch_tolerance,
             fail_on_stretch,
-            table: evolved.first().map(|(_, t)| *t),
             evolved,
             mutation: e.mutation,
             log: e.log,
@@ -277,13 +281,18 @@ impl EvolveSpec {
 /// The centre of mass of `ids` (of one particle: its position, exactly;
 /// of massless ones: their mean position).
 pub fn centre_of(world: &World, ids: &[ParticleId]) -> DVec3 {
+    centre_at(&world.state().pos, &world.particles().mass, ids)
+}
+
+/// [`centre_of`] with the particles at `positions` and of masses `mass`
+/// (a recorded frame).
+pub fn centre_at(positions: &[DVec3], mass: &[f64], ids: &[ParticleId]) -> DVec3 {
     if let [p] = ids {
-        return world.position(*p);
+        return positions[p.index()];
     }
     let (mut sum, mut m) = (DVec3::ZERO, 0.0);
-    let mass = &world.particles().mass;
     for p in ids {
-        sum += world.position(*p) * mass[p.index()];
+        sum += positions[p.index()] * mass[p.index()];
         m += mass[p.index()];
     }
     if m > 0.0 {

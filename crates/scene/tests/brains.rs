@@ -556,7 +556,8 @@ fn every_brain_kind_writes_its_genes_back_where_it_reads_them() {
     for (kind, text) in cases {
         let p = SceneProblem::parse(text, "kinds.toml").unwrap_or_else(|e| panic!("{kind}: {e}"));
         let scene = p.fresh().unwrap();
-        let brain = &scene.nervous.controllers[scene.evolve.as_ref().unwrap().index.unwrap()].brain;
+        let brain =
+            &scene.nervous.controllers[scene.evolve.as_ref().unwrap().index().unwrap()].brain;
         assert_eq!(brain.kind(), kind);
         let keys: usize = brain.genome_keys().iter().map(|k| k.genes()).sum();
         assert_eq!(

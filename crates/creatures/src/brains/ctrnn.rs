@@ -25,10 +25,9 @@
 //! every weight in [−16, 16] (Beer's), g in [0, 5], each widened to contain
 //! the value the scene gives; a τ below 1e-4 s counts as 1e-4 s.
 
-use crate::brain::{around, check_genome, finite, positive, Brain, GenomeKey};
+use crate::brain::{around, check_genome, finite, network_inputs, positive, Brain, GenomeKey};
 use animats_engine::ModelError;
 use serde::Deserialize;
-use std::f64::consts::TAU;
 
 /// The most neurons a network may have (10^6 recurrent weights).
 pub const MAX_NEURONS: usize = 1000;
@@ -116,7 +115,10 @@ fn per_neuron(
     n: usize,
     default: f64,
 ) -> Result<Vec<f64>, ModelError> {
-    matrix(field, v, n, 1).map(|m| if v.is_none() { vec![default; n] } else { m })
+    match v {
+        None => Ok(vec![default; n]),
+        Some(_) => matrix(field, v, n, 1),
+    }
 }
 
 fn matrix(
@@ -191,13 +193,7 @@ impl Brain for Ctrnn {
     fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
         let n = self.neurons();
         let (x, rates) = &mut self.scratch;
-        x.clear();
-        x.extend(inputs.iter().map(|v| 2.0 * v - 1.0));
-        if let Some(f) = self.clock {
-            let w = TAU * f * t;
-            x.push(libm::sin(w));
-            x.push(libm::cos(w));
-        }
+        network_inputs(x, inputs, self.clock, t);
         rates.clear();
         for i in 0..n {
             rates.push(sigma(self.gain[i] * (self.state[i] + self.bias[i])));

@@ -10,11 +10,10 @@
 //! layer its weights row by row (`w_j0, w_j1, ...` for neuron j), then its
 //! biases. Bounds: [−10, 10] each, widened to contain the value given.
 
-use crate::brain::{around, check_genome, positive, Brain, GenomeKey};
+use crate::brain::{around, check_genome, network_inputs, positive, Brain, GenomeKey};
 use crate::random::Random;
 use animats_engine::ModelError;
 use serde::Deserialize;
-use std::f64::consts::TAU;
 
 /// `[[controller]] kind = "neural"`.
 #[derive(Clone, Debug, Deserialize)]
@@ -148,13 +147,7 @@ impl Brain for Neural {
 
     fn think(&mut self, t: f64, _dt: f64, inputs: &[f64], outputs: &mut [f64]) {
         let (x, y) = &mut self.scratch;
-        x.clear();
-        x.extend(inputs.iter().map(|v| 2.0 * v - 1.0));
-        if let Some(f) = self.clock {
-            let w = TAU * f * t;
-            x.push(libm::sin(w));
-            x.push(libm::cos(w));
-        }
+        network_inputs(x, inputs, self.clock, t);
         let layers = self.sizes.len() - 1;
         let mut k = 0;
         for (l, s) in self.sizes.windows(2).enumerate() {

@@ -257,7 +257,6 @@ impl MorphologyProblem {
 fn placeholder_spec() -> EvolveSpec {
     EvolveSpec {
         controller: Some(NAME.into()),
-        index: None,
         evolved: Vec::new(),
         duration: 1.0,
         particles: Vec::new(),
@@ -267,7 +266,6 @@ fn placeholder_spec() -> EvolveSpec {
         fail_on_touch: Vec::new(),
         touch_tolerance: 0.0,
         fail_on_stretch: Vec::new(),
-        table: None,
         mutation: Default::default(),
         log: Default::default(),
         lanes: None,
