@@ -51,6 +51,8 @@ pub struct EventContext<'a> {
     pub start_vel: &'a [DVec3],
     /// The particles' properties.
     pub particles: &'a Properties,
+    /// The world's gravity, m/s² (zero without gravity).
+    pub gravity: DVec3,
 }
 
 /// A piece of a trial step, the particles `first..first + pos.len()`, as
@@ -83,6 +85,8 @@ pub struct TrialPiece<'a> {
     pub start_vel: &'a [DVec3],
     /// The whole world's particle properties.
     pub particles: &'a Properties,
+    /// The world's gravity, m/s² (zero without gravity).
+    pub gravity: DVec3,
 }
 
 /// A discrete event: detected after a trial step, handled by changing the

@@ -42,6 +42,7 @@ pub mod particle;
 pub mod pin;
 mod simd;
 pub mod snapshot;
+pub mod terrain;
 pub mod world;
 
 pub use error::{ModelError, SimError};
@@ -70,6 +71,7 @@ pub use jacobian::Jacobian;
 pub use particle::{ParticleDef, ParticleId, Properties, State};
 pub use simd::summary as simd_summary;
 pub use snapshot::Snapshot;
+pub use terrain::{Heightfield, Slope, Steps, Terrain};
 pub use world::{on_pool, on_pool_if, Energy, FloorDef, Stats, StepLimit, StepReport, World};
 
-pub use glam::DVec3;
+pub use glam::{DVec2, DVec3};

@@ -9,7 +9,7 @@
 //!
 //! | kind | value |
 //! |---|---|
-//! | `contact_fraction` | share of steps `particle` rests on or touches the floor (its lowest point within `[evolve] touch_tolerance` of y = 0), [0, 1] |
+//! | `contact_fraction` | share of steps `particle` rests on or touches the floor (its surface within `[evolve] touch_tolerance` of the ground: y = 0, or the terrain), [0, 1] |
 //! | `feet` | particles on the floor, averaged over the steps |
 //! | `displacement` | final centre-of-mass offset of `particles` along `axis`, m |
 //! | `mean_height` | centre-of-mass height of `particles`, averaged over the steps, m |
@@ -479,8 +479,7 @@ impl<'a> Recorder<'a> {
     /// Records the world after a step.
     pub fn step(&mut self, world: &World) {
         self.steps += 1;
-        let radius = &world.particles().radius;
-        let on_floor = |p: ParticleId| world.position(p).y - radius[p.index()] <= self.tolerance;
+        let on_floor = |p: ParticleId| world.clearance(p) <= self.tolerance;
         for (m, sum) in self.measures.iter().zip(&mut self.sums) {
             match m {
                 Measure::ContactFraction(p) if on_floor(*p) => *sum += 1.0,

@@ -237,8 +237,18 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         origins: Vec::new(),
         seed: table.seed,
         gravity: table.gravity,
+        terrain: None,
     };
     crate::entries::build_all(def, &mut cx)?;
+    // `[terrain]` without `[floor]`: the floor's defaults, so shaped.
+    if let (Some(terrain), Some(entry)) = (cx.terrain.take(), &def.terrain) {
+        cx.world
+            .add_floor(animats_engine::FloorDef {
+                terrain,
+                ..Default::default()
+            })
+            .map_err(|e| at(src, "terrain", entry).model(e))?;
+    }
     let Builder {
         mut world,
         names,
@@ -289,7 +299,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
     };
     let guard =
         animats_engine::DivergenceGuard::new(&world, !actors.is_empty() || !nervous.is_empty());
-    let mut warnings = warnings(def, &world, &name_list, dt, def.floor.is_some());
+    let mut warnings = warnings(def, &world, &name_list, dt, world.terrain().is_some());
     warnings.extend(actuator_warnings);
     Ok(Scene {
         world,
@@ -332,14 +342,17 @@ pub fn step_warning(world: &World, names: &[String], dt: f64) -> Option<String> 
 /// What is allowed but probably a mistake: see [`Scene::warnings`].
 fn warnings(def: &SceneDef, world: &World, names: &[String], dt: f64, floor: bool) -> Vec<String> {
     let mut out = Vec::new();
-    let (p, s) = (world.particles(), world.state());
+    let p = world.particles();
     if floor {
+        let flat = world.terrain().is_none_or(|t| t.is_flat());
         for (i, name) in names.iter().enumerate() {
-            let depth = p.radius[i] - s.pos[i].y;
+            let depth = -world.clearance(animats_engine::ParticleId::from_index(i));
             if depth > 1e-9 && !p.fixed[i] {
-                out.push(format!(
-                    "particle `{name}` starts {depth:.4} m inside the floor (its lowest point is below y = 0): the floor will push it out at once",
-                ));
+                out.push(if flat {
+                    format!("particle `{name}` starts {depth:.4} m inside the floor (its lowest point is below y = 0): the floor will push it out at once")
+                } else {
+                    format!("particle `{name}` starts {depth:.4} m inside the terrain: the floor will push it out at once")
+                });
             }
         }
     }

@@ -263,11 +263,10 @@ impl EvolveSpec {
     /// The end rule that holds now, if any: the first of `fail_on_touch`
     /// touching the floor, else the first of `fail_on_stretch` stretched.
     pub fn ending(&self, world: &World) -> Option<Ended> {
-        let radius = &world.particles().radius;
         let touch = self
             .fail_on_touch
             .iter()
-            .find(|(p, _)| world.position(*p).y - radius[p.index()] <= self.touch_tolerance);
+            .find(|(p, _)| world.clearance(*p) <= self.touch_tolerance);
         if let Some((_, n)) = touch {
             return Some(Ended::Touch(n.clone()));
         }

@@ -31,13 +31,20 @@
 //!
 //! A sphere below the plane but already moving up is moved up with the
 //! speed it would have at the plane.
+//!
+//! On other terrain ([`Terrain`]) all of this happens along the surface's
+//! outward normal at the point nearest the sphere's centre: the sphere is
+//! moved out along it, and the velocity's component along it is the one
+//! resolved; the tangential velocity is kept.
 
 use crate::error::ModelError;
 use crate::event::{ByPieces, DiscreteEvent, EventContext, EventState, TrialPiece};
 use crate::force::Targets;
 use crate::particle::{non_negative, ParticleId, Properties};
+use crate::terrain::Terrain;
 use glam::DVec3;
 use std::ops::Range;
+use std::sync::Arc;
 use std::sync::{Mutex, MutexGuard};
 
 /// One bounce recorded during the last step.
@@ -60,10 +67,14 @@ pub struct FloorCollision {
     pub rest_speed: f64,
     /// The particles that collide with the floor.
     pub targets: Targets,
+    /// The ground's shape (the plane y = 0 unless set).
+    terrain: Arc<Terrain>,
     hits: Vec<Hit>,
     /// The step of the last check's trial, s, and the integrator's
     /// free-flight shift: the same for every hit.
     step: f64,
+    /// The world's gravity at the last check, m/s².
+    gravity: DVec3,
     shift: f64,
     collisions: Vec<Collision>,
     /// The bounces of the pieces of a trial settled on many threads, until
@@ -110,6 +121,11 @@ struct Hit {
     index: u32,
     /// The trial's mean acceleration along the normal, m/s².
     accel: f64,
+    /// The surface's outward normal (`+y` on the flat floor).
+    normal: DVec3,
+    /// The gap between the sphere and the surface, < 0 (on terrain: on
+    /// the flat floor it is read from the position).
+    gap: f64,
 }
 
 impl Default for FloorCollision {
@@ -125,12 +141,25 @@ impl FloorCollision {
             envelope,
             rest_speed,
             targets,
+            terrain: Arc::new(Terrain::Flat),
             hits: Vec::new(),
             step: 0.0,
+            gravity: DVec3::ZERO,
             shift: 0.0,
             collisions: Vec::new(),
             pending: Pending::default(),
         }
+    }
+
+    /// The same floor shaped as `terrain`.
+    pub fn with_terrain(mut self, terrain: Arc<Terrain>) -> Self {
+        self.terrain = terrain;
+        self
+    }
+
+    /// The ground's shape.
+    pub fn terrain(&self) -> &Terrain {
+        &self.terrain
     }
 
     /// Checks the thresholds (an infinite envelope never backtracks).
@@ -156,9 +185,10 @@ impl FloorCollision {
     }
 
     /// Moves the sphere of `hit` (at `x`, moving at `v`) up to the plane
-    /// and resolves its impact, for a trial of the step `step` ending at
-    /// `t`, `shift` the integrator's free-flight shift times the hit's
-    /// acceleration and the step; the bounce, if it moved into the plane.
+    /// (out of the terrain along its normal) and resolves its impact, for a
+    /// trial of the step `step` ending at `t`, `shift` the integrator's
+    /// free-flight shift times the hit's acceleration and the step; the
+    /// bounce, if it moved into the plane.
     #[allow(clippy::too_many_arguments)]
     #[inline]
     fn resolve(
@@ -167,29 +197,77 @@ impl FloorCollision {
         step: f64,
         shift: f64,
         t: f64,
+        gravity: DVec3,
         x: &mut DVec3,
         v: &mut DVec3,
         particles: &Properties,
     ) -> Option<Collision> {
         let i = hit.index as usize;
-        let depth = particles.radius[i] - x.y;
-        x.y = particles.radius[i];
-        let (vy, a) = (v.y, hit.accel);
+        let e = particles.restitution[i];
+        if self.terrain.is_flat() {
+            let depth = particles.radius[i] - x.y;
+            x.y = particles.radius[i];
+            let (vy, impact) = self.normal_speed(v.y, hit.accel, depth, step, shift, e);
+            v.y = vy;
+            return impact.map(|impact_speed| Collision {
+                particle: ParticleId(i as u32),
+                t,
+                impact_speed,
+            });
+        }
+        let (n, depth) = (hit.normal, -hit.gap);
+        *x += n * depth;
+        let vn = v.dot(n);
+        let (after, impact) = self.normal_speed(vn, hit.accel, depth, step, shift, e);
+        *v += n * (after - vn);
+        // Moved out further than its normal speed could have carried it
+        // against gravity (a sphere sliding into a crease of the ground,
+        // onto a steeper face, while the contact force of the face it left
+        // held it up): the climb is paid from the sliding speed, so that
+        // the move never adds energy.
+        let climb = -2.0 * gravity.dot(n) * depth;
+        let excess = after * after - vn * vn + climb;
+        if excess > 0.0 {
+            let slide = *v - n * after;
+            let slide2 = slide.length_squared();
+            if slide2 > 0.0 {
+                *v -= slide * (1.0 - ((slide2 - excess).max(0.0) / slide2).sqrt());
+            }
+        }
+        impact.map(|impact_speed| Collision {
+            particle: ParticleId(i as u32),
+            t,
+            impact_speed,
+        })
+    }
+
+    /// The normal speed after moving a sphere `depth` out of the plane,
+    /// which moved along its normal at `vn` under the trial's mean normal
+    /// acceleration `a`, with restitution `e`; and its impact speed, if it
+    /// was moving into the plane.
+    #[inline]
+    fn normal_speed(
+        &self,
+        vn: f64,
+        a: f64,
+        depth: f64,
+        step: f64,
+        shift: f64,
+        e: f64,
+    ) -> (f64, Option<f64>) {
         // The normal speed at the plane under the trial's mean
         // acceleration; below zero the sphere could not have got this
         // deep this fast, and it is simply put on the plane.
-        let at_plane = (vy * vy + 2.0 * a * depth).max(0.0).sqrt();
-        if vy >= 0.0 {
-            v.y = at_plane;
-            return None;
+        let at_plane = (vn * vn + 2.0 * a * depth).max(0.0).sqrt();
+        if vn >= 0.0 {
+            return (at_plane, None);
         }
         // The rebound, in the plain velocity and in the one the
         // integrator's free flight conserves (`w = v + s a h`); the
         // smaller raises neither energy. For explicit Euler the second is
         // smaller: it keeps the ½ a² h² that each step of flight gains
         // out of the next bounce, without which a bounce never ends.
-        let e = particles.restitution[i];
-        let w = vy + shift;
+        let w = vn + shift;
         let w_at_plane = (w * w + 2.0 * a * depth).max(0.0).sqrt();
         let rebound = (e * at_plane).min(e * w_at_plane - shift);
         // A rebound that cannot keep the sphere off the plane for a
@@ -199,16 +277,21 @@ impl FloorCollision {
         } else {
             f64::INFINITY
         };
-        v.y = if at_plane < self.rest_speed || flight <= step {
+        let after = if at_plane < self.rest_speed || flight <= step {
             0.0
         } else {
             rebound
         };
-        Some(Collision {
-            particle: ParticleId(i as u32),
-            t,
-            impact_speed: at_plane,
-        })
+        (after, Some(at_plane))
+    }
+
+    /// Sphere `i` at `x` under the terrain: its gap (< 0) and the
+    /// surface's outward normal.
+    #[inline]
+    fn under_terrain(&self, x: DVec3, radius: f64) -> Option<(f64, DVec3)> {
+        let (d, n) = self.terrain.probe(x, radius)?;
+        let gap = d - radius;
+        (gap < 0.0).then_some((gap, n))
     }
 
     /// The bounces of the last step.
@@ -230,10 +313,58 @@ fn deepest(pos: &[DVec3], radius: &[f64], inv_mass: &[f64]) -> Option<f64> {
     (deepest < 0.0).then_some(deepest)
 }
 
+impl FloorCollision {
+    /// [`deepest`] on this floor's terrain.
+    fn deepest(&self, pos: &[DVec3], radius: &[f64], inv_mass: &[f64]) -> Option<f64> {
+        if self.terrain.is_flat() {
+            return deepest(pos, radius, inv_mass);
+        }
+        let mut deepest = 0.0f64;
+        for ((x, &r), &w) in pos.iter().zip(radius).zip(inv_mass) {
+            if w != 0.0 {
+                if let Some((gap, _)) = self.under_terrain(*x, r) {
+                    deepest = deepest.min(gap);
+                }
+            }
+        }
+        (deepest < 0.0).then_some(deepest)
+    }
+
+    /// `check` on terrain other than the plane y = 0.
+    fn check_terrain(&mut self, ctx: &EventContext) -> EventState {
+        let (pos, p) = (ctx.pos, ctx.particles);
+        let mut deepest = 0.0f64;
+        let mut hits = std::mem::take(&mut self.hits);
+        let mut hit = |i: usize| {
+            if p.inv_mass[i] == 0.0 {
+                return;
+            }
+            if let Some((gap, normal)) = self.under_terrain(pos[i], p.radius[i]) {
+                hits.push(Hit {
+                    index: i as u32,
+                    accel: (ctx.vel[i] - ctx.start_vel[i]).dot(normal) / ctx.h,
+                    normal,
+                    gap,
+                });
+                deepest = deepest.min(gap);
+            }
+        };
+        match &self.targets {
+            Targets::All => (0..pos.len()).for_each(&mut hit),
+            Targets::Only(ids) => ids.iter().for_each(|id| hit(id.index())),
+        }
+        self.hits = hits;
+        self.state((!self.hits.is_empty()).then_some(deepest))
+    }
+}
+
 impl DiscreteEvent for FloorCollision {
     fn check(&mut self, ctx: &EventContext) -> EventState {
         self.hits.clear();
-        (self.step, self.shift) = (ctx.step, ctx.flight_shift);
+        (self.step, self.shift, self.gravity) = (ctx.step, ctx.flight_shift, ctx.gravity);
+        if !self.terrain.is_flat() {
+            return self.check_terrain(ctx);
+        }
         let (pos, p) = (ctx.pos, ctx.particles);
         // The deepest penetration among the spheres below the plane.
         let mut deepest = 0.0f64;
@@ -242,6 +373,8 @@ impl DiscreteEvent for FloorCollision {
                 self.hits.push(Hit {
                     index: i as u32,
                     accel: (ctx.vel[i].y - ctx.start_vel[i].y) / ctx.h,
+                    normal: DVec3::Y,
+                    gap,
                 });
                 deepest = deepest.min(gap);
             }
@@ -278,6 +411,7 @@ impl DiscreteEvent for FloorCollision {
                 self.step,
                 shift,
                 t,
+                self.gravity,
                 &mut pos[i],
                 &mut vel[i],
                 particles,
@@ -317,7 +451,7 @@ impl ByPieces for FloorCollision {
         }
         let p = ctx.particles;
         let (r, w) = (&p.radius[range.clone()], &p.inv_mass[range.clone()]);
-        Some(self.state(deepest(&ctx.pos[range], r, w)))
+        Some(self.state(self.deepest(&ctx.pos[range], r, w)))
     }
 
     fn settles_pieces(&self) -> bool {
@@ -329,7 +463,7 @@ impl ByPieces for FloorCollision {
         let r = piece.first..piece.first + piece.pos.len();
         let (radius, inv_mass) = (&p.radius[r.clone()], &p.inv_mass[r]);
         // Read only first: most pieces of most steps have nothing below.
-        let state = self.state(deepest(piece.pos, radius, inv_mass));
+        let state = self.state(self.deepest(piece.pos, radius, inv_mass));
         if state == EventState::None || (state == EventState::Missed && !piece.finest) {
             return state;
         }
@@ -337,18 +471,34 @@ impl ByPieces for FloorCollision {
         let mut bounces = Vec::new();
         for k in 0..piece.pos.len() {
             // A hit as in `check` (a NaN gap is none).
-            let below = inv_mass[k] != 0.0 && piece.pos[k].y - radius[k] < 0.0;
-            if !below {
+            if inv_mass[k] == 0.0 {
                 continue;
             }
-            let accel = (piece.vel[k].y - piece.start_vel[k].y) / piece.h;
+            let (gap, normal) = if self.terrain.is_flat() {
+                (piece.pos[k].y - radius[k], DVec3::Y)
+            } else {
+                match self.under_terrain(piece.pos[k], radius[k]) {
+                    Some(below) => below,
+                    None => continue,
+                }
+            };
+            if gap.is_nan() || gap >= 0.0 {
+                continue;
+            }
+            let accel = if self.terrain.is_flat() {
+                (piece.vel[k].y - piece.start_vel[k].y) / piece.h
+            } else {
+                (piece.vel[k] - piece.start_vel[k]).dot(normal) / piece.h
+            };
             let hit = Hit {
                 index: (piece.first + k) as u32,
                 accel,
+                normal,
+                gap,
             };
             let (x, v) = (&mut piece.pos[k], &mut piece.vel[k]);
             let shift = piece.flight_shift * accel * piece.step;
-            if let Some(c) = self.resolve(hit, piece.step, shift, piece.t, x, v, p) {
+            if let Some(c) = self.resolve(hit, piece.step, shift, piece.t, piece.gravity, x, v, p) {
                 bounces.push(c);
             }
         }

@@ -17,11 +17,23 @@
 //!
 //! This force reads the accumulated net force, so it runs in the
 //! [`Stage::Contact`] stage, after every ordinary force.
+//!
+//! On other terrain ([`Terrain`]) "up" is the surface's outward normal at
+//! the point nearest the sphere: the normal reaction cancels the net
+//! force's component into the surface (and any residual normal speed
+//! within 1 µm/s of zero, which rounding leaves on a tilted surface), and
+//! friction acts in the tangent plane.
 
 use crate::error::ModelError;
 use crate::force::{Force, ForceContext, Stage, Targets};
 use crate::particle::non_negative;
+use crate::terrain::Terrain;
 use glam::DVec3;
+use std::sync::Arc;
+
+/// On terrain, a normal speed within this of zero (m/s) is rounding: the
+/// sphere is neither leaving nor hitting the surface.
+const ROUNDING_SPEED: f64 = 1e-6;
 
 /// Normal reaction and friction of the plane y = 0.
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +47,8 @@ pub struct FloorContact {
     pub contact_tolerance: f64,
     /// The particles the floor supports.
     pub targets: Targets,
+    /// The ground's shape.
+    pub terrain: Arc<Terrain>,
 }
 
 impl Default for FloorContact {
@@ -44,6 +58,7 @@ impl Default for FloorContact {
             rest_speed: 0.05,
             contact_tolerance: 1e-6,
             targets: Targets::All,
+            terrain: Arc::new(Terrain::Flat),
         }
     }
 }
@@ -62,6 +77,9 @@ impl FloorContact {
     #[inline(always)]
     fn contact(&self, ctx: &ForceContext, i: usize, f: &mut DVec3) {
         let p = &ctx.particles;
+        if !self.terrain.is_flat() {
+            return self.on_terrain(ctx, i, f);
+        }
         if p.inv_mass[i] == 0.0 || ctx.pos[i].y - p.radius[i] > self.contact_tolerance {
             return;
         }
@@ -103,6 +121,52 @@ impl FloorContact {
 }
 
 impl FloorContact {
+    /// [`FloorContact::contact`] on terrain other than the plane y = 0:
+    /// the same, along the surface's normal.
+    #[inline(never)]
+    fn on_terrain(&self, ctx: &ForceContext, i: usize, f: &mut DVec3) {
+        let p = &ctx.particles;
+        if p.inv_mass[i] == 0.0 {
+            return;
+        }
+        let reach = p.radius[i] + self.contact_tolerance;
+        let Some((d, n)) = self.terrain.probe(ctx.pos[i], reach) else {
+            return;
+        };
+        if d - p.radius[i] > self.contact_tolerance {
+            return;
+        }
+        let v = ctx.vel[i];
+        let (vn, fn_) = (v.dot(n), f.dot(n));
+        if vn > ROUNDING_SPEED || vn < -self.rest_speed || fn_ >= 0.0 {
+            return;
+        }
+        let m = p.mass[i];
+        // Cancel the push into the surface, and the residual normal speed.
+        let normal = -fn_;
+        let ft = *f - n * fn_;
+        // Rounding's normal speed is cancelled too; a real approach is the
+        // collision's to resolve.
+        let residual = if vn.abs() <= ROUNDING_SPEED { vn } else { 0.0 };
+        *f = ft - n * (residual * m / ctx.dt);
+        let vt = v - n * vn;
+        let speed = vt.length();
+        if speed < self.static_speed {
+            let hold = -ft - vt * (m / ctx.dt);
+            let needed = hold.length();
+            if needed <= p.mu_s[i] * normal {
+                *f += hold;
+                return;
+            }
+            *f += hold * ((p.mu_k[i] * normal).min(needed) / needed);
+            return;
+        }
+        let dir = vt / speed;
+        let stop = m * speed / ctx.dt + ft.dot(dir);
+        let kinetic = (p.mu_k[i] * normal).min(stop.max(0.0));
+        *f -= dir * kinetic;
+    }
+
     /// [`Force::apply`], split like the world's per-particle loops when
     /// `split` (a large world's particles on many threads): each particle's
     /// contact is its own, so the pieces give the same bits, and each

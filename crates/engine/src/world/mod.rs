@@ -75,6 +75,9 @@ pub struct FloorDef {
     pub contact: bool,
     /// The particles the floor acts on.
     pub targets: Targets,
+    /// The ground's shape: the plane y = 0, or a slope, steps or a
+    /// heightfield ([`Terrain`](crate::Terrain)).
+    pub terrain: crate::Terrain,
 }
 
 impl Default for FloorDef {
@@ -86,6 +89,7 @@ impl Default for FloorDef {
             contact_tolerance: 1e-6,
             contact: true,
             targets: Targets::All,
+            terrain: crate::Terrain::Flat,
         }
     }
 }
@@ -401,13 +405,17 @@ impl World {
         Ok(())
     }
 
-    /// Adds the floor, the plane y = 0: its collision event and, unless
+    /// Adds the floor, the plane y = 0 or the terrain `def.terrain`: its
+    /// collision event and, unless
     /// `def.contact` is false, its normal reaction and friction. A world has
     /// at most one floor; adding another replaces the contact force and adds a
     /// second collision event.
     pub fn add_floor(&mut self, def: FloorDef) -> Result<(), ModelError> {
         self.check_targets(&def.targets)?;
-        let collision = FloorCollision::new(def.envelope, def.rest_speed, def.targets.clone());
+        def.terrain.validate()?;
+        let terrain = std::sync::Arc::new(def.terrain);
+        let collision = FloorCollision::new(def.envelope, def.rest_speed, def.targets.clone())
+            .with_terrain(terrain.clone());
         collision.validate()?;
         if def.contact {
             let contact = FloorContact {
@@ -415,6 +423,7 @@ impl World {
                 rest_speed: def.rest_speed,
                 contact_tolerance: def.contact_tolerance,
                 targets: def.targets,
+                terrain,
             };
             contact.validate()?;
             self.forces.floor = Some(contact);
@@ -423,11 +432,28 @@ impl World {
         Ok(())
     }
 
+    /// The floor's shape, if the world has a floor.
+    pub fn terrain(&self) -> Option<&crate::Terrain> {
+        self.event::<FloorCollision>().map(FloorCollision::terrain)
+    }
+
+    /// How far particle `p`'s surface is from the ground (the floor's
+    /// terrain; the plane y = 0 without a floor), m: negative when it is
+    /// inside it. On a heightfield, more than 8 cells from the surface,
+    /// it is the distance to the surface within 8 cells across.
+    pub fn clearance(&self, p: ParticleId) -> f64 {
+        let (x, r) = (self.position(p), self.particles().radius[p.index()]);
+        match self.terrain() {
+            Some(t) if !t.is_flat() => t.probe(x, f64::INFINITY).map_or(x.y, |(d, _)| d) - r,
+            _ => x.y - r,
+        }
+    }
+
     /// Adds sphere–sphere contact among `def.targets` (see
     /// [`SphereContact`](crate::SphereContact)); the pairs joined by a
     /// spring, an angle joint (any two of its three particles) or a torque
     /// joint *now* are excluded, besides `def.excluded`; if the world has a
-    /// floor now, contacts never push its spheres into it. Returns the
+    /// flat floor now, contacts never push its spheres into it. Returns the
     /// event's index.
     pub fn add_sphere_contact(
         &mut self,
@@ -439,7 +465,12 @@ impl World {
         }
         def.excluded.extend(self.joined_pairs());
         let mut contact = crate::SphereContact::new(def)?;
-        if let Some(floor) = self.event::<FloorCollision>() {
+        // Only the flat floor holds spheres up against contacts; on terrain
+        // the floor's own collision event moves them out.
+        if let Some(floor) = self
+            .event::<FloorCollision>()
+            .filter(|f| f.terrain().is_flat())
+        {
             contact.on_floor(self.len(), &floor.targets);
         }
         Ok(self.add_event(Box::new(contact)))

@@ -210,6 +210,7 @@ impl World {
         self.scratch.implicit.iterations = 0;
         self.forces.one_piece = self.one_piece();
         self.checked = Checked::Whole;
+        let gravity = self.forces.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g);
         let mut dynamics = Dynamics {
             forces: &mut self.forces,
             particles: &self.particles,
@@ -234,6 +235,7 @@ impl World {
                 start_pos: &from.pos[r.clone()],
                 start_vel: &from.vel[r],
                 particles,
+                gravity,
             };
             let mut worst = EventState::None;
             for e in events {
@@ -278,6 +280,7 @@ impl World {
             start_pos: &self.state.pos,
             start_vel: &self.state.vel,
             particles: &self.particles,
+            gravity: self.forces.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g),
         };
         if large {
             let answer;

@@ -1,4 +1,5 @@
-//! `[floor]`: the plane y = 0 (collision and contact).
+//! `[floor]`: the plane y = 0 (collision and contact), or the shape
+//! `[terrain]` gives it.
 
 use super::*;
 
@@ -33,6 +34,7 @@ impl Build for FloorEntry {
                 static_speed: f.static_speed,
                 rest_speed: f.rest_speed,
                 targets,
+                terrain: cx.terrain.take().unwrap_or_default(),
                 ..FloorDef::default()
             })
             .map_err(|e| at.model(e))?;

@@ -62,6 +62,8 @@ entries! {
     particle: Vec<ParticleEntry>,
     /// `[[food]]` entries: fixed particles that jellyfish smell.
     food: Vec<FoodEntry>,
+    /// `[terrain]`: the floor's shape (slope, steps, heightfield).
+    terrain: Option<TerrainEntry>,
     /// `[floor]`: the plane y = 0.
     floor: Option<FloorEntry>,
     /// `[fluid]`: drag and buoyancy.
@@ -144,6 +146,8 @@ pub(crate) struct Builder<'s> {
     pub seed: u64,
     /// The scene's gravity.
     pub gravity: DVec3,
+    /// The floor's shape, from `[terrain]`, until the floor takes it.
+    pub terrain: Option<animats_engine::Terrain>,
 }
 
 impl Builder<'_> {
