@@ -70,6 +70,9 @@ pub struct Picture {
     pub bells: Vec<Bell>,
     /// The floor at y = 0, checkered in squares of this size, m.
     pub floor: Option<f64>,
+    /// The floor's shape instead of the plane y = 0: its triangles, drawn
+    /// with the same checker, and the terrain, for the shadows' heights.
+    pub ground: Option<(animats_view::GroundMesh, animats_engine::Terrain)>,
     /// Under water (tinted and fogged) rather than in air.
     pub water: bool,
     /// A caption for the top-left corner.
@@ -129,6 +132,7 @@ pub fn picture(
         rods,
         bells,
         floor: drawing.floor,
+        ground: drawing.ground.clone().zip(drawing.terrain.clone()),
         water: drawing.water,
         caption: None,
     }

@@ -3,7 +3,8 @@
 //! output resolution (then averaged down: antialiasing). No GPU, no display,
 //! no threads inside a frame: the same picture gives the same bytes.
 //!
-//! Order: sky or water and the checkered floor (one ray per pixel), blob
+//! Order: sky or water and the checkered floor (one ray per pixel; or the
+//! terrain's triangles, each over its projected box), blob
 //! shadows of the spheres under a light from straight above, spheres and
 //! rods (depth-tested), then the translucent bells blended over them, then
 //! the fog of the water (or of distance in air), then the caption.
@@ -11,6 +12,8 @@
 use crate::camera::{Camera, View};
 use crate::image::Image;
 use crate::picture::{hex, Bell, Colour, Picture, Rod, Sphere};
+use animats_engine::Terrain;
+use animats_view::GroundMesh;
 use glam::DVec3;
 
 /// Samples per pixel along each axis.
@@ -45,9 +48,13 @@ pub fn render(picture: &Picture, camera: &Camera, width: u32, height: u32) -> Im
     };
     let sun = SUN.normalize();
     backdrop(&mut c, &view, picture);
+    if let (Some(cell), Some((mesh, _))) = (picture.floor, &picture.ground) {
+        ground(&mut c, &view, mesh, cell, picture.water);
+    }
     if picture.floor.is_some() {
+        let terrain = picture.ground.as_ref().map(|(_, t)| t);
         for s in picture.spheres.iter().filter(|s| s.shadow) {
-            shadow(&mut c, &view, s);
+            shadow(&mut c, &view, s, terrain);
         }
     }
     for s in &picture.spheres {
@@ -78,11 +85,7 @@ fn sky_colour(ray: DVec3) -> Colour {
 
 /// Sky (or water) and the floor, one ray per pixel.
 fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
-    let (light, dark) = if picture.water {
-        (hex(0xc2b280), hex(0xb2a272))
-    } else {
-        (hex(0x96a880), hex(0x80926c))
-    };
+    let (light, dark) = floor_colours(picture.water);
     // Lambert under the sun, as the live view's floor.
     let lit = 0.55 + 0.45 * SUN.normalize().y;
     let (light, dark) = (light * lit, dark * lit);
@@ -95,7 +98,9 @@ fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
             } else {
                 sky_colour(ray)
             };
-            let Some(cell) = picture.floor else { continue };
+            let Some(cell) = picture.floor.filter(|_| picture.ground.is_none()) else {
+                continue;
+            };
             if ray.y >= -1e-9 || view.eye.y <= 0.0 {
                 continue;
             }
@@ -108,6 +113,92 @@ fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
             c.floor[i] = Some(p);
         }
     }
+}
+
+/// The floor's checker colours, unlit.
+fn floor_colours(water: bool) -> (Colour, Colour) {
+    if water {
+        (hex(0xc2b280), hex(0xb2a272))
+    } else {
+        (hex(0x96a880), hex(0x80926c))
+    }
+}
+
+/// The ground's triangles, checkered as the flat floor and lit by the sun
+/// as it is (Lambert on each triangle's normal).
+fn ground(c: &mut Canvas, view: &View, mesh: &GroundMesh, cell: f64, water: bool) {
+    let (light, dark) = floor_colours(water);
+    let sun = SUN.normalize();
+    for [a, b, t] in mesh.corners() {
+        let Some((x0, y0, x1, y1)) = triangle_bounds(c, view, [a, b, t]) else {
+            continue;
+        };
+        let (e1, e2) = (b - a, t - a);
+        let Some(mut normal) = e1.cross(e2).try_normalize() else {
+            continue;
+        };
+        if normal.dot(view.eye - a) < 0.0 {
+            normal = -normal;
+        }
+        // The flat floor's light, its change with the tilt made stronger
+        // so that the relief shows.
+        let lit = (0.55 + 0.45 * sun.y + 1.5 * (normal.dot(sun) - sun.y)).clamp(0.3, 1.1);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                // Möller–Trumbore.
+                let p = ray.cross(e2);
+                let det = e1.dot(p);
+                if det.abs() < 1e-15 {
+                    continue;
+                }
+                let s = view.eye - a;
+                let u = s.dot(p) / det;
+                if !(0.0..=1.0).contains(&u) {
+                    continue;
+                }
+                let q = s.cross(e1);
+                let v = ray.dot(q) / det;
+                if v < 0.0 || u + v > 1.0 {
+                    continue;
+                }
+                let dist = e2.dot(q) / det;
+                let i = (y * c.width + x) as usize;
+                if dist <= 0.0 || dist >= c.depth[i] {
+                    continue;
+                }
+                let hit = view.eye + ray * dist;
+                let odd = ((hit.x / cell).floor() as i64 + (hit.z / cell).floor() as i64)
+                    .rem_euclid(2)
+                    == 1;
+                c.colour[i] = if odd { dark } else { light } * lit;
+                c.depth[i] = dist;
+                c.floor[i] = Some(hit);
+            }
+        }
+    }
+}
+
+/// Screen bounds of the part of a triangle in front of the eye (clipped
+/// at a depth of 1 mm, so that a ground triangle reaching behind the eye
+/// bounds only what shows of it).
+fn triangle_bounds(c: &Canvas, view: &View, t: [DVec3; 3]) -> Option<(u32, u32, u32, u32)> {
+    const NEAR: f64 = 1e-3;
+    let mut front = Vec::with_capacity(4);
+    for k in 0..3 {
+        let (p, q) = (t[k], t[(k + 1) % 3]);
+        let (dp, dq) = (view.depth(p) - NEAR, view.depth(q) - NEAR);
+        if dp >= 0.0 {
+            front.push(p);
+        }
+        if (dp >= 0.0) != (dq >= 0.0) {
+            front.push(p + (q - p) * (dp / (dp - dq)));
+        }
+    }
+    if front.is_empty() {
+        return None;
+    }
+    bounds(c, view, &front, 1.0)
 }
 
 /// Pixel bounds (x0, y0, x1, y1) of the projection of the points, padded.
@@ -160,14 +251,15 @@ fn shade(base: Colour, normal: DVec3, ray: DVec3, sun: DVec3) -> Colour {
 }
 
 /// A soft dark disc on the floor under a sphere, fading with its height.
-fn shadow(c: &mut Canvas, view: &View, s: &Sphere) {
-    let h = s.centre.y;
+fn shadow(c: &mut Canvas, view: &View, s: &Sphere, terrain: Option<&Terrain>) {
+    let below = terrain.map_or(0.0, |t| t.height(s.centre.x, s.centre.z));
+    let h = s.centre.y - below;
     if h <= 0.0 {
         return;
     }
     let r = s.radius * 1.1;
     let strength = 0.45 * libm::exp(-h / (6.0 * s.radius + 0.3));
-    let ground = DVec3::new(s.centre.x, 0.0, s.centre.z);
+    let ground = DVec3::new(s.centre.x, below, s.centre.z);
     let square = [
         ground + DVec3::new(-r, 0.0, -r),
         ground + DVec3::new(r, 0.0, -r),

@@ -116,6 +116,12 @@ pub struct Drawing {
     pub bells: Vec<BellPlan>,
     /// The floor's checker square, m, if there is a floor.
     pub floor: Option<f64>,
+    /// The floor's triangles when it has a terrain (not the plane y = 0).
+    pub ground: Option<crate::GroundMesh>,
+    /// The floor's terrain when it is not the plane y = 0 (the renderer
+    /// asks it for heights; the page gets `ground`).
+    #[serde(skip)]
+    pub terrain: Option<animats_engine::Terrain>,
     /// Under water (tinted and fogged), not in air.
     pub water: bool,
 }
@@ -197,7 +203,10 @@ impl Drawing {
             })
             .collect();
         let floor = w.event::<animats_engine::FloorCollision>().is_some();
+        let terrain = w.terrain().filter(|t| !t.is_flat()).cloned();
         Drawing {
+            ground: terrain.as_ref().and_then(crate::ground::mesh),
+            terrain,
             balls,
             rods,
             bells,

@@ -10,6 +10,7 @@
 //!   creature's state;
 //! - `drawing.rs`: what is drawn (balls, rods, bells, floor, water), decided
 //!   once for the page and the renderer;
+//! - `ground.rs`: the ground's triangles when the floor has a terrain;
 //! - `palette.rs`: the colour of each kind of part, the one source of colour
 //!   (the page receives it from the server with the scene);
 //! - `stage.rs`: a [`Stage`] advances a world and describes it;
@@ -18,10 +19,12 @@
 #![warn(missing_docs)]
 
 pub mod drawing;
+pub mod ground;
 pub mod model;
 pub mod palette;
 pub mod stage;
 
 pub use drawing::{Ball, BellPlan, BellShape, Drawing, Look, Rod};
+pub use ground::GroundMesh;
 pub use model::{CreatureState, Describe, Dome, Part};
 pub use stage::{framing, SceneStage, Stage};

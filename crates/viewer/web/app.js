@@ -129,13 +129,32 @@ function build(desc) {
     checker.magFilter = THREE.NearestFilter;
     checker.minFilter = THREE.LinearMipmapLinearFilter;
     checker.generateMipmaps = true;
-    checker.repeat.set(size / cell / 2, size / cell / 2);
+    if (d.ground) {
+      // Terrain: the server's triangles, the checker laid on x and z.
+      const geometry = new THREE.BufferGeometry();
+      const p = d.ground.positions;
+      const uv = new Float32Array((p.length / 3) * 2);
+      for (let k = 0; k < p.length / 3; k++) {
+        uv[2 * k] = p[3 * k] / cell / 2;
+        uv[2 * k + 1] = -p[3 * k + 2] / cell / 2;
+      }
+      geometry.setAttribute('position', new THREE.Float32BufferAttribute(p, 3));
+      geometry.setAttribute('uv', new THREE.Float32BufferAttribute(uv, 2));
+      geometry.setIndex(d.ground.triangles);
+      geometry.computeVertexNormals();
+      floor = new THREE.Mesh(
+        geometry,
+        new THREE.MeshStandardMaterial({ map: checker, roughness: 0.95, flatShading: true, side: THREE.DoubleSide }),
+      );
+    } else {
+      checker.repeat.set(size / cell / 2, size / cell / 2);
+      floor = new THREE.Mesh(
+        new THREE.PlaneGeometry(size, size),
+        new THREE.MeshStandardMaterial({ map: checker, roughness: 0.95 }),
+      );
+      floor.rotation.x = -Math.PI / 2;
+    }
     checker.needsUpdate = true;
-    floor = new THREE.Mesh(
-      new THREE.PlaneGeometry(size, size),
-      new THREE.MeshStandardMaterial({ map: checker, roughness: 0.95 }),
-    );
-    floor.rotation.x = -Math.PI / 2;
     floor.receiveShadow = true;
     group.add(floor);
   }
@@ -193,6 +212,7 @@ function build(desc) {
     return { div, particle: l.particle, lift: 3 * desc.drawing.balls[l.particle].radius + 0.05 };
   });
   drawn = { group, spheres, springs, domes, floor, water, labels, size: desc.distance };
+  viewer.groundTriangles = d.ground ? floor.geometry.index.count / 3 : 0;
 
   // Depth precision: the near plane scales with the scene, or the grid
   // flickers into the floor.

@@ -4,7 +4,8 @@
 use crate::sensor::{unit, Sensor};
 use animats_engine::{ParticleId, World};
 
-/// Height of `particle`'s lowest point above the plane y = 0, m, in [0, 1].
+/// Height of `particle`'s lowest point above the plane y = 0 (on terrain:
+/// its distance from the terrain's surface), m, in [0, 1].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeightSensor {
     /// The sphere measured.
@@ -13,7 +14,6 @@ pub struct HeightSensor {
 
 impl Sensor for HeightSensor {
     fn level(&self, world: &World) -> f64 {
-        let r = world.particles().radius[self.particle.index()];
-        unit(world.position(self.particle).y - r)
+        unit(world.clearance(self.particle))
     }
 }

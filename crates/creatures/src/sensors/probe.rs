@@ -12,10 +12,10 @@ use std::f64::consts::PI;
 /// it is put back on it by the collision.
 pub const TOUCH_TOLERANCE: f64 = 1e-3;
 
-/// True while `p`'s lowest point is on or below the floor (within
-/// [`TOUCH_TOLERANCE`]).
+/// True while `p`'s surface is on or inside the floor (within
+/// [`TOUCH_TOLERANCE`]; on terrain, of the terrain's surface).
 pub fn touches_floor(world: &World, p: ParticleId) -> bool {
-    world.position(p).y - world.particles().radius[p.index()] <= TOUCH_TOLERANCE
+    world.clearance(p) <= TOUCH_TOLERANCE
 }
 
 /// What is read.

@@ -443,7 +443,12 @@ impl World {
     /// it is the distance to the surface within 8 cells across.
     pub fn clearance(&self, p: ParticleId) -> f64 {
         let (x, r) = (self.position(p), self.particles().radius[p.index()]);
-        match self.terrain() {
+        // The contact force holds the same terrain, without a search.
+        let terrain = match &self.forces.floor {
+            Some(f) => Some(&*f.terrain),
+            None => self.terrain(),
+        };
+        match terrain {
             Some(t) if !t.is_flat() => t.probe(x, f64::INFINITY).map_or(x.y, |(d, _)| d) - r,
             _ => x.y - r,
         }

@@ -230,6 +230,31 @@ try {
     heap.child.kill('SIGINT');
   }
 
+  // Terrain (issue 43): `animats view scenes/walker_rough.toml` draws the
+  // heightfield's triangles, and the walker stays on them.
+  const rough = await serve(['view', resolve(root, 'scenes/walker_rough.toml'), '--port', '0']);
+  try {
+    const tab = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    const tabErrors = [];
+    tab.on('pageerror', (e) => tabErrors.push(e.message));
+    await tab.goto(rough.url);
+    await tab.waitForFunction(() => window.__viewer && window.__viewer.frame && window.__viewer.frame.t > 2, null, { timeout: 30000 });
+    const ground = await tab.evaluate(() => {
+      const g = window.__viewer.scene.drawing.ground;
+      return { sent: g ? g.triangles.length / 3 : 0, drawn: window.__viewer.groundTriangles };
+    });
+    // 100 × 30 cells of two triangles, and the ring out to the horizon.
+    check(ground.sent >= 6000 && ground.drawn === ground.sent, 'view walker_rough.toml: the heightfield is drawn as triangles',
+      `${ground.sent} sent, ${ground.drawn} drawn`);
+    const drawn = await canvasStats(tab);
+    check(drawn.variance > 50 && tabErrors.length === 0, 'view walker_rough.toml: drawn, no script errors',
+      `luminance variance ${drawn.variance.toFixed(0)}; ${tabErrors.join('; ')}`);
+    await tab.screenshot({ path: join(dirname(screenshot), 'rough.png') });
+    await tab.close();
+  } finally {
+    rough.child.kill('SIGINT');
+  }
+
   // `evolve --view`: the thesis's roobot hops with the best brain so far,
   // and the overlay says which and how the run stands.
   const out = mkdtempSync(join(tmpdir(), 'animats-evolve-view-'));
