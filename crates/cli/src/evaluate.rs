@@ -6,7 +6,7 @@
 //! them.
 
 use crate::Failure;
-use animats_scene::evaluate::{evaluate, evaluate_robust, SceneProblem};
+use animats_scene::evaluate::{evaluate, score, SceneProblem};
 use std::path::PathBuf;
 
 /// Arguments of `animats evaluate`.
@@ -54,13 +54,11 @@ pub fn run(args: Args) -> Result<(), Failure> {
                     "{file}: the scene has no [evolve] table: nothing to evaluate (docs/SCENES.md)"
                 )))
             }
-            // `robust = true`: at the scene's step and half of it, as
-            // evolution scores it.
-            Some(spec) if spec.robust => {
+            // Robust, trials: as evolution scores it.
+            Some(_) => {
                 let build = || animats_scene::parse(&text, &file).map_err(|e| e.to_string());
-                return report(evaluate_robust(build).map_err(Failure::Other)?, args.json);
+                return report(score(build).map_err(Failure::Other)?, args.json);
             }
-            Some(_) => scene,
         }
     };
     report(evaluate(scene).map_err(Failure::Other)?, args.json)
@@ -76,9 +74,19 @@ fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Fail
             "time": time,
             "ended": ended,
         });
-        // A scene with an [archive] adds its measures, in order.
+        // A scene with an [archive] adds its measures, in order; one whose
+        // fitness counts energy, a target or terms adds them.
         if !e.measures.is_empty() {
             out["measures"] = serde_json::json!(e.measures);
+        }
+        if let Some(j) = e.energy {
+            out["energy"] = serde_json::json!(j);
+        }
+        if let Some(d) = e.target_distance {
+            out["target_distance"] = serde_json::json!(d);
+        }
+        if !e.terms.is_empty() {
+            out["terms"] = serde_json::json!(e.terms);
         }
         println!("{out}");
     } else {
@@ -86,9 +94,23 @@ fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Fail
         println!("distance  {distance} m");
         println!("time      {time} s");
         println!("ended     {ended}");
+        let list = |v: &[f64]| {
+            v.iter()
+                .map(|x| x.to_string())
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         if !e.measures.is_empty() {
-            let m: Vec<String> = e.measures.iter().map(|x| x.to_string()).collect();
-            println!("measures  {}", m.join(" "));
+            println!("measures  {}", list(&e.measures));
+        }
+        if let Some(j) = e.energy {
+            println!("energy    {j} J");
+        }
+        if let Some(d) = e.target_distance {
+            println!("target    {d} m");
+        }
+        if !e.terms.is_empty() {
+            println!("terms     {}", list(&e.terms));
         }
     }
     Ok(())

@@ -44,6 +44,10 @@ pub trait Env: Send {
     fn observation_names(&self) -> Vec<String>;
     /// What each action drives.
     fn action_names(&self) -> Vec<String>;
+    /// Each observation's (low, high) bounds; sensor levels: (0, 1).
+    fn observation_bounds(&self) -> Vec<(f64, f64)> {
+        vec![(0.0, 1.0); self.observation_size()]
+    }
     /// Simulated seconds per step.
     fn dt(&self) -> f64;
     /// Steps in a whole episode (the time limit).
@@ -122,6 +126,9 @@ impl<E: Env + ?Sized> Env for Box<E> {
     }
     fn action_names(&self) -> Vec<String> {
         (**self).action_names()
+    }
+    fn observation_bounds(&self) -> Vec<(f64, f64)> {
+        (**self).observation_bounds()
     }
     fn dt(&self) -> f64 {
         (**self).dt()

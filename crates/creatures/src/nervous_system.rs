@@ -137,6 +137,9 @@ pub struct NervousSystem {
     pub gates: Vec<Option<Gate>>,
     /// Controllers, in the scene's order.
     pub controllers: Vec<Wired>,
+    /// Added to each level a controller orders, in the order of
+    /// `actuators` (an evaluation's noisy trial); empty: none.
+    pub offsets: Vec<f64>,
     levels: Vec<f64>,
 }
 
@@ -230,6 +233,10 @@ impl NervousSystem {
             }
             c.brain.think(t, dt, &c.in_buf, &mut c.out_buf);
             for (&o, &l) in c.outputs.iter().zip(&c.out_buf) {
+                let l = match self.offsets.get(o) {
+                    Some(d) => l + d,
+                    None => l,
+                };
                 slew(
                     &mut self.actuators[o].1,
                     self.rates.get(o).copied().flatten(),

@@ -83,6 +83,9 @@ fn generation(qd: &mut Qd) {
                 time: 0.0,
                 ended: Ended::Timeout,
                 measures: m.to_vec(),
+                energy: None,
+                target_distance: None,
+                terms: Vec::new(),
             }
         })
         .collect();
@@ -175,6 +178,9 @@ fn shifted_sphere(asked: &[Vec<f64>]) -> Vec<Outcome> {
                 time: 0.0,
                 ended: Ended::Timeout,
                 measures: vec![x[..half].iter().sum(), x[half..].iter().sum()],
+                energy: None,
+                target_distance: None,
+                terms: Vec::new(),
             }
         })
         .collect()

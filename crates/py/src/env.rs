@@ -7,8 +7,8 @@ use crate::{runtime_error, scene_error, value_error};
 use animats_creatures::env::{Env as _, Transition};
 use animats_creatures::vec_env::VecEnv as RustVecEnv;
 use animats_evolve::ProblemSpec;
-use animats_scene::env::SceneEnv;
-use numpy::ndarray::Array2;
+use animats_scene::env::{Observation, SceneEnv};
+use numpy::ndarray::{Array2, Array3};
 use numpy::PyUntypedArrayMethods;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -16,25 +16,48 @@ use std::sync::Mutex;
 
 type Dyn = Box<dyn animats_creatures::env::Env>;
 
-/// How to make one copy: the scene, and the episode's length and step when
-/// they are not the scene's.
+/// How to make one copy: the scene, the episode's length and step when
+/// they are not the scene's, the physics steps per action (or the rate to
+/// act at) and what is observed (`None`: the scene's sensors, or its state
+/// if it has none).
 #[derive(Clone)]
 struct Recipe {
     scene: ProblemSpec,
     seconds: Option<f64>,
     dt: Option<f64>,
+    frame_skip: Option<u32>,
+    act_hz: Option<f64>,
+    observation: Option<Observation>,
 }
 
 impl Recipe {
-    fn new(what: &Bound<'_, PyAny>, seconds: Option<f64>, dt: Option<f64>) -> PyResult<Recipe> {
+    fn new(
+        what: &Bound<'_, PyAny>,
+        seconds: Option<f64>,
+        dt: Option<f64>,
+        frame_skip: Option<u32>,
+        act_hz: Option<f64>,
+        observation: Option<&str>,
+    ) -> PyResult<Recipe> {
+        if let Some(hz) = act_hz {
+            if !(hz > 0.0 && hz.is_finite()) {
+                return Err(value_error(format!("act_hz must be > 0, got {hz}")));
+            }
+        }
         Ok(Recipe {
             scene: problem_spec(what)?,
             seconds,
             dt,
+            frame_skip,
+            act_hz,
+            observation: observation
+                .map(str::parse)
+                .transpose()
+                .map_err(value_error)?,
         })
     }
 
-    fn make(&self, noise: f64) -> PyResult<Dyn> {
+    fn make_scene(&self, noise: f64) -> PyResult<SceneEnv> {
         if !(noise >= 0.0 && noise.is_finite()) {
             return Err(value_error(format!(
                 "noise must be a finite number ≥ 0, got {noise}"
@@ -44,25 +67,49 @@ impl Recipe {
             .map_err(scene_error)?
             .with_timing(self.seconds, self.dt)
             .map_err(value_error)?;
-        Ok(Box::new(env))
+        let skip = match (self.frame_skip, self.act_hz) {
+            (Some(k), _) => k,
+            (None, Some(hz)) => env.frame_skip_for(hz),
+            (None, None) => 1,
+        };
+        let observation = self.observation.unwrap_or(env.observation());
+        env.with_actions(skip, observation).map_err(value_error)
+    }
+
+    fn make(&self, noise: f64) -> PyResult<Dyn> {
+        Ok(Box::new(self.make_scene(noise)?))
     }
 }
 
-fn obs<'py>(py: Python<'py>, e: &Dyn) -> Bound<'py, PyArray1<f64>> {
+/// What the software renderer draws of the scene now, and the camera
+/// `distance` m from the centre of the `[evolve]` particles.
+fn picture(env: &SceneEnv, distance: f64) -> (animats_render::Picture, animats_render::Camera) {
+    let scene = env.scene();
+    let pos = &scene.world.state().pos;
+    let drawing = animats_view::Drawing::of(scene, distance);
+    let bells = drawing.bell_shapes(pos, &[]);
+    let picture = animats_render::picture(&drawing, pos, &bells, &scene.nervous.actuator_levels());
+    let centre = env.watched_centre();
+    let target = animats_engine::DVec3::new(centre.x, centre.y.max(0.0), centre.z);
+    (picture, animats_render::Camera::framing(target, distance))
+}
+
+fn obs<'py>(py: Python<'py>, e: &dyn animats_creatures::env::Env) -> Bound<'py, PyArray1<f64>> {
     let mut o = vec![0.0; e.observation_size()];
     e.observe(&mut o);
     PyArray1::from_vec(py, o)
 }
 
 /// One environment: actions are actuator levels in [0, 1], observations
-/// sensor levels in [0, 1], the reward the increase of the fitness.
+/// sensor levels in [0, 1] (or the body's state), the reward the increase
+/// of the fitness.
 #[pyclass(module = "animats")]
 pub struct Env {
-    env: Mutex<Dyn>,
+    env: Mutex<SceneEnv>,
 }
 
 impl Env {
-    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Dyn>> {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, SceneEnv>> {
         self.env
             .lock()
             .map_err(|_| runtime_error("the environment was poisoned by an earlier failure"))
@@ -75,19 +122,86 @@ impl Env {
     /// adds to every particle's velocity a uniform random vector of up to
     /// this (m/s per component), drawn from the reset's seed. `seconds` and
     /// `dt` change the episode's length (the `[evolve]` duration) and step
-    /// (the scene's; the roobot's: 20 s at 8 ms).
+    /// (the scene's; the roobot's: 20 s at 8 ms). Each action is held for
+    /// `frame_skip` physics steps (or as many as make about `act_hz`
+    /// actions a simulated second; default 1). `observation`: "sensors",
+    /// "state" or "both" (default: the sensors, or the state of a scene
+    /// without any).
     #[new]
-    #[pyo3(signature = (scene, noise = 0.0, seconds = None, dt = None))]
+    #[pyo3(signature = (scene, noise = 0.0, seconds = None, dt = None, frame_skip = None, act_hz = None, observation = None))]
     fn new(
         scene: &Bound<'_, PyAny>,
         noise: f64,
         seconds: Option<f64>,
         dt: Option<f64>,
+        frame_skip: Option<u32>,
+        act_hz: Option<f64>,
+        observation: Option<&str>,
     ) -> PyResult<Env> {
-        let env = Recipe::new(scene, seconds, dt)?.make(noise)?;
+        let env =
+            Recipe::new(scene, seconds, dt, frame_skip, act_hz, observation)?.make_scene(noise)?;
         Ok(Env {
             env: Mutex::new(env),
         })
+    }
+
+    /// Each observation's (low, high).
+    #[getter]
+    fn observation_bounds(&self) -> PyResult<Vec<(f64, f64)>> {
+        Ok(self.lock()?.observation_bounds())
+    }
+
+    /// Physics steps per action.
+    #[getter]
+    fn frame_skip(&self) -> PyResult<u32> {
+        Ok(self.lock()?.frame_skip())
+    }
+
+    /// The centre's distance along the `[evolve]` axis since the reset, m.
+    #[getter]
+    fn distance(&self) -> PyResult<f64> {
+        Ok(self.lock()?.distance())
+    }
+
+    /// The actuators' positive work since the reset, J.
+    #[getter]
+    fn energy(&self) -> PyResult<f64> {
+        Ok(self.lock()?.energy())
+    }
+
+    /// Why the episode ended (`timeout`, `touch NAME`, `stretch A-B`,
+    /// `blow-up`), or None while it goes on.
+    #[getter]
+    fn ended(&self) -> PyResult<Option<String>> {
+        Ok(self.lock()?.ended().map(ToString::to_string))
+    }
+
+    /// The scene now, drawn by the software renderer (`animats render`'s):
+    /// a `(height, width, 3)` uint8 array, the camera following the
+    /// `[evolve]` particles and framing the body as it was at the reset.
+    #[pyo3(signature = (width = 480, height = 320))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        width: u32,
+        height: u32,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        if !(16..=4096).contains(&width) || !(16..=4096).contains(&height) {
+            return Err(value_error(format!(
+                "width and height must be between 16 and 4096 pixels, got {width} × {height}"
+            )));
+        }
+        let (picture, camera) = {
+            let e = self.lock()?;
+            picture(
+                &e,
+                e.framing_distance(50.0, f64::from(width) / f64::from(height)),
+            )
+        };
+        let rgb = py.detach(|| animats_render::render(&picture, &camera, width, height).rgb);
+        let a = Array3::from_shape_vec((height as usize, width as usize, 3), rgb)
+            .map_err(runtime_error)?;
+        Ok(a.into_pyarray(py))
     }
 
     /// Starts a new episode; returns the first observation.
@@ -95,7 +209,7 @@ impl Env {
     fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let mut e = self.lock()?;
         e.reset(seed).map_err(runtime_error)?;
-        Ok(obs(py, &e))
+        Ok(obs(py, &*e))
     }
 
     /// The observation now.
@@ -113,7 +227,7 @@ impl Env {
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, f64, bool, bool)> {
         let mut e = self.lock()?;
         let t = e.step(&crate::elements(&action)).map_err(value_error)?;
-        Ok((obs(py, &e), t.reward, t.terminated, t.truncated))
+        Ok((obs(py, &*e), t.reward, t.terminated, t.truncated))
     }
 
     /// What each observation is.
@@ -195,9 +309,10 @@ fn observations<'py>(py: Python<'py>, v: &RustVecEnv<Dyn>) -> PyResult<Bound<'py
 #[pymethods]
 impl VecEnv {
     /// `n` copies of `scene` (an `animats.Scene`, a path or "roobot"),
-    /// copy `k` reset with seed `seed + k`.
+    /// copy `k` reset with seed `seed + k`; the rest as `Env`'s.
     #[new]
-    #[pyo3(signature = (scene, n, seed = 0, noise = 0.0, seconds = None, dt = None))]
+    #[pyo3(signature = (scene, n, seed = 0, noise = 0.0, seconds = None, dt = None, frame_skip = None, act_hz = None, observation = None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         scene: &Bound<'_, PyAny>,
@@ -206,6 +321,9 @@ impl VecEnv {
         noise: f64,
         seconds: Option<f64>,
         dt: Option<f64>,
+        frame_skip: Option<u32>,
+        act_hz: Option<f64>,
+        observation: Option<&str>,
     ) -> PyResult<VecEnv> {
         if n == 0 || n > 1 << 20 {
             return Err(value_error(format!(
@@ -213,7 +331,7 @@ impl VecEnv {
                 1 << 20
             )));
         }
-        let recipe = Recipe::new(scene, seconds, dt)?;
+        let recipe = Recipe::new(scene, seconds, dt, frame_skip, act_hz, observation)?;
         recipe.make(noise)?;
         let v = py
             .detach(|| RustVecEnv::new(n, seed, |_| recipe.make(noise).map_err(|e| e.to_string())))
@@ -289,6 +407,12 @@ impl VecEnv {
     #[getter]
     fn action_names(&self) -> PyResult<Vec<String>> {
         Ok(self.lock()?.first().action_names())
+    }
+
+    /// Each observation's (low, high).
+    #[getter]
+    fn observation_bounds(&self) -> PyResult<Vec<(f64, f64)>> {
+        Ok(self.lock()?.first().observation_bounds())
     }
 
     /// Simulated seconds per step.

@@ -164,15 +164,13 @@ pub fn evaluate_scenes<'py>(
 /// One scene text scored as `animats evaluate` scores its file.
 fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
     let scene = animats_scene::parse(text, file).map_err(|e| e.to_string())?;
-    match &scene.evolve {
-        None => Err(format!(
+    if scene.evolve.is_none() {
+        return Err(format!(
             "{file}: the scene has no [evolve] table: nothing to evaluate"
-        )),
-        Some(spec) if spec.robust => animats_scene::evaluate::evaluate_robust(|| {
-            animats_scene::parse(text, file).map_err(|e| e.to_string())
-        }),
-        Some(_) => animats_scene::evaluate::evaluate(scene),
+        ));
     }
+    // Robust, trials: as evolution scores it.
+    animats_scene::evaluate::score(|| animats_scene::parse(text, file).map_err(|e| e.to_string()))
 }
 
 /// Fitness of each row of a `(P, D)` float64 array of genomes under a
@@ -320,6 +318,20 @@ pub(crate) fn outcome_dict<'py>(py: Python<'py>, o: &[Outcome]) -> PyResult<Boun
             .map(|x| PyArray1::from_vec(py, x.measures.clone()))
             .collect();
         d.set_item("measures", list)?;
+    }
+    // Scenes whose fitness counts energy or a target: those figures (NaN
+    // where a scene has none).
+    for (key, get) in [
+        (
+            "energy",
+            (|o: &Outcome| o.energy) as fn(&Outcome) -> Option<f64>,
+        ),
+        ("target_distance", |o: &Outcome| o.target_distance),
+    ] {
+        if o.iter().any(|x| get(x).is_some()) {
+            let v = o.iter().map(|x| get(x).unwrap_or(f64::NAN)).collect();
+            d.set_item(key, PyArray1::from_vec(py, v))?;
+        }
     }
     Ok(d)
 }

@@ -303,6 +303,9 @@ impl Evolution {
                     distance: distance[i],
                     ended: ended[i].parse().map_err(value_error)?,
                     measures: measures.get(i).cloned().unwrap_or_default(),
+                    energy: None,
+                    target_distance: None,
+                    terms: Vec::new(),
                 })
             })
             .collect::<PyResult<_>>()?;

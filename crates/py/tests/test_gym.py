@@ -25,9 +25,65 @@ def test_scene_passes_gymnasiums_checker(pogo_env):
     assert env.observation_space.shape == (2,)
 
 
-def test_a_scene_without_sensors_is_refused(root):
-    with pytest.raises(animats.SceneError, match="sensor"):
-        gymnasium.make("animats/Scene-v0", scene=str(root / "scenes" / "walker.toml"))
+def test_a_scene_without_sensors_observes_its_state(root):
+    walker = str(root / "scenes" / "walker.toml")
+    env = gymnasium.make("animats/Scene-v0", scene=walker)
+    assert env.unwrapped.observation_names[0] == "centre y"
+    with pytest.raises(ValueError, match="sensor"):
+        gymnasium.make("animats/Scene-v0", scene=walker, observation="sensors")
+
+
+@pytest.mark.parametrize("observation", ["sensors", "state", "both"])
+@pytest.mark.parametrize("frame_skip", [1, 7, None])
+@pytest.mark.parametrize("render_mode", [None, "rgb_array"])
+def test_every_combination_passes_gymnasiums_checker(pogo_env, observation, frame_skip, render_mode):
+    env = gymnasium.make(
+        "animats/Scene-v0", scene=str(pogo_env), observation=observation,
+        frame_skip=frame_skip, render_mode=render_mode,
+    )
+    check_env(env.unwrapped, skip_render_check=render_mode is None)
+    inner = env.unwrapped
+    n = len(inner.observation_names)
+    if observation == "sensors":
+        assert n == 2
+    else:
+        assert inner.observation_names[n - 1].startswith("contact ")
+    # Without frame_skip the agent acts at about 50 Hz.
+    physics = inner._env.dt / inner.frame_skip
+    if frame_skip is None:
+        assert abs(inner.dt - 0.02) <= physics / 2 + 1e-12
+    else:
+        assert inner.frame_skip == frame_skip
+
+
+def test_info_carries_distance_energy_and_why_it_ended(pogo_env):
+    env = gymnasium.make("animats/Scene-v0", scene=str(pogo_env))
+    _, info = env.reset(seed=0)
+    assert info["ended"] is None and info["energy"] == 0.0 and info["distance"] == 0.0
+    energy = 0.0
+    while True:
+        k = round(info["time"] / env.unwrapped.dt)
+        _, _, term, trunc, info = env.step(np.array([0.9 if k % 20 < 5 else 0.3]))
+        assert info["energy"] >= energy  # positive work only adds up
+        energy = info["energy"]
+        if term or trunc:
+            break
+    assert info["ended"] == "timeout" and energy > 0.0 and info["distance"] != 0.0
+
+
+def test_rgb_array_renders_the_scene_as_animats_render_does(pogo_env):
+    env = gymnasium.make("animats/Scene-v0", scene=str(pogo_env), render_mode="rgb_array")
+    env.reset(seed=0)
+    first = env.render()
+    assert first.shape == (320, 480, 3) and first.dtype == np.uint8
+    assert first.std() > 10, "not a blank picture"
+    for k in range(25):
+        env.step(np.array([0.9 if k % 10 < 3 else 0.3]))
+    later = env.render()
+    assert np.any(first != later), "the picture follows the scene"
+    plain = gymnasium.make("animats/Scene-v0", scene=str(pogo_env))
+    plain.reset(seed=0)
+    assert plain.render() is None
 
 
 def _episode(env, policy, seed):
@@ -67,6 +123,7 @@ def test_rewards_add_up_to_the_evolve_fitness(pogo_env):
         if term or trunc:
             break
     assert trunc and not term and steps == env.unwrapped.max_steps == round(5.0 / env.unwrapped.dt)
+    assert env.unwrapped.frame_skip > 1, "Scene-v0 acts at about 50 Hz, not every physics step"
     want = 1.0 * steps * env.unwrapped.dt + 50.0 * (centre() - y0)
     assert total == pytest.approx(want, abs=1e-9)
     assert abs(centre() - y0) > 1e-3, "the pogo moved"

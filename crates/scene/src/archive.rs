@@ -15,8 +15,10 @@
 //! | `mean_height` | centre-of-mass height of `particles`, averaged over the steps, m |
 //! | `speed` | `displacement` / time survived, m/s |
 //! | `particles`, `muscles`, `mass`, `size` | the body as built: its particles, its actuators, its moving mass (kg), its largest extent (m) |
+//! | `energy` | the actuators' positive work, J ([`crate::work`]) |
 //!
-//! `particles` and `axis` default to `[evolve]`'s.
+//! `particles` and `axis` default to `[evolve]`'s. The same measures, each
+//! with a `weight`, are `[evolve] terms` of the fitness ([`TermEntry`]).
 
 use crate::build::{At, Names};
 use crate::def::Typed;
@@ -118,7 +120,37 @@ pub enum MeasureEntry {
     Mass {},
     /// Largest extent of the body as built, m.
     Size {},
+    /// The actuators' positive work, J.
+    Energy {},
 }
+
+/// `[evolve] terms = [{ kind = "...", weight = w, ... }]`: a measure (as
+/// the archive's) and its weight in the fitness; read as a table, so that
+/// its errors are reported at its own entry.
+#[derive(Clone, Debug)]
+pub struct TermEntry(pub Result<(f64, MeasureEntry), String>);
+
+impl<'de> Deserialize<'de> for TermEntry {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut table = toml::Table::deserialize(d)?;
+        let weight = match table.remove("weight") {
+            None => Err("missing field `weight`".to_string()),
+            Some(toml::Value::Float(w)) => Ok(w),
+            Some(toml::Value::Integer(w)) => Ok(w as f64),
+            Some(other) => Err(format!("`weight` must be a number, got {other}")),
+        };
+        Ok(TermEntry(weight.and_then(|w| {
+            toml::Value::Table(table)
+                .try_into::<MeasureEntry>()
+                .map(|m| (w, m))
+                .map_err(|e| e.message().trim().to_string())
+        })))
+    }
+}
+
+/// Every measure kind, for messages.
+pub(crate) const KINDS: &str =
+    "contact_fraction, feet, displacement, mean_height, speed, particles, muscles, mass, size, energy";
 
 /// One measure, resolved against the scene.
 #[derive(Clone, Debug, PartialEq)]
@@ -141,6 +173,15 @@ pub enum Measure {
     Mass,
     /// See [`MeasureEntry::Size`].
     Size,
+    /// See [`MeasureEntry::Energy`].
+    Energy,
+}
+
+impl Measure {
+    /// Whether it needs the actuators' work summed.
+    pub fn needs_work(&self) -> bool {
+        matches!(self, Measure::Energy)
+    }
 }
 
 /// The archive's grid and the search's settings: what an optimiser needs,
@@ -226,9 +267,7 @@ impl ArchiveEntry {
             let m = m.get().map_err(|(field, msg)| {
                 at.err(
                     &format!("measures[{i}]{}", dotted(field)),
-                    format!(
-                        "{msg} (kinds: contact_fraction, feet, displacement, mean_height, speed, particles, muscles, mass, size)"
-                    ),
+                    format!("{msg} (kinds: {KINDS})"),
                 )
             })?;
             names.push(m.name());
@@ -338,54 +377,73 @@ impl ArchiveEntry {
         })?;
         let mut measures = Vec::with_capacity(grid.names.len());
         for (i, m) in self.measures.iter().enumerate() {
-            let field = format!("measures[{i}]");
             let Ok(m) = m.get() else { continue };
-            let list = |p: &Option<Vec<String>>| -> Result<Vec<ParticleId>, SceneError> {
-                match p {
-                    None => Ok(evolve.particles.clone()),
-                    Some(l) if l.is_empty() => Err(at.err(
-                        &format!("{field}.particles"),
-                        "name at least one particle (or leave it out: [evolve]'s)",
-                    )),
-                    Some(l) => l
-                        .iter()
-                        .map(|n| names.one(at, &format!("{field}.particles"), n))
-                        .collect(),
-                }
-            };
-            let axis = |a: &Option<[f64; 3]>| -> Result<DVec3, SceneError> {
-                match a {
-                    None => Ok(evolve.axis),
-                    Some(a) => {
-                        let v = at.vec3(&format!("{field}.axis"), *a)?;
-                        if v.length() == 0.0 {
-                            return Err(at.err(&format!("{field}.axis"), "must not be zero"));
-                        }
-                        Ok(v.normalize())
-                    }
-                }
-            };
-            measures.push(match m {
-                MeasureEntry::ContactFraction { particle } => Measure::ContactFraction(names.one(
-                    at,
-                    &format!("{field}.particle"),
-                    particle,
-                )?),
-                MeasureEntry::Feet {} => Measure::Feet,
-                MeasureEntry::Displacement { particles, axis: a } => {
-                    Measure::Displacement(list(particles)?, axis(a)?)
-                }
-                MeasureEntry::MeanHeight { particles } => Measure::MeanHeight(list(particles)?),
-                MeasureEntry::Speed { particles, axis: a } => {
-                    Measure::Speed(list(particles)?, axis(a)?)
-                }
-                MeasureEntry::Particles {} => Measure::Particles,
-                MeasureEntry::Muscles {} => Measure::Muscles,
-                MeasureEntry::Mass {} => Measure::Mass,
-                MeasureEntry::Size {} => Measure::Size,
-            });
+            measures.push(m.resolve(
+                at,
+                &format!("measures[{i}]"),
+                names,
+                &evolve.particles,
+                evolve.axis,
+            )?);
         }
         Ok(ArchiveSpec { grid, measures })
+    }
+}
+
+impl MeasureEntry {
+    /// The measure, resolved against the scene (`field`: where it was
+    /// written; `particles` and `axis`: `[evolve]`'s, the defaults).
+    pub(crate) fn resolve(
+        &self,
+        at: &At,
+        field: &str,
+        names: &Names,
+        particles: &[ParticleId],
+        axis: DVec3,
+    ) -> Result<Measure, SceneError> {
+        let list = |p: &Option<Vec<String>>| -> Result<Vec<ParticleId>, SceneError> {
+            match p {
+                None => Ok(particles.to_vec()),
+                Some(l) if l.is_empty() => Err(at.err(
+                    &format!("{field}.particles"),
+                    "name at least one particle (or leave it out: [evolve]'s)",
+                )),
+                Some(l) => l
+                    .iter()
+                    .map(|n| names.one(at, &format!("{field}.particles"), n))
+                    .collect(),
+            }
+        };
+        let direction = |a: &Option<[f64; 3]>| -> Result<DVec3, SceneError> {
+            match a {
+                None => Ok(axis),
+                Some(a) => {
+                    let v = at.vec3(&format!("{field}.axis"), *a)?;
+                    if v.length() == 0.0 {
+                        return Err(at.err(&format!("{field}.axis"), "must not be zero"));
+                    }
+                    Ok(v.normalize())
+                }
+            }
+        };
+        Ok(match self {
+            MeasureEntry::ContactFraction { particle } => {
+                Measure::ContactFraction(names.one(at, &format!("{field}.particle"), particle)?)
+            }
+            MeasureEntry::Feet {} => Measure::Feet,
+            MeasureEntry::Displacement { particles, axis: a } => {
+                Measure::Displacement(list(particles)?, direction(a)?)
+            }
+            MeasureEntry::MeanHeight { particles } => Measure::MeanHeight(list(particles)?),
+            MeasureEntry::Speed { particles, axis: a } => {
+                Measure::Speed(list(particles)?, direction(a)?)
+            }
+            MeasureEntry::Particles {} => Measure::Particles,
+            MeasureEntry::Muscles {} => Measure::Muscles,
+            MeasureEntry::Mass {} => Measure::Mass,
+            MeasureEntry::Size {} => Measure::Size,
+            MeasureEntry::Energy {} => Measure::Energy,
+        })
     }
 }
 
@@ -410,6 +468,7 @@ impl MeasureEntry {
             MeasureEntry::Muscles {} => "muscles".into(),
             MeasureEntry::Mass {} => "mass".into(),
             MeasureEntry::Size {} => "size".into(),
+            MeasureEntry::Energy {} => "energy".into(),
         }
     }
 }
@@ -427,13 +486,17 @@ pub struct Recorder<'a> {
 }
 
 impl<'a> Recorder<'a> {
-    /// Starts recording `spec`'s measures of `world` (before its first
-    /// step); `muscles` is the scene's actuator count.
-    pub fn new(spec: &'a ArchiveSpec, evolve: &EvolveSpec, world: &World, muscles: usize) -> Self {
+    /// Starts recording `measures` of `world` (before its first step);
+    /// `muscles` is the scene's actuator count.
+    pub fn new(
+        measures: &'a [Measure],
+        evolve: &EvolveSpec,
+        world: &World,
+        muscles: usize,
+    ) -> Self {
         let p = world.particles();
         let moving: Vec<usize> = (0..world.len()).filter(|&i| p.inv_mass[i] > 0.0).collect();
-        let fixed = spec
-            .measures
+        let fixed = measures
             .iter()
             .map(|m| match m {
                 Measure::Particles => moving.len() as f64,
@@ -458,8 +521,7 @@ impl<'a> Recorder<'a> {
                 _ => 0.0,
             })
             .collect();
-        let starts = spec
-            .measures
+        let starts = measures
             .iter()
             .map(|m| match m {
                 Measure::Displacement(ids, _) | Measure::Speed(ids, _) => centre(world, ids),
@@ -467,9 +529,9 @@ impl<'a> Recorder<'a> {
             })
             .collect();
         Recorder {
-            measures: &spec.measures,
+            measures,
             tolerance: evolve.touch_tolerance,
-            sums: vec![0.0; spec.measures.len()],
+            sums: vec![0.0; measures.len()],
             starts,
             fixed,
             steps: 0,
@@ -496,8 +558,9 @@ impl<'a> Recorder<'a> {
         }
     }
 
-    /// The measures, given the world at the end and the time survived, s.
-    pub fn finish(&self, world: &World, time: f64) -> Vec<f64> {
+    /// The measures, given the world at the end, the time survived (s) and
+    /// the actuators' positive work (J; read by `energy` alone).
+    pub fn finish(&self, world: &World, time: f64, work: f64) -> Vec<f64> {
         let per_step = |s: f64| {
             if self.steps == 0 {
                 0.0
@@ -525,6 +588,7 @@ impl<'a> Recorder<'a> {
                 Measure::Particles | Measure::Muscles | Measure::Mass | Measure::Size => {
                     self.fixed[i]
                 }
+                Measure::Energy => work,
             })
             .collect()
     }

@@ -315,6 +315,7 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         nervous,
         evolve,
         archive,
+        seed: table.seed,
     })
 }
 

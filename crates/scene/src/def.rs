@@ -287,7 +287,9 @@ pub struct GateEntry {
 
 /// `[evolve]`: what `animats evolve SCENE` tunes and how an evaluation
 /// (`animats evaluate SCENE`) is scored:
-/// `fitness = time_weight × time survived + distance_weight × distance`.
+/// `fitness = time_weight × time survived + distance_weight × distance
+/// − energy_weight × work − target_weight × distance to target + Σ weight ×
+/// term`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct EvolveEntry {
@@ -339,6 +341,39 @@ pub struct EvolveEntry {
     /// `cma-es`, ...); default `cma-es` (`body-ga` in a `[morphology]`
     /// scene).
     pub optimiser: Option<String>,
+    /// Per joule of the actuators' positive work, subtracted; default 0.
+    #[serde(default)]
+    pub energy_weight: f64,
+    /// Where the centre of `particles` should end up, m; default none.
+    pub target: Option<[f64; 3]>,
+    /// Per metre of the final distance to `target`, subtracted; default 1.
+    pub target_weight: Option<f64>,
+    /// Evaluations per genome, each from a start perturbed by `noise`;
+    /// default 1.
+    pub trials: Option<u32>,
+    /// How much each trial is perturbed: every free particle's start moves
+    /// by up to `noise` × its radius along each axis, every actuator's
+    /// level by up to ±`noise`; default 0.
+    #[serde(default)]
+    pub noise: f64,
+    /// What counts of the trials: `mean` or `worst`; default `mean`.
+    #[serde(default)]
+    pub aggregate: AggregateName,
+    /// Measures (the archive's kinds, `{ kind = "...", weight = w }`)
+    /// added to the fitness, each times its weight.
+    #[serde(default)]
+    pub terms: Vec<crate::archive::TermEntry>,
+}
+
+/// `[evolve] aggregate`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum AggregateName {
+    /// The mean of the trials' fitness (and of every other figure).
+    #[default]
+    Mean,
+    /// The trial with the lowest fitness.
+    Worst,
 }
 
 /// `fail_on_stretch = [{ a = "...", b = "...", length = 1.0 }]`.

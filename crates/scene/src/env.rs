@@ -1,19 +1,51 @@
 //! A scene as an environment ([`animats_creatures::env::Env`]): any scene
-//! with actuators, sensors and an `[evolve]` table, with a program as its
-//! brain. Actions: every actuator's level, in the scene's order (each moves
-//! at most its `rate` allows; no controller runs). Observations: every
-//! sensor's level. Reward: the increase over the step of the `[evolve]`
-//! fitness (`time_weight × time + distance_weight × distance`); the episode
-//! ends as the evaluation does (a `fail_on_touch` particle touching the
-//! floor or a blow-up: terminated; `duration`: truncated), so an episode's
-//! rewards add up to the fitness [`crate::evaluate::evaluate`] gives the same
-//! run.
+//! with actuators and an `[evolve]` table, with a program as its brain.
+//! Actions: every actuator's level, in the scene's order (each moves at
+//! most its `rate` allows; no controller runs), held for `frame_skip`
+//! physics steps. Observations ([`Observation`]): every sensor's level, the
+//! body's state, or both. Reward: the increase over the action's steps of
+//! the `[evolve]` fitness (`time_weight × time + distance_weight × distance
+//! − energy_weight × work − target_weight × distance to target`; its
+//! `terms` and `trials` are not part of it); the episode ends as the
+//! evaluation does (a `fail_on_touch` particle touching the floor or a
+//! blow-up: terminated; `duration`: truncated), so an episode's rewards add
+//! up to the fitness [`crate::evaluate::evaluate`] gives the same run.
 
 use crate::error::SceneError;
-use crate::evaluate::{EvolveSpec, SceneProblem};
+use crate::evaluate::{Ended, EvolveSpec, SceneProblem};
+use crate::work::Work;
 use crate::Scene;
 use animats_creatures::env::{check_action, perturb, Env, Transition};
-use animats_engine::DVec3;
+use animats_creatures::sensors::probe::touches_floor;
+use animats_engine::{DVec3, ParticleId};
+
+/// What an environment observes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Observation {
+    /// Every sensor's level, in [0, 1].
+    #[default]
+    Sensors,
+    /// The body's state: the centre of mass's height and velocity, every
+    /// moving particle's position and velocity relative to it, every
+    /// spring's length and whether each moving particle touches the floor.
+    State,
+    /// The sensors, then the state.
+    Both,
+}
+
+impl std::str::FromStr for Observation {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Observation, String> {
+        match s {
+            "sensors" => Ok(Observation::Sensors),
+            "state" => Ok(Observation::State),
+            "both" => Ok(Observation::Both),
+            _ => Err(format!(
+                "observation must be \"sensors\", \"state\" or \"both\", got {s:?}"
+            )),
+        }
+    }
+}
 
 /// A scene stepped by a program.
 pub struct SceneEnv {
@@ -30,6 +62,20 @@ pub struct SceneEnv {
     over: bool,
     /// The step, when it is not the scene's.
     dt: Option<f64>,
+    /// Physics steps per action.
+    frame_skip: u32,
+    /// What is observed.
+    observation: Observation,
+    /// The moving particles (the state's).
+    moving: Vec<ParticleId>,
+    /// The actuators' positive work since the reset.
+    work: Work,
+    /// Physics steps since the reset.
+    physics_steps: u64,
+    /// Why the episode ended, once it has.
+    ended: Option<Ended>,
+    /// The moving particles' bounding box at the reset (spheres included).
+    extent: (DVec3, DVec3),
 }
 
 impl SceneEnv {
@@ -48,12 +94,6 @@ impl SceneEnv {
                 "the scene has no [[actuator]]: an environment's actions are actuator levels",
             ));
         }
-        if scene.nervous.sensors.is_empty() {
-            return Err(SceneError::file(
-                file,
-                "the scene has no [[sensor]]: an environment's observations are sensor levels",
-            ));
-        }
         let actions = scene
             .nervous
             .actuators
@@ -65,6 +105,12 @@ impl SceneEnv {
             .sensors
             .iter()
             .map(|(n, _)| n.clone())
+            .collect();
+        let inv = &scene.world.particles().inv_mass;
+        let moving = scene
+            .world
+            .particle_ids()
+            .filter(|p| inv[p.index()] > 0.0)
             .collect();
         let mut env = SceneEnv {
             problem,
@@ -79,7 +125,19 @@ impl SceneEnv {
             fitness: 0.0,
             over: false,
             dt: None,
+            frame_skip: 1,
+            observation: Observation::Sensors,
+            moving,
+            work: Work::default(),
+            physics_steps: 0,
+            ended: None,
+            extent: (DVec3::ZERO, DVec3::ZERO),
         };
+        // A scene without sensors observes its state.
+        if env.scene.nervous.sensors.is_empty() {
+            env.observation = Observation::State;
+            env.observations = env.names();
+        }
         env.reset(0).map_err(|e| SceneError::file(file, e))?;
         Ok(env)
     }
@@ -115,6 +173,144 @@ impl SceneEnv {
         Ok(self)
     }
 
+    /// Each action held for `frame_skip` physics steps (≥ 1), and what
+    /// is observed. A scene without sensors can only observe its state.
+    pub fn with_actions(
+        mut self,
+        frame_skip: u32,
+        observation: Observation,
+    ) -> Result<SceneEnv, String> {
+        if frame_skip == 0 {
+            return Err("frame_skip must be at least 1".into());
+        }
+        if observation != Observation::State && self.scene.nervous.sensors.is_empty() {
+            return Err(
+                "the scene has no [[sensor]]: observe its state (observation = \"state\"), or give it sensors".into(),
+            );
+        }
+        self.frame_skip = frame_skip;
+        self.observation = observation;
+        self.observations = self.names();
+        self.reset(0)?;
+        Ok(self)
+    }
+
+    /// The physics steps per action that make the agent act at about
+    /// `hz` times a simulated second with the scene's step.
+    pub fn frame_skip_for(&self, hz: f64) -> u32 {
+        let dt = self.dt.unwrap_or(self.scene.dt);
+        ((1.0 / hz / dt).round() as u32).max(1)
+    }
+
+    /// The names of the observations, in order.
+    fn names(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.observation != Observation::State {
+            out.extend(self.scene.nervous.sensors.iter().map(|(n, _)| n.clone()));
+        }
+        if self.observation != Observation::Sensors {
+            let name = |p: &ParticleId| self.scene.name(*p).to_string();
+            out.push("centre y".into());
+            out.extend(["centre vx", "centre vy", "centre vz"].map(String::from));
+            for axis in ["x", "y", "z"] {
+                out.extend(self.moving.iter().map(|p| format!("{axis} {}", name(p))));
+            }
+            for axis in ["vx", "vy", "vz"] {
+                out.extend(self.moving.iter().map(|p| format!("{axis} {}", name(p))));
+            }
+            for (k, s) in self.scene.world.forces().springs.iter().enumerate() {
+                let (a, b) = s.ends();
+                out.push(format!("length {k} {}-{}", name(&a), name(&b)));
+            }
+            out.extend(self.moving.iter().map(|p| format!("contact {}", name(p))));
+        }
+        out
+    }
+
+    /// The state's values, appended to `out` in the order of [`Self::names`].
+    fn state(&self, out: &mut Vec<f64>) {
+        let w = &self.scene.world;
+        let (pos, vel, mass) = (&w.state().pos, &w.state().vel, &w.particles().mass);
+        let (mut c, mut v, mut m) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+        for p in &self.moving {
+            let i = p.index();
+            c += pos[i] * mass[i];
+            v += vel[i] * mass[i];
+            m += mass[i];
+        }
+        if m > 0.0 {
+            (c, v) = (c / m, v / m);
+        }
+        out.push(c.y);
+        out.extend([v.x, v.y, v.z]);
+        for k in 0..3 {
+            out.extend(self.moving.iter().map(|p| pos[p.index()][k] - c[k]));
+        }
+        for k in 0..3 {
+            out.extend(self.moving.iter().map(|p| vel[p.index()][k] - v[k]));
+        }
+        for s in w.forces().springs.iter() {
+            let (a, b) = s.ends();
+            out.push((pos[a.index()] - pos[b.index()]).length());
+        }
+        let floor = w.terrain().is_some();
+        out.extend(
+            self.moving
+                .iter()
+                .map(|p| f64::from(u8::from(floor && touches_floor(w, *p)))),
+        );
+    }
+
+    /// What it observes.
+    pub fn observation(&self) -> Observation {
+        self.observation
+    }
+
+    /// Physics steps per action.
+    pub fn frame_skip(&self) -> u32 {
+        self.frame_skip
+    }
+
+    /// The centre of the `[evolve]` particles now.
+    pub fn watched_centre(&self) -> DVec3 {
+        self.spec.centre(&self.scene.world)
+    }
+
+    /// How far a camera with a vertical field of view of `fov` degrees on
+    /// a picture `aspect` wide per unit high stands so that the body's
+    /// extent at the reset fills 40 % of the width (or 60 % of the height),
+    /// as `animats render` frames a creature; at least 0.3 m.
+    pub fn framing_distance(&self, fov: f64, aspect: f64) -> f64 {
+        let (lo, hi) = (self.extent.0, self.extent.1);
+        let extent = hi - lo;
+        let across = DVec3::new(extent.x, 0.0, extent.z).length().max(0.05);
+        let tall = extent.y.max(0.05);
+        let tan = (0.5 * fov.to_radians()).tan();
+        (across / (0.4 * 2.0 * tan * aspect))
+            .max(tall / (0.6 * 2.0 * tan))
+            .max(0.3)
+    }
+
+    /// Whether the episode's physics steps are all taken.
+    pub fn physics_done(&self) -> bool {
+        self.physics_steps >= self.physics_limit() || self.over
+    }
+
+    /// The distance the centre has gone along the axis since the reset, m.
+    pub fn distance(&self) -> f64 {
+        (self.last - self.start).dot(self.spec.axis)
+    }
+
+    /// The actuators' positive work since the reset, J.
+    pub fn energy(&self) -> f64 {
+        self.work.positive
+    }
+
+    /// Why the episode ended, once it has.
+    pub fn ended(&self) -> Option<&Ended> {
+        self.ended.as_ref()
+    }
+
     /// Reads and parses a scene file.
     pub fn load(path: &std::path::Path, noise: f64) -> Result<SceneEnv, SceneError> {
         let file = path.display().to_string();
@@ -138,8 +334,22 @@ impl SceneEnv {
         if blew_up {
             distance = distance.min(0.0);
         }
-        self.spec.time_weight * self.steps as f64 * self.scene.dt
-            + self.spec.distance_weight * distance
+        let mut fitness = self.spec.time_weight * self.physics_steps as f64 * self.scene.dt
+            + self.spec.distance_weight * distance;
+        if self.spec.energy_weight != 0.0 {
+            fitness -= self.spec.energy_weight * self.work.positive;
+        }
+        if let Some((t, w)) = self.spec.target {
+            fitness -= w * (self.last - t).length();
+        }
+        fitness
+    }
+}
+
+impl SceneEnv {
+    /// Physics steps in a whole episode.
+    fn physics_limit(&self) -> u64 {
+        (self.spec.duration / self.scene.dt).round() as u64
     }
 }
 
@@ -156,11 +366,27 @@ impl Env for SceneEnv {
     fn action_names(&self) -> Vec<String> {
         self.actions.clone()
     }
+    fn observation_bounds(&self) -> Vec<(f64, f64)> {
+        let sensors = match self.observation {
+            Observation::State => 0,
+            _ => self.scene.nervous.sensors.len(),
+        };
+        let mut b = vec![(0.0, 1.0); sensors];
+        b.resize(self.observations.len(), (f64::NEG_INFINITY, f64::INFINITY));
+        if self.observation != Observation::Sensors {
+            // Contacts: 0 or 1.
+            let n = self.observations.len();
+            for x in &mut b[n - self.moving.len()..] {
+                *x = (0.0, 1.0);
+            }
+        }
+        b
+    }
     fn dt(&self) -> f64 {
-        self.scene.dt
+        self.scene.dt * f64::from(self.frame_skip)
     }
     fn max_steps(&self) -> u64 {
-        (self.spec.duration / self.scene.dt).round() as u64
+        self.physics_limit().div_ceil(u64::from(self.frame_skip))
     }
 
     fn reset(&mut self, seed: u64) -> Result<(), String> {
@@ -171,16 +397,44 @@ impl Env for SceneEnv {
         perturb(&mut scene.world, seed, self.noise)?;
         self.start = self.spec.centre(&scene.world);
         self.last = self.start;
-        self.over = self.spec.ending(&scene.world).is_some();
+        self.ended = self.spec.ending(&scene.world);
+        self.over = self.ended.is_some();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        let radius = &scene.world.particles().radius;
+        for p in &self.moving {
+            let (x, r) = (scene.world.position(*p), radius[p.index()]);
+            lo = lo.min(x - DVec3::splat(r));
+            hi = hi.max(x + DVec3::splat(r));
+        }
+        self.extent = if lo.is_finite() {
+            (lo, hi)
+        } else {
+            (DVec3::ZERO, DVec3::ZERO)
+        };
         self.scene = scene;
         self.steps = 0;
+        self.physics_steps = 0;
+        self.work = Work::default();
         self.fitness = 0.0;
         Ok(())
     }
 
     fn observe(&self, out: &mut [f64]) {
-        for (o, (_, s)) in out.iter_mut().zip(&self.scene.nervous.sensors) {
-            *o = s.level(&self.scene.world);
+        let mut v = Vec::with_capacity(out.len());
+        if self.observation != Observation::State {
+            v.extend(
+                self.scene
+                    .nervous
+                    .sensors
+                    .iter()
+                    .map(|(_, s)| s.level(&self.scene.world)),
+            );
+        }
+        if self.observation != Observation::Sensors {
+            self.state(&mut v);
+        }
+        for (o, x) in out.iter_mut().zip(v) {
+            *o = x;
         }
     }
 
@@ -190,21 +444,45 @@ impl Env for SceneEnv {
             return Err("the episode has ended: call reset".into());
         }
         let dt = self.scene.dt;
-        let mut blew_up = self.scene.step_driven(action, dt).is_err();
-        if !blew_up {
-            self.steps += 1;
-            let c = self.spec.centre(&self.scene.world);
-            if c.is_finite() {
-                self.last = c;
-            } else {
+        let limit = self.physics_limit();
+        let mut blew_up = false;
+        let mut ending = None;
+        for _ in 0..self.frame_skip {
+            self.work.before(&self.scene);
+            if self.scene.step_driven(action, dt).is_err() {
                 blew_up = true;
+                break;
+            }
+            self.work.after(&self.scene, dt);
+            self.physics_steps += 1;
+            let c = self.spec.centre(&self.scene.world);
+            if !c.is_finite() {
+                blew_up = true;
+                break;
+            }
+            self.last = c;
+            ending = self.spec.ending(&self.scene.world);
+            if ending.is_some() || self.physics_steps >= limit {
+                break;
             }
         }
+        self.steps += 1;
         let fitness = self.score(blew_up);
         let reward = fitness - self.fitness;
         self.fitness = fitness;
-        let terminated = blew_up || self.spec.ending(&self.scene.world).is_some();
-        let t = Transition::after(reward, terminated, self.steps, self.max_steps());
+        if blew_up {
+            ending = Some(Ended::BlowUp);
+        }
+        let terminated = ending.is_some();
+        let t = Transition {
+            reward,
+            terminated,
+            truncated: !terminated && self.physics_steps >= limit,
+        };
+        if t.truncated {
+            ending = Some(Ended::Timeout);
+        }
+        self.ended = ending;
         self.over = t.ends();
         Ok(t)
     }

@@ -15,7 +15,7 @@
 //! [`animats_creatures::brain::GenomeKey`]s say.
 
 use crate::build::{At, Names};
-use crate::def::{EvolveEntry, LogName, MutationName, SceneDef};
+use crate::def::{AggregateName, EvolveEntry, LogName, MutationName, SceneDef};
 use crate::error::SceneError;
 use crate::source::Source;
 use crate::Scene;
@@ -69,7 +69,32 @@ pub struct EvolveSpec {
     /// The optimiser to use unless told, by its command-line name
     /// (checked by whoever runs the evolution).
     pub optimiser: Option<String>,
+    /// Per joule of the actuators' positive work ([`crate::work`]),
+    /// subtracted from the fitness.
+    pub energy_weight: f64,
+    /// Where the centre of `particles` should end up, and the weight per
+    /// metre it ends from there, subtracted.
+    pub target: Option<(DVec3, f64)>,
+    /// Evaluations per genome.
+    pub trials: u32,
+    /// How much each trial's start and actuators are perturbed.
+    pub noise: f64,
+    /// What counts of the trials.
+    pub aggregate: AggregateName,
+    /// Measures added to the fitness, each times its weight: (weight,
+    /// measure).
+    pub terms: Vec<(f64, crate::archive::Measure)>,
 }
+
+impl EvolveSpec {
+    /// Whether an evaluation must sum the actuators' work.
+    pub fn needs_work(&self) -> bool {
+        self.energy_weight != 0.0 || self.terms.iter().any(|(_, m)| m.needs_work())
+    }
+}
+
+/// The most trials an evaluation may have.
+pub const MAX_TRIALS: u32 = 1000;
 
 /// An `[evolve]` table's end rules, resolved.
 struct EndRules {
@@ -144,7 +169,7 @@ impl EvolveSpec {
             evolved.push((i, origins[i]));
         }
         let duration = Self::duration(at, e, dt)?;
-        let particles = match &e.particles {
+        let particles: Vec<ParticleId> = match &e.particles {
             None => world.particle_ids().collect(),
             Some(list) if list.is_empty() => {
                 return Err(at.err(
@@ -175,11 +200,50 @@ impl EvolveSpec {
             }
             other => other,
         };
+        let axis = axis.normalize();
+        let target = match e.target {
+            None => {
+                if e.target_weight.is_some() {
+                    return Err(at.err(
+                        "target_weight",
+                        "weighs the distance to `target`: give `target` too",
+                    ));
+                }
+                None
+            }
+            Some(t) => Some((
+                at.vec3("target", t)?,
+                at.finite("target_weight", e.target_weight.unwrap_or(1.0))?,
+            )),
+        };
+        let trials = e.trials.unwrap_or(1);
+        if !(1..=MAX_TRIALS).contains(&trials) {
+            return Err(at.err(
+                "trials",
+                format!("must be between 1 and {MAX_TRIALS}, got {trials}"),
+            ));
+        }
+        let noise = at.finite("noise", e.noise)?;
+        if !(0.0..=1.0).contains(&noise) {
+            return Err(at.err(
+                "noise",
+                format!("must be in [0, 1] (a fraction of each radius and of each actuator's range), got {noise}"),
+            ));
+        }
+        let mut terms = Vec::with_capacity(e.terms.len());
+        for (i, t) in e.terms.iter().enumerate() {
+            let field = format!("terms[{i}]");
+            let (weight, m) = t.0.as_ref().map_err(|msg| {
+                at.err(&field, format!("{msg} (kinds: {})", crate::archive::KINDS))
+            })?;
+            let weight = at.finite(&format!("{field}.weight"), *weight)?;
+            terms.push((weight, m.resolve(at, &field, names, &particles, axis)?));
+        }
         Ok(EvolveSpec {
             controller: names_evolved.first().map(|c| c.to_string()),
             duration,
             particles,
-            axis: axis.normalize(),
+            axis,
             distance_weight: at.finite("distance_weight", e.distance_weight)?,
             time_weight: at.finite("time_weight", e.time_weight)?,
             fail_on_touch,
@@ -191,6 +255,12 @@ impl EvolveSpec {
             lanes,
             robust: e.robust.unwrap_or(false),
             optimiser: e.optimiser.clone(),
+            energy_weight: at.finite("energy_weight", e.energy_weight)?,
+            target,
+            trials,
+            noise,
+            aggregate: e.aggregate,
+            terms,
         })
     }
 
@@ -348,7 +418,8 @@ impl std::str::FromStr for Ended {
 /// optimiser is told.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Evaluation {
-    /// `time_weight × time + distance_weight × distance`.
+    /// `time_weight × time + distance_weight × distance − energy_weight ×
+    /// energy − target_weight × target distance + Σ weight × term`.
     pub fitness: f64,
     /// Distance along the axis, m.
     pub distance: f64,
@@ -359,6 +430,14 @@ pub struct Evaluation {
     /// The scene's `[archive]` measures, in order (empty without one),
     /// computed during this evaluation.
     pub measures: Vec<f64>,
+    /// The actuators' positive work, J, when the scene's fitness or
+    /// measures need it.
+    pub energy: Option<f64>,
+    /// The final distance of the centre from `[evolve] target`, m, when
+    /// the scene has one.
+    pub target_distance: Option<f64>,
+    /// The values of `[evolve] terms`, in order (before their weights).
+    pub terms: Vec<f64>,
 }
 
 /// Runs `scene`'s `[evolve]` evaluation; `observe` sees the scene before
@@ -378,21 +457,39 @@ pub fn evaluate_with(
     let mut ended = Ended::Timeout;
     let mut last = start;
     let archive = scene.archive.clone();
-    let mut recorder = archive.as_ref().map(|a| {
-        crate::archive::Recorder::new(a, &spec, &scene.world, scene.nervous.actuators.len())
-    });
+    let muscles = scene.nervous.actuators.len();
+    let mut recorder = archive
+        .as_ref()
+        .map(|a| crate::archive::Recorder::new(&a.measures, &spec, &scene.world, muscles));
+    let term_measures: Vec<_> = spec.terms.iter().map(|(_, m)| m.clone()).collect();
+    let mut terms = (!term_measures.is_empty())
+        .then(|| crate::archive::Recorder::new(&term_measures, &spec, &scene.world, muscles));
+    let needs_work = spec.needs_work()
+        || archive
+            .as_ref()
+            .is_some_and(|a| a.measures.iter().any(|m| m.needs_work()));
+    let mut work = needs_work.then(crate::work::Work::default);
     observe(&scene);
     if let Some(end) = spec.ending(&scene.world) {
         ended = end;
     } else {
         while done < steps {
+            if let Some(w) = &mut work {
+                w.before(&scene);
+            }
             if scene.step(dt).is_err() {
                 ended = Ended::BlowUp;
                 break;
             }
+            if let Some(w) = &mut work {
+                w.after(&scene, dt);
+            }
             done += 1;
             observe(&scene);
             if let Some(r) = &mut recorder {
+                r.step(&scene.world);
+            }
+            if let Some(r) = &mut terms {
                 r.step(&scene.world);
             }
             let c = spec.centre(&scene.world);
@@ -412,18 +509,36 @@ pub fn evaluate_with(
     if ended == Ended::BlowUp {
         distance = distance.min(0.0);
     }
-    let measures = recorder.map_or_else(Vec::new, |r| r.finish(&scene.world, time));
+    let energy = work.map(|w| w.positive);
+    let joules = energy.unwrap_or(0.0);
+    let measures = recorder.map_or_else(Vec::new, |r| r.finish(&scene.world, time, joules));
+    let terms = terms.map_or_else(Vec::new, |r| r.finish(&scene.world, time, joules));
+    let mut fitness = spec.time_weight * time + spec.distance_weight * distance;
+    if spec.energy_weight != 0.0 {
+        fitness -= spec.energy_weight * joules;
+    }
+    // A blow-up's last centre is the last finite one: no profit from it.
+    let target_distance = spec.target.map(|(t, _)| (last - t).length());
+    if let (Some((_, w)), Some(d)) = (spec.target, target_distance) {
+        fitness -= w * d;
+    }
+    for ((w, _), v) in spec.terms.iter().zip(&terms) {
+        fitness += w * v;
+    }
     Ok(Evaluation {
-        fitness: spec.time_weight * time + spec.distance_weight * distance,
+        fitness,
         distance,
         time,
         ended,
         measures,
+        energy,
+        target_distance,
+        terms,
     })
 }
 
 /// Runs `scene`'s `[evolve]` evaluation once, at the scene's step (see
-/// [`SceneProblem::evaluate`] for a robust scene's two).
+/// [`score`] for a scene's trials and robust evaluations).
 pub fn evaluate(scene: Scene) -> Result<Evaluation, String> {
     evaluate_with(scene, |_| {})
 }
@@ -438,12 +553,146 @@ pub fn evaluate_robust(make: impl Fn() -> Result<Scene, String>) -> Result<Evalu
     let mut fine = make()?;
     fine.dt *= 0.5;
     let second = evaluate(fine)?;
+    Ok(worse(first, second))
+}
+
+/// The worse of two evaluations (the first of equals; NaN is worst).
+fn worse(first: Evaluation, second: Evaluation) -> Evaluation {
     let sane = |f: f64| if f.is_nan() { f64::NEG_INFINITY } else { f };
-    Ok(if sane(second.fitness) < sane(first.fitness) {
+    if sane(second.fitness) < sane(first.fitness) {
         second
     } else {
         first
-    })
+    }
+}
+
+/// Scores the scene `make()` builds as its `[evolve]` table says: once, or
+/// `trials` times, trial `k` perturbed by `noise` from the scene's seed and
+/// `k` ([`perturb`]: the same perturbations for every genome), each trial
+/// robust if the table asks; the mean of the trials counts (every figure
+/// averaged, the ending the worst trial's), or with `aggregate = "worst"`
+/// the worst trial.
+pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
+    let first = make()?;
+    let spec = first
+        .evolve
+        .clone()
+        .ok_or("the scene has no [evolve] table: nothing to evaluate")?;
+    let perturbed = spec.trials > 1 || spec.noise > 0.0;
+    let one = |k: u32, scene: Option<Scene>| -> Result<Evaluation, String> {
+        let build = || -> Result<Scene, String> {
+            let mut s = make()?;
+            if perturbed {
+                perturb(&mut s, k)?;
+            }
+            Ok(s)
+        };
+        if spec.robust {
+            evaluate_robust(build)
+        } else {
+            match scene {
+                Some(s) if !perturbed => evaluate(s),
+                _ => evaluate(build()?),
+            }
+        }
+    };
+    if !perturbed {
+        return one(0, Some(first));
+    }
+    let trials = (0..spec.trials)
+        .map(|k| one(k, None))
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(aggregate(trials, spec.aggregate))
+}
+
+/// The trials' evaluations as `aggregate` says.
+fn aggregate(trials: Vec<Evaluation>, how: AggregateName) -> Evaluation {
+    let mut it = trials.into_iter();
+    let Some(first) = it.next() else {
+        unreachable!("at least one trial")
+    };
+    match how {
+        AggregateName::Worst => it.fold(first, worse),
+        AggregateName::Mean => {
+            let mut n = 1.0;
+            let mut sum = first.clone();
+            let mut worst = first;
+            for e in it {
+                n += 1.0;
+                sum.fitness += e.fitness;
+                sum.distance += e.distance;
+                sum.time += e.time;
+                for (a, b) in sum.measures.iter_mut().zip(&e.measures) {
+                    *a += b;
+                }
+                for (a, b) in sum.terms.iter_mut().zip(&e.terms) {
+                    *a += b;
+                }
+                if let (Some(a), Some(b)) = (&mut sum.energy, e.energy) {
+                    *a += b;
+                }
+                if let (Some(a), Some(b)) = (&mut sum.target_distance, e.target_distance) {
+                    *a += b;
+                }
+                worst = worse(worst, e);
+            }
+            let mean = |x: f64| x / n;
+            Evaluation {
+                fitness: mean(sum.fitness),
+                distance: mean(sum.distance),
+                time: mean(sum.time),
+                ended: worst.ended,
+                measures: sum.measures.into_iter().map(mean).collect(),
+                energy: sum.energy.map(mean),
+                target_distance: sum.target_distance.map(mean),
+                terms: sum.terms.into_iter().map(mean).collect(),
+            }
+        }
+    }
+}
+
+/// Perturbs `scene` for trial `k` of its `[evolve] trials` by `noise`:
+/// every free particle's start moves by a uniform offset of up to `noise`
+/// × its radius along each axis (lifted out of the floor if that puts it
+/// in), and every actuator's level is offset by a uniform amount in
+/// [−`noise`, `noise`] for the whole trial; drawn from the scene's seed and
+/// `k`, so the same for every genome.
+pub fn perturb(scene: &mut Scene, k: u32) -> Result<(), String> {
+    let Some(spec) = &scene.evolve else {
+        return Ok(());
+    };
+    let noise = spec.noise;
+    if noise == 0.0 {
+        return Ok(());
+    }
+    let mut random =
+        animats_creatures::seaworld::Random::for_entry(scene.seed, 5000 + u64::from(k));
+    let w = &mut scene.world;
+    let floor = w.terrain().is_some();
+    for id in w.particle_ids().collect::<Vec<_>>() {
+        let p = w.particles();
+        let (r, fixed) = (p.radius[id.index()], p.fixed[id.index()]);
+        if fixed {
+            continue;
+        }
+        let mut step = || random.between(-noise, noise) * r;
+        let offset = DVec3::new(step(), step(), step());
+        let x = w.position(id) + offset;
+        w.set_position(id, x).map_err(|e| e.to_string())?;
+        if floor {
+            let inside = -w.clearance(id);
+            if inside > 0.0 {
+                w.set_position(id, x + DVec3::Y * inside)
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+    }
+    let offsets = (0..scene.nervous.actuators.len())
+        .map(|_| random.between(-noise, noise))
+        .collect();
+    scene.nervous.offsets = offsets;
+    scene.rearm_guard();
+    Ok(())
 }
 
 /// A scene whose `[evolve]` controller is evolved: genome → evaluation.
@@ -564,14 +813,11 @@ impl SceneProblem {
         Ok(scene)
     }
 
-    /// Evaluates `genome`: once, or for a robust scene ([`EvolveSpec::robust`])
-    /// at the scene's step and half of it, the worse counting.
+    /// Evaluates `genome` as the scene's `[evolve]` says ([`score`]): once,
+    /// at the scene's step and half of it for a robust scene
+    /// ([`EvolveSpec::robust`]), over its trials.
     pub fn evaluate(&self, genome: &[f64]) -> Result<Evaluation, String> {
-        if self.spec.robust {
-            evaluate_robust(|| self.scene(genome))
-        } else {
-            evaluate(self.scene(genome)?)
-        }
+        score(|| self.scene(genome))
     }
 
     /// The scene's text with `genome` written into the `[evolve]`

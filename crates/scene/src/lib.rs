@@ -34,6 +34,7 @@ pub mod morphology;
 pub(crate) mod nervous;
 pub mod params;
 pub mod source;
+pub mod work;
 
 pub use error::SceneError;
 
@@ -76,6 +77,9 @@ pub struct Scene {
     /// starts inside the floor, a nail given a velocity, a step far past the
     /// stiffest spring's stability limit): front ends print them.
     pub warnings: Vec<String>,
+    /// The scene's seed (`[world] seed`): what its random entries and its
+    /// evaluation's trials are drawn from.
+    pub seed: u64,
 }
 
 /// What a particle is part of, for drawing (its colour and look).

@@ -4,7 +4,7 @@
 //! evaluation's fitness.
 
 use animats_creatures::env::Env;
-use animats_scene::env::SceneEnv;
+use animats_scene::env::{Observation, SceneEnv};
 use animats_scene::evaluate::{evaluate_with, Ended};
 
 /// The pogo stick scored on staying up and on its height gained (its
@@ -18,7 +18,7 @@ fn pogo() -> String {
 
 #[test]
 fn replaying_the_controllers_orders_gives_the_evaluation() {
-    let scene = animats_scene::parse(&pogo(), "pogo.toml").unwrap();
+    let scene = animats_scene::parse(&pogo_costed(), "pogo.toml").unwrap();
     let (mut orders, mut centres) = (Vec::new(), Vec::new());
     let mut first = true;
     let e = evaluate_with(scene, |s| {
@@ -38,9 +38,9 @@ fn replaying_the_controllers_orders_gives_the_evaluation() {
     })
     .unwrap();
     assert_eq!(e.ended, Ended::Timeout);
-    assert!(e.distance.abs() > 0.0 && e.fitness > 0.0, "{e:?}");
+    assert!(e.distance.abs() > 0.0 && e.energy.unwrap() > 0.0, "{e:?}");
 
-    let mut env = SceneEnv::parse(&pogo(), "pogo.toml", 0.0).unwrap();
+    let mut env = SceneEnv::parse(&pogo_costed(), "pogo.toml", 0.0).unwrap();
     assert_eq!(env.action_names(), ["leg_muscle"]);
     assert_eq!(env.observation_size(), 2);
     let mut total = 0.0;
@@ -57,22 +57,24 @@ fn replaying_the_controllers_orders_gives_the_evaluation() {
         last.unwrap().truncated,
         "the episode ends at the evaluation's duration"
     );
+    // Time, distance, the muscles' work and the target: all of it.
     assert_eq!(env.fitness(), e.fitness);
+    assert_eq!(Some(env.energy()), e.energy);
     assert!((total - e.fitness).abs() <= 1e-9 * e.fitness.abs().max(1.0));
     assert!(env.step(&orders[0]).is_err(), "stepping past the end");
 }
 
 #[test]
-fn an_environment_needs_sensors_actuators_and_evolve() {
+fn an_environment_needs_actuators_and_evolve_and_sensors_to_observe_them() {
     let walker = include_str!("../../../scenes/walker.toml");
-    let err = SceneEnv::parse(walker, "walker.toml", 0.0)
+    // No sensors: it observes its state.
+    let env = SceneEnv::parse(walker, "walker.toml", 0.0).unwrap();
+    assert_eq!(env.observation_names()[0], "centre y");
+    let err = env
+        .with_actions(1, Observation::Sensors)
         .err()
-        .expect("the walker has no sensors")
-        .to_string();
-    assert!(
-        err.contains("walker.toml") && err.contains("[[sensor]]"),
-        "{err}"
-    );
+        .expect("the walker has no sensors");
+    assert!(err.contains("[[sensor]]"), "{err}");
     let plain = "[world]\ndt = 0.01\n[[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0.0, 1.0, 0.0]\nradius = 0.1\n";
     let err = SceneEnv::parse(plain, "plain.toml", 0.0)
         .err()
@@ -98,4 +100,98 @@ fn reset_noise_is_drawn_from_the_seed() {
     assert_ne!(a, c);
     assert!(env.step(&[f64::NAN]).is_err());
     assert!(env.step(&[0.5, 0.5]).is_err());
+}
+
+/// The pogo stick with an energy weight and a target, so that every term
+/// of the fitness that an environment rewards is in play.
+fn pogo_costed() -> String {
+    pogo() + "energy_weight = 0.5\ntarget = [0.3, 1.0, 0.0]\ntarget_weight = 2.0\n"
+}
+
+#[test]
+fn held_actions_are_single_steps_repeated_and_rewards_still_add_up() {
+    let text = pogo_costed();
+    let e = animats_scene::evaluate::evaluate(animats_scene::parse(&text, "pogo.toml").unwrap())
+        .unwrap();
+    let mut one = SceneEnv::parse(&text, "pogo.toml", 0.0).unwrap();
+    let mut held = SceneEnv::parse(&text, "pogo.toml", 0.0)
+        .unwrap()
+        .with_actions(7, Observation::Both)
+        .unwrap();
+    assert_eq!(held.dt(), 7.0 * one.dt());
+    assert_eq!(held.max_steps(), one.max_steps().div_ceil(7));
+    let action = |k: u64| [0.5 + 0.4 * (k as f64 * 0.37).sin()];
+    let (mut total, mut k) = (0.0, 0u64);
+    loop {
+        let a = action(k);
+        let t = held.step(&a).unwrap();
+        total += t.reward;
+        for _ in 0..7 {
+            if one.physics_done() {
+                break;
+            }
+            one.step(&a).unwrap();
+        }
+        k += 1;
+        let (s, r) = (held.scene(), one.scene());
+        assert_eq!(s.world.state().pos, r.world.state().pos, "action {k}");
+        if t.ends() {
+            assert!(t.truncated && !t.terminated);
+            break;
+        }
+    }
+    assert_eq!(k, held.max_steps());
+    assert_eq!(held.fitness(), one.fitness());
+    assert!((total - held.fitness()).abs() < 1e-9 * held.fitness().abs().max(1.0));
+    // The info: distance, work and why it ended.
+    assert_eq!(held.ended(), Some(&animats_scene::evaluate::Ended::Timeout));
+    assert!(held.energy() > 0.0 && held.distance().abs() > 0.0);
+    // Driven by the same orders as its controller, the fitness is the
+    // evaluation's, energy and target included.
+    println!("evaluation {e:?}; environment {} J", held.energy());
+    assert!(e.energy.unwrap() > 0.0 && e.target_distance.unwrap() > 0.0);
+}
+
+#[test]
+fn the_state_is_relative_to_the_centre_of_mass() {
+    let walker = include_str!("../../../scenes/walker.toml");
+    let mut env = SceneEnv::parse(walker, "walker.toml", 0.0)
+        .unwrap()
+        .with_actions(10, Observation::State)
+        .unwrap();
+    for _ in 0..30 {
+        env.step(&[0.5; 6]).unwrap();
+    }
+    let names = env.observation_names();
+    let mut o = vec![0.0; env.observation_size()];
+    env.observe(&mut o);
+    let s = env.scene();
+    let (n, springs) = (s.world.len(), s.world.forces().springs.len());
+    // Centre height and velocity, positions, velocities, lengths, contacts.
+    assert_eq!(o.len(), 4 + 6 * n + springs + n, "{names:?}");
+    let mass = &s.world.particles().mass;
+    for k in 0..3 {
+        // Σ m (x − c) = 0 for the positions and for the velocities.
+        let first = 4 + k * n;
+        let moment: f64 = (0..n).map(|i| mass[i] * o[first + i]).sum();
+        assert!(moment.abs() < 1e-12, "{}: {moment}", names[first]);
+        let first = 4 + 3 * n + k * n;
+        let moment: f64 = (0..n).map(|i| mass[i] * o[first + i]).sum();
+        assert!(moment.abs() < 1e-12, "{}: {moment}", names[first]);
+    }
+    let centre = s.evolve.as_ref().unwrap().centre(&s.world);
+    let all =
+        animats_scene::evaluate::centre_of(&s.world, &s.world.particle_ids().collect::<Vec<_>>());
+    assert!((o[0] - all.y).abs() < 1e-12, "{} vs {}", o[0], all.y);
+    assert!(centre.is_finite());
+    let spine = s.world.forces().springs.iter().next().unwrap();
+    let (a, b) = spine.ends();
+    let length = (s.world.position(a) - s.world.position(b)).length();
+    assert_eq!(o[4 + 6 * n], length, "{}", names[4 + 6 * n]);
+    // The walker stands on its four feet, not its hips.
+    let contacts = &o[4 + 6 * n + springs..];
+    assert_eq!(contacts.iter().sum::<f64>(), 4.0, "{contacts:?}");
+    let bounds = env.observation_bounds();
+    assert_eq!(bounds[0], (f64::NEG_INFINITY, f64::INFINITY));
+    assert_eq!(bounds[o.len() - 1], (0.0, 1.0));
 }

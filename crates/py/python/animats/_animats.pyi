@@ -128,25 +128,35 @@ class Evolution:
 
 class Env:
     observation_names: List[str]
+    observation_bounds: List[Tuple[float, float]]
     action_names: List[str]
     dt: float
+    frame_skip: int
     max_steps: int
     time: float
+    distance: float
+    energy: float
+    ended: Optional[str]
     def __init__(
         self,
         scene: SceneLike,
         noise: float = 0.0,
         seconds: Optional[float] = None,
         dt: Optional[float] = None,
+        frame_skip: Optional[int] = None,
+        act_hz: Optional[float] = None,
+        observation: Optional[str] = None,
     ) -> None: ...
     def reset(self, seed: int = 0) -> F64: ...
     def observe(self) -> F64: ...
     def step(self, action: F64) -> Tuple[F64, float, bool, bool]: ...
     def positions(self) -> F64: ...
+    def render(self, width: int = 480, height: int = 320) -> npt.NDArray[np.uint8]: ...
 
 class VecEnv:
     num_envs: int
     observation_names: List[str]
+    observation_bounds: List[Tuple[float, float]]
     action_names: List[str]
     dt: float
     max_steps: int
@@ -158,6 +168,9 @@ class VecEnv:
         noise: float = 0.0,
         seconds: Optional[float] = None,
         dt: Optional[float] = None,
+        frame_skip: Optional[int] = None,
+        act_hz: Optional[float] = None,
+        observation: Optional[str] = None,
     ) -> None: ...
     def reset(self, seed: int = 0) -> F64: ...
     def step(

@@ -12,16 +12,29 @@ Importing this module registers:
   rewards add up to the fitness ``animats.evaluate`` gives the same run.
   8 ms per step, 20 s (2500 steps) per episode, terminated when the hip,
   head or tail touches the floor or the leg stretches to 1 m.
-- ``animats/Scene-v0``: any scene with actuators, sensors and an
-  ``[evolve]`` table, ``gymnasium.make("animats/Scene-v0", scene=path)``.
-  Actions: every actuator's level (the scene's own controllers do not run);
-  observations: every sensor's level; reward: the increase of the
-  ``[evolve]`` fitness; the episode lasts its ``duration`` and terminates
-  when an ``[evolve]`` end rule holds or the run blows up.
+- ``animats/Scene-v0``: any scene with actuators and an ``[evolve]``
+  table, ``gymnasium.make("animats/Scene-v0", scene=path)``. Actions: every
+  actuator's level (the scene's own controllers do not run), each held for
+  ``frame_skip`` physics steps (default: as many as make the agent act at
+  about 50 Hz: 40 for a 0.5 ms step); observations: ``observation =
+  "sensors"`` (every sensor's level, in [0, 1]; the default), ``"state"``
+  (the centre of mass's height and velocity, every moving particle's
+  position and velocity relative to it, every spring's length, and 1 or 0
+  for each moving particle touching the floor; the default of a scene with
+  no sensors) or ``"both"``; reward: the increase of the ``[evolve]``
+  fitness (energy and target terms included); the episode lasts its
+  ``duration`` and terminates when an ``[evolve]`` end rule holds or the run
+  blows up.
 
 Both accept ``noise`` (m/s): each reset adds to every particle's velocity a
 uniform random vector of up to ``noise`` per component, drawn from the
-reset's seed (0 by default: every episode starts the same).
+reset's seed (0 by default: every episode starts the same);
+``render_mode="rgb_array"``: ``render()`` returns the scene drawn by the
+software renderer (``animats render``'s), ``(320, 480, 3)`` uint8; and
+every ``info`` carries ``time`` (s), ``distance`` (m along the ``[evolve]``
+axis), ``energy`` (J, the actuators' positive work) and ``ended``
+(``None``, or ``"timeout"``, ``"touch NAME"``, ``"stretch A-B"``,
+``"blow-up"``).
 
 ``gymnasium.make_vec(id, num_envs=N)`` gives :class:`AnimatsVectorEnv`, the
 native vector environment that steps all N copies in one call in Rust (in
@@ -46,10 +59,16 @@ __all__ = ["AnimatsEnv", "AnimatsVectorEnv", "RoobotEnv", "SceneEnv"]
 _SEED_LIMIT = 2**63
 
 
+def _box(bounds: list) -> spaces.Box:
+    low = np.array([b[0] for b in bounds], dtype=np.float64)
+    high = np.array([b[1] for b in bounds], dtype=np.float64)
+    return spaces.Box(low, high, (len(bounds),), dtype=np.float64)
+
+
 class AnimatsEnv(gymnasium.Env):
     """One animats environment (see the module documentation)."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 50}
 
     def __init__(
         self,
@@ -58,35 +77,49 @@ class AnimatsEnv(gymnasium.Env):
         seconds: Optional[float] = None,
         dt: Optional[float] = None,
         render_mode: Optional[str] = None,
+        frame_skip: Optional[int] = None,
+        observation: Optional[str] = None,
+        act_hz: Optional[float] = None,
     ) -> None:
-        if render_mode is not None:
+        if render_mode not in (None, "rgb_array"):
             raise ValueError(
-                "animats environments do not render; use `animats view` or `animats render`"
+                f'render_mode must be None or "rgb_array", got {render_mode!r}'
             )
-        self._env = _animats.Env(scene, noise, seconds, dt)
-        n_obs = len(self._env.observation_names)
+        self._env = _animats.Env(scene, noise, seconds, dt, frame_skip, act_hz, observation)
         n_act = len(self._env.action_names)
-        self.observation_space = spaces.Box(0.0, 1.0, (n_obs,), dtype=np.float64)
+        self.observation_space = _box(self._env.observation_bounds)
         self.action_space = spaces.Box(0.0, 1.0, (n_act,), dtype=np.float64)
         self.observation_names = self._env.observation_names
         self.action_names = self._env.action_names
         self.dt = self._env.dt
+        self.frame_skip = self._env.frame_skip
         self.max_steps = self._env.max_steps
-        self.render_mode = None
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": max(1, round(1.0 / self.dt))}
+
+    def _info(self) -> dict:
+        e = self._env
+        return {"time": e.time, "distance": e.distance, "energy": e.energy, "ended": e.ended}
 
     def reset(
         self, *, seed: Optional[int] = None, options: Optional[dict] = None
     ) -> tuple[np.ndarray, dict]:
         super().reset(seed=seed)
         obs = self._env.reset(int(self.np_random.integers(0, _SEED_LIMIT)))
-        return obs, {"time": 0.0}
+        return obs, self._info()
 
     def step(
         self, action: Any
     ) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict]:
         a = np.ascontiguousarray(action, dtype=np.float64).reshape(-1)
         obs, reward, terminated, truncated = self._env.step(a)
-        return obs, reward, terminated, truncated, {"time": self._env.time}
+        return obs, reward, terminated, truncated, self._info()
+
+    def render(self) -> Optional[np.ndarray]:
+        """The scene now, ``(320, 480, 3)`` uint8 (``render_mode="rgb_array"``)."""
+        if self.render_mode != "rgb_array":
+            return None
+        return self._env.render(480, 320)
 
 
 class RoobotEnv(AnimatsEnv):
@@ -98,17 +131,30 @@ class RoobotEnv(AnimatsEnv):
         seconds: Optional[float] = None,
         dt: Optional[float] = None,
         render_mode: Optional[str] = None,
+        frame_skip: Optional[int] = None,
+        observation: Optional[str] = None,
     ) -> None:
-        super().__init__("roobot", noise, seconds, dt, render_mode)
+        super().__init__("roobot", noise, seconds, dt, render_mode, frame_skip, observation)
 
 
 class SceneEnv(AnimatsEnv):
-    """``animats/Scene-v0``: ``scene`` is a path or an ``animats.Scene``."""
+    """``animats/Scene-v0``: ``scene`` is a path or an ``animats.Scene``;
+    without ``frame_skip`` the agent acts at about 50 Hz."""
 
     def __init__(
-        self, scene: Any, noise: float = 0.0, render_mode: Optional[str] = None
+        self,
+        scene: Any,
+        noise: float = 0.0,
+        render_mode: Optional[str] = None,
+        frame_skip: Optional[int] = None,
+        observation: Optional[str] = None,
+        seconds: Optional[float] = None,
+        dt: Optional[float] = None,
     ) -> None:
-        super().__init__(scene, noise, None, None, render_mode)
+        super().__init__(
+            scene, noise, seconds, dt, render_mode, frame_skip, observation,
+            act_hz=None if frame_skip is not None else 50.0,
+        )
 
 
 class AnimatsVectorEnv(VectorEnv):
@@ -126,14 +172,20 @@ class AnimatsVectorEnv(VectorEnv):
         seconds: Optional[float] = None,
         dt: Optional[float] = None,
         render_mode: Optional[str] = None,
+        frame_skip: Optional[int] = None,
+        observation: Optional[str] = None,
+        act_hz: Optional[float] = None,
     ) -> None:
         if render_mode is not None:
-            raise ValueError("animats environments do not render")
-        self._env = _animats.VecEnv(scene, num_envs, 0, noise, seconds, dt)
+            raise ValueError(
+                "vector environments do not render; render a single one (render_mode=\"rgb_array\")"
+            )
+        self._env = _animats.VecEnv(
+            scene, num_envs, 0, noise, seconds, dt, frame_skip, act_hz, observation
+        )
         self.num_envs = num_envs
-        n_obs = len(self._env.observation_names)
         n_act = len(self._env.action_names)
-        self.single_observation_space = spaces.Box(0.0, 1.0, (n_obs,), dtype=np.float64)
+        self.single_observation_space = _box(self._env.observation_bounds)
         self.single_action_space = spaces.Box(0.0, 1.0, (n_act,), dtype=np.float64)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
@@ -164,6 +216,9 @@ def _roobot_vector(num_envs: int = 1, **kwargs: Any) -> AnimatsVectorEnv:
 
 
 def _scene_vector(num_envs: int = 1, *, scene: Any, **kwargs: Any) -> AnimatsVectorEnv:
+    # As Scene-v0: about 50 actions a second unless told.
+    if kwargs.get("frame_skip") is None:
+        kwargs.setdefault("act_hz", 50.0)
     return AnimatsVectorEnv(num_envs, scene, **kwargs)
 
 

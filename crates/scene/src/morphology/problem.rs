@@ -271,6 +271,12 @@ fn placeholder_spec() -> EvolveSpec {
         lanes: None,
         robust: false,
         optimiser: None,
+        energy_weight: 0.0,
+        target: None,
+        trials: 1,
+        noise: 0.0,
+        aggregate: Default::default(),
+        terms: Vec::new(),
     }
 }
 

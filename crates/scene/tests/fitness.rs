@@ -1,0 +1,183 @@
+//! Richer fitness (issue 43): the actuators' positive work against closed
+//! forms, a target, noisy trials and measure terms.
+
+use animats_scene::evaluate::{evaluate, perturb, score, Evaluation};
+
+fn parse(text: &str) -> animats_scene::Scene {
+    animats_scene::parse(text, "f.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn scored(text: &str) -> Evaluation {
+    score(|| animats_scene::parse(text, "f.toml").map_err(|e| e.to_string())).unwrap()
+}
+
+/// Two nailed particles 0.3 m apart joined by a 100 N/m muscle whose rest
+/// length an oscillator swings over [0.1, 0.2] m at 1 Hz.
+fn muscle(evolve: &str) -> String {
+    format!(
+        "[world]\ndt = 0.001\ngravity = [0, 0, 0]\n\n\
+         [[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0, 0, 0]\nradius = 0.01\nfixed = true\n\n\
+         [[particle]]\nname = \"b\"\nmass = 1.0\nposition = [0.3, 0, 0]\nradius = 0.01\nfixed = true\n\n\
+         [[spring]]\nname = \"m\"\na = \"a\"\nb = \"b\"\nstiffness = 100.0\nrest_length = 0.15\n\n\
+         [[actuator]]\nname = \"m\"\nspring = \"m\"\nmin = 0.1\nmax = 0.2\n\n\
+         [[controller]]\nname = \"osc\"\nkind = \"oscillator\"\noutputs = [\"m\"]\nfrequency = 1.0\n\
+         amplitude = [0.5]\nphase = [0.0]\noffset = [0.5]\n\n\
+         [evolve]\ncontroller = \"osc\"\nduration = 3.0\n{evolve}\n"
+    )
+}
+
+#[test]
+fn a_muscles_positive_work_is_what_it_puts_into_its_spring() {
+    // The ends are nailed: l = 0.3 m throughout, and the spring stores
+    // ½ k (l − r)². Each shortening of the rest length from 0.2 to 0.1 m
+    // puts in ½ k [(0.3 − 0.1)² − (0.3 − 0.2)²] = 1.5 J; each lengthening
+    // takes it back, which does not count. Three periods: 4.5 J.
+    let e = scored(&muscle("energy_weight = 2.0"));
+    let energy = e.energy.unwrap();
+    println!("work {energy} J, fitness {}", e.fitness);
+    // The level is sampled once a step: the turning points are met within
+    // a step (2π·1 Hz·1 ms of phase), which misses (1 − cos) of a swing.
+    assert!((energy - 4.5).abs() < 1e-4, "{energy}");
+    // fitness = time_weight × 3 s + 0 m − 2 × work.
+    assert!(
+        (e.fitness - (3.0 - 2.0 * energy)).abs() < 1e-12,
+        "{}",
+        e.fitness
+    );
+    // Without a weight nothing is summed.
+    assert_eq!(scored(&muscle("")).energy, None);
+}
+
+#[test]
+fn a_motors_work_is_the_kinetic_energy_it_gives() {
+    // A 2 N m motor spins a 0.5 kg mass on a 0.2 m arm round a nailed hub
+    // (held at 0.2 m by a stiff spring), no gravity: its positive work is
+    // the kinetic energy the mass has gained, to the integrator's error.
+    let text = "[world]\ndt = 0.0001\ngravity = [0, 0, 0]\nintegrator = \"rk4\"\n\n\
+         [[particle]]\nname = \"hub\"\nmass = 1.0\nposition = [0, 0, 0]\nradius = 0.01\nfixed = true\n\n\
+         [[particle]]\nname = \"m\"\nmass = 0.5\nposition = [0.2, 0, 0]\nradius = 0.01\n\n\
+         [[spring]]\na = \"hub\"\nb = \"m\"\nstiffness = 100000.0\ndamping = 0.0\n\n\
+         [[torque_joint]]\nname = \"motor\"\nend = \"m\"\njoint = \"hub\"\naxis = [0, 0, 1]\n\n\
+         [[actuator]]\nname = \"drive\"\ntorque_joint = \"motor\"\nmin = 0.0\nmax = 4.0\nlevel = 0.5\n\n\
+         [evolve]\nduration = 0.5\nenergy_weight = 1.0\n";
+    let e = scored(text);
+    let mut s = parse(text);
+    let before = s.world.energy().total();
+    for _ in 0..5000 {
+        s.step(s.dt).unwrap();
+    }
+    // The mechanical energy it has gained: the mass's kinetic energy and
+    // the spring's, stretched 2.5 mm by the 250 N the turn needs.
+    let gained = s.world.energy().total() - before;
+    let energy = e.energy.unwrap();
+    println!("motor work {energy} J, mechanical energy gained {gained} J");
+    // τ t / (m r) = 2·0.5/(0.5·0.2) = 10 m/s: about 25 J.
+    assert!((gained - 25.0).abs() < 1.0, "{gained}");
+    // The trapezoidal sum of τ ω h against RK4's exact-to-h⁴ energy.
+    assert!(
+        (energy - gained).abs() < 1e-4 * gained,
+        "{energy} vs {gained}"
+    );
+}
+
+#[test]
+fn a_target_costs_its_weight_per_metre_of_the_final_distance() {
+    let text = "[world]\ndt = 0.001\n\n[floor]\n\n\
+         [[particle]]\nname = \"ball\"\nmass = 1.0\nradius = 0.05\nposition = [1, 0.05, 0]\n\n\
+         [evolve]\nduration = 1.0\ntarget = [4, 0.05, 4]\ntarget_weight = 3.0\n";
+    let e = scored(text);
+    // It rests where it stands: 5 m from the target (3-4-5).
+    assert!((e.target_distance.unwrap() - 5.0).abs() < 1e-12);
+    assert!(
+        (e.fitness - (1.0 - 3.0 * 5.0)).abs() < 1e-9,
+        "{}",
+        e.fitness
+    );
+}
+
+/// A walker whose start and muscles vary by trial.
+fn walker(evolve: &str) -> String {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/walker_evolved.toml"
+    ))
+    .unwrap();
+    let text = text.replace("duration = 10.0\nparticles", "duration = 2.0\nparticles");
+    text.replace("[evolve]\n", &format!("[evolve]\n{evolve}\n"))
+}
+
+#[test]
+fn trials_score_their_mean_or_their_worst_and_repeat_to_the_bit() {
+    let plain = scored(&walker(""));
+    // Noise 0: every trial is the plain run.
+    let same = scored(&walker("trials = 3"));
+    assert_eq!(same, plain);
+    // Noisy trials, each its own perturbation of the start and the muscles.
+    let text = walker("trials = 4\nnoise = 0.2");
+    let each: Vec<Evaluation> = (0..4)
+        .map(|k| {
+            let mut s = parse(&text);
+            perturb(&mut s, k).unwrap();
+            evaluate(s).unwrap()
+        })
+        .collect();
+    let fitness: Vec<f64> = each.iter().map(|e| e.fitness).collect();
+    println!("plain {}, trials {fitness:?}", plain.fitness);
+    assert!(fitness.windows(2).all(|w| w[0] != w[1]), "{fitness:?}");
+    let mean = scored(&text);
+    let sum: f64 = fitness.iter().sum();
+    assert_eq!(mean.fitness, sum / 4.0);
+    let worst = scored(&walker("trials = 4\nnoise = 0.2\naggregate = \"worst\""));
+    let lowest = fitness.iter().cloned().fold(f64::INFINITY, f64::min);
+    assert_eq!(worst.fitness, lowest);
+    // Again, the same bits; another scene seed, other trials.
+    assert_eq!(scored(&text), mean);
+    let reseeded = text.replace("[world]\n", "[world]\nseed = 99\n");
+    assert_ne!(scored(&reseeded).fitness, mean.fitness);
+}
+
+#[test]
+fn terms_add_their_measures_times_their_weights() {
+    let text = walker(
+        "terms = [{ kind = \"mean_height\", weight = 100.0 }, { kind = \"feet\", weight = -2.0 }]",
+    );
+    let plain = scored(&walker(""));
+    let e = scored(&text);
+    println!("terms {:?}", e.terms);
+    assert_eq!(e.terms.len(), 2);
+    // The walker stands: its hips' centre averages 0.1–0.2 m, 2–4 feet down.
+    assert!(e.terms[0] > 0.05 && e.terms[0] < 0.25, "{:?}", e.terms);
+    assert!(e.terms[1] >= 1.0 && e.terms[1] <= 4.0, "{:?}", e.terms);
+    let expected = plain.fitness + 100.0 * e.terms[0] - 2.0 * e.terms[1];
+    assert!(
+        (e.fitness - expected).abs() < 1e-9,
+        "{} vs {expected}",
+        e.fitness
+    );
+}
+
+#[test]
+fn bad_fitness_keys_are_named() {
+    let bad = |evolve: &str, expect: &str| {
+        let text = muscle(evolve);
+        let e = match animats_scene::parse(&text, "f.toml") {
+            Ok(_) => panic!("accepted {evolve}"),
+            Err(e) => e.to_string(),
+        };
+        println!("{e}");
+        assert!(e.contains(expect), "{evolve}: {e}");
+    };
+    bad("trials = 0", "evolve.trials: must be between 1 and 1000");
+    bad("noise = 2.0", "evolve.noise");
+    bad("target_weight = 2.0", "evolve.target_weight");
+    bad("aggregate = \"median\"", "unknown variant `median`");
+    bad(
+        "terms = [{ kind = \"feet\" }]",
+        "evolve.terms[0]: missing field `weight`",
+    );
+    bad(
+        "terms = [{ kind = \"zest\", weight = 1 }]",
+        "evolve.terms[0]",
+    );
+    bad("energy_weight = nan", "evolve.energy_weight");
+}
