@@ -53,6 +53,13 @@ pub struct SceneStage {
     scene: Scene,
     /// The particles the camera frames and follows (see [`SceneStage::follow`]).
     focus: Vec<usize>,
+    /// The `[evolve]` particles' centre at the start, if the scene has one.
+    start: Option<DVec3>,
+}
+
+/// The `[evolve]` particles' centre in `scene`, if it has the table.
+fn start_of(scene: &Scene) -> Option<DVec3> {
+    scene.evolve.as_ref().map(|e| e.centre(&scene.world))
 }
 
 impl SceneStage {
@@ -68,8 +75,7 @@ impl SceneStage {
     /// whole and not followed.
     pub fn following(path: PathBuf, follow: Option<&str>) -> Result<SceneStage, String> {
         let scene = animats_scene::load(&path).map_err(|e| e.to_string())?;
-        let focus = focus_of(&scene, follow).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(SceneStage { path, scene, focus })
+        SceneStage::from_scene(path, scene, follow)
     }
 
     /// A scene already built (`path` names it), following as
@@ -80,7 +86,38 @@ impl SceneStage {
         follow: Option<&str>,
     ) -> Result<SceneStage, String> {
         let focus = focus_of(&scene, follow).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok(SceneStage { path, scene, focus })
+        let start = start_of(&scene);
+        Ok(SceneStage {
+            path,
+            scene,
+            focus,
+            start,
+        })
+    }
+
+    /// How the run stands against the scene's `[evolve]` table: the
+    /// distance its particles' centre has gone along the axis, and the
+    /// score of the time and that distance so far
+    /// (`time_weight × t + distance_weight × d`, the fitness when the table
+    /// weighs nothing else).
+    pub fn progress(&self) -> Option<(f64, f64)> {
+        let spec = self.scene.evolve.as_ref()?;
+        let d = (spec.centre(&self.scene.world) - self.start?).dot(spec.axis);
+        let t = self.scene.world.time();
+        Some((d, spec.time_weight * t + spec.distance_weight * d))
+    }
+
+    /// [`SceneStage::progress`] as the overlay writes it.
+    pub fn progress_note(&self) -> Option<String> {
+        let (d, score) = self.progress()?;
+        let spec = self.scene.evolve.as_ref()?;
+        let plain = spec.energy_weight == 0.0 && spec.target.is_none() && spec.terms.is_empty();
+        let label = if plain {
+            "fitness"
+        } else {
+            "time and distance score"
+        };
+        Some(format!("distance {d:.2} m · {label} {score:.1}"))
     }
 
     /// The scene being played.
@@ -221,16 +258,25 @@ impl Stage for SceneStage {
         self.scene.world.steps_on_pool()
     }
 
-    /// With sleeping spheres (`[contacts] sleep_speed`), how many sleep.
+    /// With sleeping spheres (`[contacts] sleep_speed`), how many sleep;
+    /// with `[evolve]`, the distance and fitness so far.
     fn note(&self) -> Option<String> {
-        let c = self.scene.world.event::<animats_engine::SphereContact>()?;
-        (c.def().sleep_speed > 0.0).then(|| {
-            format!(
-                "{} spheres asleep, {} pairs touching",
-                c.sleeping(),
-                c.touching()
-            )
-        })
+        let sleep = self
+            .scene
+            .world
+            .event::<animats_engine::SphereContact>()
+            .filter(|c| c.def().sleep_speed > 0.0)
+            .map(|c| {
+                format!(
+                    "{} spheres asleep, {} pairs touching",
+                    c.sleeping(),
+                    c.touching()
+                )
+            });
+        match (sleep, self.progress_note()) {
+            (Some(a), Some(b)) => Some(format!("{a} · {b}")),
+            (a, b) => a.or(b),
+        }
     }
 
     fn step(&mut self, dt: f64) -> Result<(), String> {
@@ -289,6 +335,7 @@ impl Stage for SceneStage {
 
     fn reset(&mut self) -> Result<(), String> {
         self.scene = animats_scene::load(&self.path).map_err(|e| e.to_string())?;
+        self.start = start_of(&self.scene);
         Ok(())
     }
 

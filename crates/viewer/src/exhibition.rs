@@ -1,8 +1,10 @@
 //! Watching an evolution (`animats evolve [SCENE] --view`): the best
 //! brain found so far, over all lanes, drives the scene from its start, as
-//! its fitness was measured. When the run ends (the evaluation's duration,
+//! its fitness was measured — the scene's own brain only until the first
+//! generation has a best. When the run ends (the evaluation's duration,
 //! a `fail_on_touch` particle on the floor, a blow-up) it starts again with
-//! whatever the best is by then. The evolution publishes through a
+//! whatever the best is by then. The overlay gives the run shown's
+//! distance and fitness so far. The evolution publishes through a
 //! [`BestBrain`].
 
 use crate::protocol::{CreatureState, Describe};
@@ -113,7 +115,9 @@ impl Stage for Exhibition {
     }
 
     fn step(&mut self, dt: f64) -> Result<(), String> {
-        if self.ended() {
+        // The first best replaces the scene's own brain at once; later ones
+        // wait for the run shown to end.
+        if self.ended() || (self.shown.is_none() && self.board.board().best.is_some()) {
             return self.restart();
         }
         // A run that blows up ends too: the next best starts.
@@ -145,8 +149,11 @@ impl Stage for Exhibition {
             Some((f, lane)) => format!("showing fitness {f:.2} (lane {lane})"),
             None => "showing the scene's own brain".to_string(),
         };
+        let now = self.stage.progress_note().map_or(String::new(), |p| {
+            format!(" · {p} at {:.1} s", self.stage.time())
+        });
         Some(format!(
-            "generation {} of {}: best fitness {}; {showing}",
+            "generation {} of {}: best fitness {}; {showing}{now}",
             b.generation,
             b.generations,
             b.best

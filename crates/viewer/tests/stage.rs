@@ -137,8 +137,9 @@ fn the_thesis_exhibition_plays_the_best_gait_as_its_fitness_was_measured() {
     );
 }
 
-/// `evolve SCENE --view`: the scene plays the best brain so far and, when
-/// a run ends as an evaluation would, starts again with the newest best.
+/// `evolve SCENE --view`: the scene's own brain only until the first best
+/// exists, then the best so far; when a run ends as an evaluation would,
+/// it starts again with the newest best.
 #[test]
 fn a_scene_exhibition_replays_the_newest_best_brain() {
     use animats_viewer::BestBrain;
@@ -152,29 +153,65 @@ fn a_scene_exhibition_replays_the_newest_best_brain() {
     let mut show = Exhibition::new(problem.clone(), board.clone()).unwrap();
     assert!(show.note().unwrap().contains("the scene's own brain"));
     let dt = show.dt();
+    for _ in 0..100 {
+        show.step(dt).unwrap();
+    }
     let mut g = problem.start().to_vec();
     g[0] = 3.0; // another frequency
     board.set_best(&g, 123.0, 0);
-    // It finishes the run it is showing (0.5 s), then restarts with the best.
-    let mut restarted = false;
-    for _ in 0..2000 {
+    // The first best is shown at once, from the start.
+    show.step(dt).unwrap();
+    assert_eq!(show.time(), 0.0);
+    let note = show.note().unwrap();
+    assert!(note.contains("showing fitness 123.00 (lane 0)"), "{note}");
+    // A better one waits for the run shown (0.5 s) to end.
+    g[0] = 2.5;
+    board.set_best(&g, 150.0, 1);
+    let mut steps = 0;
+    loop {
         let before = show.time();
         show.step(dt).unwrap();
+        steps += 1;
         if show.time() < before {
-            restarted = true;
             break;
         }
+        assert!(steps < 2000, "the run of 0.5 s ends");
     }
-    assert!(restarted, "the run of 0.5 s ended and started again");
-    assert_eq!(show.time(), 0.0);
-    assert!(
-        show.note()
-            .unwrap()
-            .contains("showing fitness 123.00 (lane 0)"),
-        "{:?}",
-        show.note()
-    );
+    assert!(steps >= 999, "it finished the run first: {steps} steps");
+    assert!(show
+        .note()
+        .unwrap()
+        .contains("showing fitness 150.00 (lane 1)"));
     assert!(show.focus().is_some(), "it follows the [evolve] particles");
+}
+
+/// The overlay's distance and fitness are the evaluation's, step by step:
+/// at the end of the run they are what `animats evaluate` prints.
+#[test]
+fn the_overlay_gives_the_distance_and_fitness_so_far() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/walker_evolved.toml");
+    let e = animats_scene::evaluate::evaluate(animats_scene::load(&path).unwrap()).unwrap();
+    let mut stage = SceneStage::load(path).unwrap();
+    assert!(stage
+        .note()
+        .unwrap()
+        .starts_with("distance 0.00 m · fitness 0.0"));
+    let dt = stage.dt();
+    for _ in 0..(e.time / dt).round() as usize {
+        stage.step(dt).unwrap();
+    }
+    let (d, f) = stage.progress().unwrap();
+    assert_eq!(d, e.distance);
+    assert!(
+        (f - e.fitness).abs() < 1e-9 * e.fitness,
+        "{f} vs {}",
+        e.fitness
+    );
+    let note = stage.note().unwrap();
+    assert!(
+        note.contains(&format!("distance {:.2} m", e.distance)),
+        "{note}"
+    );
 }
 
 #[test]
