@@ -35,6 +35,8 @@ pub struct Optimiser {
     inner: AnyOptimiser,
     dim: usize,
     asked: bool,
+    /// The problem it was made for, if any (for `best_toml`).
+    problem: Option<animats_evolve::ProblemSpec>,
 }
 
 #[pymethods]
@@ -61,10 +63,10 @@ impl Optimiser {
         problem: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Optimiser> {
         let kind = self::kind(kind)?;
-        let mut setup = match problem {
-            Some(p) => {
-                let spec = problem_spec(p)?;
-                let problem = build(&spec)?;
+        let spec = problem.map(problem_spec).transpose()?;
+        let mut setup = match &spec {
+            Some(spec) => {
+                let problem = build(spec)?;
                 let config = Config {
                     optimiser: kind,
                     population,
@@ -118,6 +120,7 @@ impl Optimiser {
             inner: AnyOptimiser::new(&setup).map_err(value_error)?,
             dim,
             asked: false,
+            problem: spec,
         })
     }
 
@@ -167,6 +170,28 @@ impl Optimiser {
         self.inner
             .best()
             .map(|(g, f)| (PyArray1::from_vec(py, g.to_vec()), f))
+    }
+
+    /// The scene with the best genome so far written in, as `animats
+    /// evolve` writes `best.toml` (None before anything was told); only for
+    /// an optimiser made with `problem`.
+    fn best_toml(&self) -> PyResult<Option<String>> {
+        let spec = self.problem.as_ref().ok_or_else(|| {
+            value_error("this optimiser has no problem: make it with problem=SCENE, or use scene.best_toml(genome)")
+        })?;
+        let Some((genome, fitness)) = self.inner.best() else {
+            return Ok(None);
+        };
+        let problem = build(spec)?;
+        let comment = format!(
+            "{} with the best genome of an animats.Optimiser ({}, generation {}): fitness {fitness}",
+            spec.file,
+            self.inner.kind().name(),
+            self.inner.generation()
+        );
+        animats_evolve::Problem::scene_toml(problem.as_ref(), genome, &comment)
+            .map(Some)
+            .map_err(runtime_error)
     }
 }
 

@@ -90,3 +90,22 @@ def test_genes_outside_their_bounds_are_refused_unless_clipped(root):
     # hold them (Appendix B), so they are not refused.
     far = animats.ROOBOT_INITIAL * 3.0
     assert np.isfinite(animats.evaluate("roobot", far)[0])
+
+
+def test_an_optimiser_writes_its_best_as_a_scene(root):
+    path = root / "scenes" / "walker.toml"
+    opt = animats.Optimiser("cma-es", problem=str(path), seed=2)
+    assert opt.best_toml() is None, "nothing told yet"
+    scene = animats.load(path)
+    for _ in range(3):
+        g = opt.ask()
+        opt.tell(animats.evaluate(scene, g))
+    best, fitness = opt.best()
+    text = opt.best_toml()
+    assert "animats.Optimiser" in text.splitlines()[0]
+    back = animats.parse(text, "best.toml")
+    assert np.array_equal(back.start(), best)
+    # The written scene scores what the optimiser was told for its best.
+    assert animats.evaluate(back, back.start())[0] == fitness
+    with pytest.raises(ValueError, match="no problem"):
+        animats.Optimiser("cma-es", dim=3).best_toml()

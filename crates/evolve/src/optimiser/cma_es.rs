@@ -244,7 +244,10 @@ impl CmaEs {
             Some(bd) => y
                 .iter()
                 .enumerate()
-                .map(|(i, v)| bd.lo[i] + bd.width(i) * v.clamp(0.0, 1.0))
+                .map(|(i, v)| {
+                    // Clamped again: lo + width rounds past hi by an ulp.
+                    (bd.lo[i] + bd.width(i) * v.clamp(0.0, 1.0)).clamp(bd.lo[i], bd.hi[i])
+                })
                 .collect(),
             None => y.to_vec(),
         }

@@ -205,7 +205,10 @@ impl Qd {
             Some(b) => x
                 .iter()
                 .enumerate()
-                .map(|(i, v)| b.lo[i] + v.clamp(0.0, 1.0) * b.width(i))
+                .map(|(i, v)| {
+                    // Clamped again: lo + width rounds past hi by an ulp.
+                    (b.lo[i] + v.clamp(0.0, 1.0) * b.width(i)).clamp(b.lo[i], b.hi[i])
+                })
                 .collect(),
             None => x.to_vec(),
         }
