@@ -66,6 +66,13 @@ pub struct Args {
     /// stays open after the run until Ctrl-C.
     #[arg(long)]
     view: bool,
+    /// Record where the run's time goes (every ask, evaluation and tell:
+    /// its lane, generation, batch, thread, start and duration) into
+    /// DIR/schedule.csv, and print the wall time the run's own dependencies
+    /// predict for 1 to 64 workers, with and without the barrier at the
+    /// end of each batch of generations. The results are unchanged.
+    #[arg(long)]
+    schedule: bool,
     #[command(flatten)]
     serving: crate::view::Serving,
 }
@@ -370,6 +377,7 @@ fn evolve(
     pool: &rayon::ThreadPool,
     stop: &AtomicBool,
     board: Option<&BestBrain>,
+    tracer: Option<&animats_evolve::schedule::Tracer>,
 ) -> Result<bool, Failure> {
     // Built once for the whole run (a scene is parsed and checked here).
     let problem = state.config.problem.build().map_err(input)?;
@@ -385,7 +393,7 @@ fn evolve(
             return Ok(true);
         }
         let begun = Instant::now();
-        pool.install(|| state.advance_with(problem.as_ref(), batch))
+        pool.install(|| state.advance_traced(problem.as_ref(), batch, tracer))
             .map_err(Failure::Other)?;
         batch = animats_evolve::next_batch(batch, begun.elapsed());
         if let Some(board) = board {
@@ -399,6 +407,66 @@ fn evolve(
     }
     progress.bar.finish_and_clear();
     Ok(false)
+}
+
+/// Writes DIR/schedule.csv and prints the schedule model's predictions
+/// (`--schedule`), beside the `wall` s the run took on `threads`.
+fn report_schedule(
+    dir: &Path,
+    s: &animats_evolve::schedule::Schedule,
+    wall: f64,
+    threads: usize,
+) -> Result<(), Failure> {
+    use animats_evolve::schedule::Piece;
+    let mut csv = String::from("lane,generation,piece,candidate,batch,thread,start_s,seconds\n");
+    for w in &s.work {
+        let (piece, k) = match w.piece {
+            Piece::Ask => ("ask", String::new()),
+            Piece::Evaluate(k) => ("evaluate", k.to_string()),
+            Piece::Tell => ("tell", String::new()),
+        };
+        csv.push_str(&format!(
+            "{},{},{piece},{k},{},{},{:.9},{:.9}\n",
+            w.lane, w.generation, w.batch, w.thread, w.start, w.seconds
+        ));
+    }
+    animats_files::write_atomically(&dir.join("schedule.csv"), csv.as_bytes())
+        .map_err(|e| Failure::Other(e.to_string()))?;
+    let work = s.work_seconds();
+    let evaluations: Vec<f64> = s
+        .work
+        .iter()
+        .filter(|w| matches!(w.piece, Piece::Evaluate(_)))
+        .map(|w| w.seconds)
+        .collect();
+    let eval_sum: f64 = evaluations.iter().sum();
+    let batches = s.work.last().map_or(0, |w| w.batch + 1);
+    println!(
+        "schedule: {} evaluations ({:.3} s, mean {:.2} ms, longest {:.2} ms) and {:.3} s of asks and tells in {batches} batches; {work:.3} s of work in {wall:.3} s on {threads} threads",
+        evaluations.len(),
+        eval_sum,
+        1e3 * eval_sum / evaluations.len().max(1) as f64,
+        1e3 * evaluations.iter().cloned().fold(0.0, f64::max),
+        work - eval_sum,
+    );
+    println!(
+        "  critical path {:.3} s with batch barriers, {:.3} s without; predicted on {threads} threads {:.3} s (measured {wall:.3} s)",
+        s.critical_path(true),
+        s.critical_path(false),
+        s.makespan(threads, true)
+    );
+    println!("  workers   predicted wall   speed-up   without barriers");
+    let one = s.makespan(1, true);
+    for w in [1usize, 2, 4, 8, 16, 32, 64] {
+        let (a, b) = (s.makespan(w, true), s.makespan(w, false));
+        println!(
+            "  {w:>7}   {a:>12.3} s   {:>7.2}×   {b:>9.3} s {:>6.2}×",
+            one / a,
+            one / b
+        );
+    }
+    println!("wrote {}/schedule.csv", dir.display());
+    Ok(())
 }
 
 /// Runs the command.
@@ -422,9 +490,20 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let viewing = watch(&args, &state, &stop)?;
     let (start, evals_at_start) = (Instant::now(), state.evaluations);
     let board = viewing.as_ref().map(|(b, _)| b);
-    let interrupted = evolve(&args, &dir, &mut state, &pool, &stop, board)?;
-    save(&dir, &state, true)?;
+    let tracer = args
+        .schedule
+        .then(animats_evolve::schedule::Tracer::default);
+    let interrupted = evolve(
+        &args,
+        &dir,
+        &mut state,
+        &pool,
+        &stop,
+        board,
+        tracer.as_ref(),
+    )?;
     let wall = start.elapsed().as_secs_f64();
+    save(&dir, &state, true)?;
     let evals = state.evaluations - evals_at_start;
     println!(
         "{} lanes, generation {} of {}, seed {}: {evals} evaluations in {wall:.2} s ({:.0}/s, {threads} threads)",
@@ -479,6 +558,9 @@ pub fn run(args: Args) -> Result<(), Failure> {
             ""
         }
     );
+    if let Some(t) = &tracer {
+        report_schedule(&dir, &t.schedule(), wall, threads)?;
+    }
     if let Some((_, thread)) = viewing {
         if !interrupted {
             println!("the view stays open: Ctrl-C to stop");

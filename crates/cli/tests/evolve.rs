@@ -376,3 +376,75 @@ fn nonsense_counts_and_intervals_are_refused_with_a_plain_message() {
     }
     assert!(!std::path::Path::new(out).join("log.csv").exists());
 }
+
+/// `evolve --schedule` (issue 41) records the run's work without changing
+/// it: the log is the same bits as without the flag and at 1, 2 and 3
+/// threads; schedule.csv holds every evaluation; the model replays the
+/// run's own work (one worker: the sum of the durations).
+#[test]
+fn the_schedule_is_recorded_without_changing_the_run() {
+    let dir = scratch("schedule");
+    let run = |name: &str, threads: &str, schedule: bool| {
+        let out = dir.join(name);
+        let mut a = vec![
+            "evolve",
+            "--generations",
+            "6",
+            "--lanes",
+            "3",
+            "--seed",
+            "4",
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if schedule {
+            a.push("--schedule");
+        }
+        let o = animats(&a);
+        let (stdout, err) = text(&o);
+        assert!(o.status.success(), "{err}");
+        (
+            std::fs::read_to_string(out.join("log.csv")).unwrap(),
+            stdout,
+            out,
+        )
+    };
+    let (plain, _, _) = run("plain", "2", false);
+    for t in ["1", "2", "3"] {
+        let (log, stdout, out) = run(&format!("s{t}"), t, true);
+        assert_eq!(log, plain, "{t} threads");
+        let csv = std::fs::read_to_string(out.join("schedule.csv")).unwrap();
+        assert_eq!(
+            csv.lines().next(),
+            Some("lane,generation,piece,candidate,batch,thread,start_s,seconds")
+        );
+        // 3 lanes × 6 generations, each with an ask and a tell.
+        let rows: Vec<&str> = csv.lines().skip(1).collect();
+        let asks = rows.iter().filter(|r| r.contains(",ask,")).count();
+        let tells = rows.iter().filter(|r| r.contains(",tell,")).count();
+        let evals = rows.iter().filter(|r| r.contains(",evaluate,")).count();
+        assert_eq!((asks, tells), (18, 18), "{t} threads");
+        // As many as the run reports ("...: N evaluations in ...").
+        let evaluations: usize = stdout
+            .split(" evaluations in ")
+            .next()
+            .and_then(|h| h.rsplit(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap();
+        assert_eq!(evals, evaluations, "{t} threads");
+        assert!(stdout.contains("workers   predicted wall"), "{stdout}");
+        // One worker's predicted wall is the recorded work.
+        let work: f64 = rows
+            .iter()
+            .map(|r| r.rsplit(',').next().unwrap().parse::<f64>().unwrap())
+            .sum();
+        let line = stdout
+            .lines()
+            .find(|l| l.trim_start().starts_with("1 "))
+            .unwrap();
+        let one: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        assert!((one - work).abs() < 2e-3, "{one} vs {work}");
+    }
+}

@@ -13,6 +13,8 @@
 //!   ([`problem::SceneEvolution`] over `animats_scene::evaluate::SceneProblem`).
 //! - [`run::State`]: a run's lanes and log; `advance` moves it on.
 //! - [`checkpoint`]: save and load a run.
+//! - [`schedule`]: a run's work, recorded, and replayed on any number of
+//!   workers to predict its wall time.
 
 #![warn(missing_docs)]
 
@@ -21,6 +23,7 @@ pub mod checkpoint;
 pub mod optimiser;
 pub mod problem;
 pub mod run;
+pub mod schedule;
 
 pub use optimiser::{cma_es, ga, hill_climber};
 

@@ -529,13 +529,27 @@ impl State {
     /// [`State::advance`] with the problem already built from
     /// `self.config.problem` (a long run builds it once, not per batch).
     pub fn advance_with(&mut self, problem: &dyn Problem, generations: u64) -> Result<(), String> {
+        self.advance_traced(problem, generations, None)
+    }
+
+    /// [`State::advance_with`], its work recorded by `tracer` (as one batch)
+    /// when given: the same results, bit for bit.
+    pub fn advance_traced(
+        &mut self,
+        problem: &dyn Problem,
+        generations: u64,
+        tracer: Option<&crate::schedule::Tracer>,
+    ) -> Result<(), String> {
         let target = self.config.generations;
         let todo: Vec<u64> = self
             .lanes
             .iter()
             .map(|l| generations.min(target.saturating_sub(l.generation)))
             .collect();
-        let rows = advance_lanes(&mut self.lanes, &todo, problem)?;
+        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer)?;
+        if let Some(t) = tracer {
+            t.next_batch();
+        }
         self.extend_log(rows);
         Ok(())
     }
@@ -850,6 +864,7 @@ fn advance_lanes(
     lanes: &mut [Lane],
     todo: &[u64],
     problem: &dyn Problem,
+    tracer: Option<&crate::schedule::Tracer>,
 ) -> Result<Vec<LogRow>, String> {
     use std::sync::Mutex;
     struct Slot<'a> {
@@ -894,7 +909,7 @@ fn advance_lanes(
             b.slots[k].lane.take().map(|lane| (k, lane))
         };
         let Some((k, lane)) = taken else { return };
-        let result = advance_lane(lane, problem, 1);
+        let result = advance_lane(lane, problem, 1, tracer);
         let Ok(mut b) = board.lock() else { return };
         match result {
             Ok(rows) => b.rows.extend(rows),
@@ -946,16 +961,40 @@ fn lanes_len(todo: &[u64]) -> usize {
     todo.iter().filter(|&&n| n > 0).count()
 }
 
-/// Generations of one lane; rows in generation order.
-fn advance_lane(lane: &mut Lane, problem: &dyn Problem, n: u64) -> Result<Vec<LogRow>, String> {
+/// Generations of one lane; rows in generation order; each piece of work
+/// recorded by `tracer` if given.
+fn advance_lane(
+    lane: &mut Lane,
+    problem: &dyn Problem,
+    n: u64,
+    tracer: Option<&crate::schedule::Tracer>,
+) -> Result<Vec<LogRow>, String> {
+    use crate::schedule::Piece;
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {
+        let (k, g) = (lane.lane, lane.generation);
+        let began = std::time::Instant::now();
         let population = lane.optimiser.ask_with(problem.variation())?;
+        if let Some(t) = tracer {
+            t.done(k, g, Piece::Ask, began);
+        }
         let outcomes: Vec<Outcome> = population
             .par_iter()
-            .map(|g| problem.evaluate(g))
+            .enumerate()
+            .map(|(i, genome)| {
+                let began = std::time::Instant::now();
+                let o = problem.evaluate(genome);
+                if let Some(t) = tracer {
+                    t.done(k, g, Piece::Evaluate(i), began);
+                }
+                o
+            })
             .collect::<Result<_, _>>()?;
+        let began = std::time::Instant::now();
         rows.push(record(lane, Some(problem), population, &outcomes)?);
+        if let Some(t) = tracer {
+            t.done(k, g, Piece::Tell, began);
+        }
     }
     Ok(rows)
 }

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Evolution's scaling with threads (issue 41): the three runs of the issue
+# at 1, 2, 4, 8 and 16 threads, wall time and speed-up each, every log
+# checked identical; then the schedule model's prediction (`evolve
+# --schedule`) from each row's 1-thread run, to set beside the measured.
+#
+# Builds nothing: it takes the release binary built elsewhere (carry it to
+# a many-core machine in an ignored folder):
+#   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
+#   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
+# About 2 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+B=${ANIMATS:-target/carry/animats}
+[ -x "$B" ] || B=target/release/animats
+[ -x "$B" ] || { echo "no animats binary: build it (cargo build --release)" >&2; exit 2; }
+THREADS=${THREADS:-"1 2 4 8 16"}
+OUT=$(mktemp -d)
+trap 'rm -rf "$OUT"' EXIT
+echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%d)"
+rows=(
+  "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
+  "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
+  "quadruped3|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1"
+)
+header="| run |"; rule="|---|"
+for t in $THREADS; do header+=" $t |"; rule+="---|"; done
+echo; echo "$header speed-up at ${THREADS##* } |"; echo "$rule---|"
+for row in "${rows[@]}"; do
+  name=${row%%|*}; args=${row#*|}
+  line="| $name |"; first=""; last=""
+  for t in $THREADS; do
+    start=$(date +%s.%N)
+    # shellcheck disable=SC2086
+    "$B" evolve $args --threads "$t" --out "$OUT/$name-$t" > "$OUT/$name-$t.txt" 2>&1
+    wall=$(echo "$(date +%s.%N) - $start" | bc -l)
+    [ -z "$first" ] && first=$wall
+    last=$wall
+    if ! cmp -s "$OUT/$name-${THREADS%% *}/log.csv" "$OUT/$name-$t/log.csv"; then
+      echo "$name: the log at $t threads differs from the first" >&2; exit 1
+    fi
+    line+=" $(printf '%.2f' "$wall") s |"
+  done
+  echo "$line $(printf '%.1f' "$(echo "$first / $last" | bc -l)")× |"
+done
+echo
+echo "schedule model (evolve --schedule), from each row's 1-thread run:"
+for row in "${rows[@]}"; do
+  name=${row%%|*}; args=${row#*|}
+  echo "== $name"
+  # shellcheck disable=SC2086
+  "$B" evolve $args --threads 1 --schedule --out "$OUT/$name-schedule" 2>&1 | sed -n '/^schedule:/,/^wrote .*schedule.csv/p'
+done

@@ -1,0 +1,372 @@
+//! Where an evolution's time goes, and what more workers would make of it:
+//! a [`Tracer`] records every piece of work of a run (each lane's `ask`,
+//! each candidate's evaluation, each `tell`, with its duration, its thread
+//! and the batch it ran in), and a [`Schedule`] replays that work on any
+//! number of workers under the run's own dependencies — a lane's
+//! generations one after another, a generation's evaluations after its
+//! `ask` and before its `tell`, and (as `animats evolve` runs) every
+//! worker waiting for the slowest lane at the end of each batch — to
+//! predict the run's wall time. `animats evolve --schedule` prints the
+//! prediction for 1 to 64 workers from a run on the cores at hand.
+//!
+//! The replay is greedy list scheduling (Graham's): a free worker takes the
+//! ready piece that comes first in the order the run's own scheduler would
+//! reach it — the lane that has done the fewest generations of its batch,
+//! then the lowest lane, then the candidate's index. Its makespan `T(W)`
+//! lies between `max(work / W, critical path)` and `work / W + critical
+//! path` (Graham, 1969); the tests check both. It models no contention
+//! (memory bandwidth, frequency scaling): the prediction is what the
+//! dependencies and the measured durations allow.
+
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// What a piece of work was.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Piece {
+    /// The optimiser asking for a generation.
+    Ask,
+    /// Candidate `k`'s evaluation.
+    Evaluate(usize),
+    /// The optimiser told the generation's outcomes (and the log row).
+    Tell,
+}
+
+/// One piece of work of a run.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Work {
+    /// Its lane.
+    pub lane: usize,
+    /// Its generation (the lane's, 0-based).
+    pub generation: u64,
+    /// What it was.
+    pub piece: Piece,
+    /// The batch (the run's `advance` call) it ran in, 0-based.
+    pub batch: usize,
+    /// The rayon thread that ran it (0 outside a pool).
+    pub thread: usize,
+    /// When it started, s after the tracer was made.
+    pub start: f64,
+    /// How long it took, s.
+    pub seconds: f64,
+}
+
+/// Records a run's work as it happens (many threads at once).
+#[derive(Debug)]
+pub struct Tracer {
+    origin: Instant,
+    work: Mutex<Vec<Work>>,
+    batch: Mutex<usize>,
+}
+
+impl Default for Tracer {
+    fn default() -> Self {
+        Tracer {
+            origin: Instant::now(),
+            work: Mutex::new(Vec::new()),
+            batch: Mutex::new(0),
+        }
+    }
+}
+
+impl Tracer {
+    /// Starts timing a piece (the instant to hand back to [`Tracer::done`]).
+    pub fn begin(&self) -> Instant {
+        Instant::now()
+    }
+
+    /// Records a piece that started at `began`.
+    pub fn done(&self, lane: usize, generation: u64, piece: Piece, began: Instant) {
+        let seconds = began.elapsed().as_secs_f64();
+        let start = began.duration_since(self.origin).as_secs_f64();
+        let batch = *self.batch.lock().unwrap_or_else(|p| p.into_inner());
+        let w = Work {
+            lane,
+            generation,
+            piece,
+            batch,
+            thread: rayon::current_thread_index().unwrap_or(0),
+            start,
+            seconds,
+        };
+        self.work.lock().unwrap_or_else(|p| p.into_inner()).push(w);
+    }
+
+    /// The next pieces belong to the next batch.
+    pub fn next_batch(&self) {
+        *self.batch.lock().unwrap_or_else(|p| p.into_inner()) += 1;
+    }
+
+    /// Everything recorded, in a fixed order (batch, lane, generation,
+    /// piece), whatever order the threads finished in.
+    pub fn schedule(&self) -> Schedule {
+        let mut work = self.work.lock().unwrap_or_else(|p| p.into_inner()).clone();
+        work.sort_by(|a, b| {
+            (a.batch, a.lane, a.generation, a.piece).cmp(&(b.batch, b.lane, b.generation, b.piece))
+        });
+        Schedule { work }
+    }
+}
+
+/// A run's recorded work, to replay.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Schedule {
+    /// Every piece, ordered by (batch, lane, generation, piece).
+    pub work: Vec<Work>,
+}
+
+/// One lane-generation of a batch, as the replay sees it.
+struct Step {
+    lane: usize,
+    /// Its rank among the lane's generations in the batch.
+    rank: u64,
+    ask: f64,
+    evaluations: Vec<f64>,
+    tell: f64,
+}
+
+impl Schedule {
+    /// The sum of every piece's duration, s: one worker's wall time.
+    pub fn work_seconds(&self) -> f64 {
+        self.work.iter().map(|w| w.seconds).sum()
+    }
+
+    /// The longest chain of dependent pieces, s (batch barriers included
+    /// when `barriers`): no number of workers is faster.
+    pub fn critical_path(&self, barriers: bool) -> f64 {
+        let mut total = 0.0;
+        let mut lanes: std::collections::BTreeMap<usize, f64> = Default::default();
+        for batch in self.batches() {
+            let mut in_batch: std::collections::BTreeMap<usize, f64> = Default::default();
+            for s in batch {
+                let longest = s.evaluations.iter().cloned().fold(0.0, f64::max);
+                *in_batch.entry(s.lane).or_default() += s.ask + longest + s.tell;
+            }
+            if barriers {
+                total += in_batch.values().cloned().fold(0.0, f64::max);
+            } else {
+                for (lane, t) in in_batch {
+                    *lanes.entry(lane).or_default() += t;
+                }
+            }
+        }
+        if barriers {
+            total
+        } else {
+            lanes.values().cloned().fold(0.0, f64::max)
+        }
+    }
+
+    /// The batches, each a list of lane-generations in (lane, generation)
+    /// order.
+    fn batches(&self) -> Vec<Vec<Step>> {
+        let mut out: Vec<Vec<Step>> = Vec::new();
+        let mut last: Option<(usize, usize, u64)> = None;
+        let mut rank: std::collections::BTreeMap<(usize, usize), u64> = Default::default();
+        for w in &self.work {
+            if out.len() <= w.batch {
+                out.resize_with(w.batch + 1, Vec::new);
+            }
+            let key = (w.batch, w.lane, w.generation);
+            if last != Some(key) {
+                let r = rank.entry((w.batch, w.lane)).or_default();
+                out[w.batch].push(Step {
+                    lane: w.lane,
+                    rank: *r,
+                    ask: 0.0,
+                    evaluations: Vec::new(),
+                    tell: 0.0,
+                });
+                *r += 1;
+                last = Some(key);
+            }
+            let Some(step) = out[w.batch].last_mut() else {
+                continue;
+            };
+            match w.piece {
+                Piece::Ask => step.ask += w.seconds,
+                Piece::Evaluate(_) => step.evaluations.push(w.seconds),
+                Piece::Tell => step.tell += w.seconds,
+            }
+        }
+        out
+    }
+
+    /// The predicted wall time on `workers` workers, s: every batch
+    /// replayed by greedy list scheduling, each ending when its slowest
+    /// lane does (`barriers`, as `animats evolve` runs today) or the whole
+    /// run as one batch (lanes never waiting for each other).
+    pub fn makespan(&self, workers: usize, barriers: bool) -> f64 {
+        let workers = workers.max(1);
+        let batches = self.batches();
+        if barriers {
+            batches.iter().map(|b| replay(b, workers)).sum()
+        } else {
+            let mut all: Vec<Step> = Vec::new();
+            let mut done: std::collections::BTreeMap<usize, u64> = Default::default();
+            for b in batches {
+                for mut s in b {
+                    let d = done.entry(s.lane).or_default();
+                    s.rank = *d;
+                    *d += 1;
+                    all.push(s);
+                }
+            }
+            all.sort_by_key(|s| (s.lane, s.rank));
+            replay(&all, workers)
+        }
+    }
+}
+
+/// Greedy list scheduling of one batch's lane-generations on `workers`
+/// workers; the makespan, s.
+fn replay(steps: &[Step], workers: usize) -> f64 {
+    use std::cmp::Reverse;
+    use std::collections::{BTreeSet, BinaryHeap, HashMap};
+    // A task: (step index, what). Ready tasks are ordered as the run's
+    // scheduler reaches them: fewest generations done, lane, then piece.
+    #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+    enum What {
+        Ask,
+        Evaluate(usize),
+        Tell,
+    }
+    /// A task's place in the order the run's scheduler reaches it.
+    type Key = (u64, usize, What, usize);
+    let order = |i: usize, what: What| -> Key { (steps[i].rank, steps[i].lane, what, i) };
+    // Each lane's steps in order: the next one becomes ready when the
+    // previous one's tell ends.
+    let mut next_of: HashMap<usize, usize> = HashMap::new();
+    let mut first: Vec<usize> = Vec::new();
+    {
+        let mut by_lane: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+        for (i, s) in steps.iter().enumerate() {
+            by_lane.entry(s.lane).or_default().push(i);
+        }
+        for list in by_lane.values() {
+            let mut sorted = list.clone();
+            sorted.sort_by_key(|&i| steps[i].rank);
+            first.push(sorted[0]);
+            for w in sorted.windows(2) {
+                next_of.insert(w[0], w[1]);
+            }
+        }
+    }
+    let mut ready: BTreeSet<Key> = BTreeSet::new();
+    for &i in &first {
+        ready.insert(order(i, What::Ask));
+    }
+    // Running tasks by end time (ties by order, for determinism).
+    let mut running: BinaryHeap<Reverse<(u64, Key)>> = BinaryHeap::new();
+    let mut left: Vec<usize> = steps.iter().map(|s| s.evaluations.len()).collect();
+    let (mut now, mut free) = (0.0f64, workers);
+    // Time in integer nanoseconds inside the heap, so that it orders totally.
+    let nanos = |t: f64| (t * 1e9).round() as u64;
+    loop {
+        while free > 0 {
+            let Some(&task) = ready.iter().next() else {
+                break;
+            };
+            ready.remove(&task);
+            let (_, _, what, i) = task;
+            let seconds = match what {
+                What::Ask => steps[i].ask,
+                What::Evaluate(k) => steps[i].evaluations[k],
+                What::Tell => steps[i].tell,
+            };
+            running.push(Reverse((nanos(now + seconds), task)));
+            free -= 1;
+        }
+        let Some(Reverse((end, (_, _, what, i)))) = running.pop() else {
+            break;
+        };
+        now = end as f64 * 1e-9;
+        free += 1;
+        match what {
+            What::Ask => {
+                if steps[i].evaluations.is_empty() {
+                    ready.insert(order(i, What::Tell));
+                }
+                for k in 0..steps[i].evaluations.len() {
+                    ready.insert(order(i, What::Evaluate(k)));
+                }
+            }
+            What::Evaluate(_) => {
+                left[i] -= 1;
+                if left[i] == 0 {
+                    ready.insert(order(i, What::Tell));
+                }
+            }
+            What::Tell => {
+                if let Some(&n) = next_of.get(&i) {
+                    ready.insert(order(n, What::Ask));
+                }
+            }
+        }
+    }
+    now
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A made-up run: `lanes` lanes, `generations` each in batches of
+    /// `per_batch`, `population` candidates of uneven length.
+    fn run(lanes: usize, generations: u64, per_batch: u64, population: usize) -> Schedule {
+        let mut work = Vec::new();
+        for g in 0..generations {
+            for lane in 0..lanes {
+                let batch = (g / per_batch) as usize;
+                let w = |piece, seconds| Work {
+                    lane,
+                    generation: g,
+                    piece,
+                    batch,
+                    thread: 0,
+                    start: 0.0,
+                    seconds,
+                };
+                work.push(w(Piece::Ask, 0.001));
+                for k in 0..population {
+                    let s = 0.01 * (1.0 + ((lane * 7 + k * 3 + g as usize) % 5) as f64);
+                    work.push(w(Piece::Evaluate(k), s));
+                }
+                work.push(w(Piece::Tell, 0.002));
+            }
+        }
+        let mut s = Schedule { work };
+        s.work.sort_by(|a, b| {
+            (a.batch, a.lane, a.generation, a.piece).cmp(&(b.batch, b.lane, b.generation, b.piece))
+        });
+        s
+    }
+
+    #[test]
+    fn the_replay_keeps_within_grahams_bounds() {
+        let s = run(6, 12, 4, 12);
+        let work = s.work_seconds();
+        for barriers in [true, false] {
+            let path = s.critical_path(barriers);
+            // One worker: the sum of the work, to rounding.
+            assert!((s.makespan(1, barriers) - work).abs() < 1e-6);
+            for w in [2, 3, 4, 8, 16, 64, 1000] {
+                let t = s.makespan(w, barriers);
+                let lower = (work / w as f64).max(path);
+                // Graham: each batch is within work/W + its path.
+                let batches = 3.0;
+                let upper = work / w as f64 + path + batches * 1e-6;
+                assert!(
+                    t >= lower - 1e-6 && t <= upper,
+                    "{w}: {lower} ≤ {t} ≤ {upper}"
+                );
+            }
+            // Unbounded workers: the critical path.
+            assert!((s.makespan(10_000, barriers) - path).abs() < 1e-6);
+        }
+        // Barriers only cost.
+        assert!(s.makespan(16, false) <= s.makespan(16, true) + 1e-9);
+        // The replay is a pure function of the schedule.
+        assert_eq!(s.makespan(7, true), s.makespan(7, true));
+    }
+}
