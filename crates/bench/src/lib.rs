@@ -419,7 +419,10 @@ pub fn run(name: &str, opts: Options) -> Result<Vec<Row>, String> {
     let runs = opts.runs.max(5);
     match name {
         "chain-64" | "cloth-32" | "cloth-128" => Ok(run_mass_spring(name, runs)),
-        "nbody5" => Ok(vec![run_nbody5(opts.quick, runs)]),
+        "nbody5" => Ok(vec![
+            run_nbody5(opts.quick, runs, false),
+            run_nbody5(opts.quick, runs, true),
+        ]),
         "allpairs-1000" => Ok(run_allpairs(opts.quick, runs)),
         "hopper" => hopper::run(opts.quick, runs),
         "brains" => brains::run(opts.quick, runs),
@@ -627,12 +630,15 @@ fn run_mass_spring(name: &str, runs: usize) -> Vec<Row> {
     rows
 }
 
-fn run_nbody5(quick: bool, runs: usize) -> Row {
+/// nbody5 through the engine: the tutorial's user force, or the built-in
+/// n-body force (`builtin`).
+fn run_nbody5(quick: bool, runs: usize, builtin: bool) -> Row {
     use nbody5::*;
     let steps = if quick { 5_000_000 } else { 50_000_000 };
+    let make = if builtin { builtin_world } else { engine_world };
     let (engine, baseline, world, reference) = measure_pair(
         runs,
-        engine_world,
+        make,
         |w| {
             for _ in 0..steps {
                 w.step(DT).expect("n-body stays finite");
@@ -645,7 +651,7 @@ fn run_nbody5(quick: bool, runs: usize) -> Row {
             }
         },
     );
-    let mut short = engine_world();
+    let mut short = make();
     let e0 = world_energy(&short);
     for _ in 0..1000 {
         short.step(DT).expect("n-body stays finite");
@@ -678,7 +684,11 @@ fn run_nbody5(quick: bool, runs: usize) -> Row {
     ));
     Row {
         workload: "nbody5".into(),
-        variant: "symplectic, user force".into(),
+        variant: if builtin {
+            "symplectic, built-in force".into()
+        } else {
+            "symplectic, user force".into()
+        },
         particles: 5,
         springs: 0,
         steps,

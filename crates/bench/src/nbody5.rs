@@ -1,6 +1,7 @@
 //! `nbody5`: the Computer Language Benchmarks Game's n-body
 //! (`docs/WORKLOADS.md`), run through the engine with the tutorial's user-defined
-//! force (`examples/nbody/gravity.rs`), beside the reference scalar `advance`.
+//! force (`examples/nbody/gravity.rs`) and with the built-in n-body force,
+//! beside the reference scalar `advance`.
 
 use animats_engine::{DVec3, IntegratorKind, ParticleDef, World};
 use std::f64::consts::PI;
@@ -105,6 +106,25 @@ pub fn engine_world() -> World {
     }
     let bodies: Vec<_> = w.particle_ids().collect();
     w.add_force(Box::new(tutorial::NBodyGravity::new(1.0, &bodies)));
+    w
+}
+
+/// The same system with the engine's built-in n-body force
+/// ([`animats_engine::NBodyGravity`], G = 1, no softening) instead of the
+/// tutorial's user force.
+pub fn builtin_world() -> World {
+    let mut w = World::new();
+    w.set_integrator(IntegratorKind::Symplectic);
+    for (p, v, m) in bodies() {
+        w.add_particle(ParticleDef::new(m).at(p).with_velocity(v))
+            .expect("valid body");
+    }
+    w.add_nbody(animats_engine::NBodyGravity::new(
+        1.0,
+        0.0,
+        animats_engine::Targets::All,
+    ))
+    .expect("valid n-body force");
     w
 }
 
