@@ -4,7 +4,10 @@
 //! blows up) and score it with the thesis's form (§3.2.1.6):
 //! `fitness = time_weight × time survived + distance_weight × distance`,
 //! the distance being how far the centre of mass of `particles` moved along
-//! `axis`. A run that blows up keeps the time it survived but no forward
+//! `axis`, less `energy_weight` × the actuators' positive work
+//! ([`crate::work`]) and `target_weight` × the final distance from
+//! `target`, plus each of `terms` (archive measures) times its weight;
+//! [`score`] averages (or takes the worst of) `trials` perturbed runs. A run that blows up keeps the time it survived but no forward
 //! distance (only a backward one), so that an optimiser cannot profit from
 //! an explosion that flings the body ahead.
 //!
@@ -543,19 +546,6 @@ pub fn evaluate(scene: Scene) -> Result<Evaluation, String> {
     evaluate_with(scene, |_| {})
 }
 
-/// `[evolve] robust = true`: the evaluation of `make()` at its step and of
-/// another `make()` at half of it; the worse fitness counts (the first of
-/// equals; NaN is worst). A body tuned to the step's errors, which loses
-/// its gait when the step is refined, scores as it would at the finer
-/// step.
-pub fn evaluate_robust(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
-    let first = evaluate(make()?)?;
-    let mut fine = make()?;
-    fine.dt *= 0.5;
-    let second = evaluate(fine)?;
-    Ok(worse(first, second))
-}
-
 /// The worse of two evaluations (the first of equals; NaN is worst).
 fn worse(first: Evaluation, second: Evaluation) -> Evaluation {
     let sane = |f: f64| if f.is_nan() { f64::NEG_INFINITY } else { f };
@@ -568,8 +558,11 @@ fn worse(first: Evaluation, second: Evaluation) -> Evaluation {
 
 /// Scores the scene `make()` builds as its `[evolve]` table says: once, or
 /// `trials` times, trial `k` perturbed by `noise` from the scene's seed and
-/// `k` ([`perturb`]: the same perturbations for every genome), each trial
-/// robust if the table asks; the mean of the trials counts (every figure
+/// `k` ([`perturb`]: the same perturbations for every genome; without
+/// noise every trial is the same run, evaluated once); with `robust = true`
+/// each trial also at half the scene's step, the worse counting (the first
+/// of equals; NaN is worst: a gait tuned to the step's errors scores as it
+/// would at the finer step); the mean of the trials counts (every figure
 /// averaged, the ending the worst trial's), or with `aggregate = "worst"`
 /// the worst trial.
 pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
@@ -578,7 +571,11 @@ pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, Str
         .evolve
         .clone()
         .ok_or("the scene has no [evolve] table: nothing to evaluate")?;
-    let perturbed = spec.trials > 1 || spec.noise > 0.0;
+    // Without noise every trial is the same run: one is enough.
+    let perturbed = spec.noise > 0.0;
+    let trials = if perturbed { spec.trials } else { 1 };
+    // Trial k from `scene` (the first build, reused) or a fresh one,
+    // perturbed; robust: again at half the step, the worse counting.
     let one = |k: u32, scene: Option<Scene>| -> Result<Evaluation, String> {
         let build = || -> Result<Scene, String> {
             let mut s = make()?;
@@ -587,21 +584,32 @@ pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, Str
             }
             Ok(s)
         };
-        if spec.robust {
-            evaluate_robust(build)
-        } else {
-            match scene {
-                Some(s) if !perturbed => evaluate(s),
-                _ => evaluate(build()?),
+        let full = evaluate(match scene {
+            Some(mut s) => {
+                if perturbed {
+                    perturb(&mut s, k)?;
+                }
+                s
             }
+            None => build()?,
+        })?;
+        if !spec.robust {
+            return Ok(full);
         }
+        let mut fine = build()?;
+        fine.dt *= 0.5;
+        Ok(worse(full, evaluate(fine)?))
     };
-    if !perturbed {
-        return one(0, Some(first));
-    }
-    let trials = (0..spec.trials)
-        .map(|k| one(k, None))
+    let mut first = Some(first);
+    let trials = (0..trials)
+        .map(|k| one(k, first.take()))
         .collect::<Result<Vec<_>, String>>()?;
+    if !perturbed {
+        return trials
+            .into_iter()
+            .next()
+            .ok_or_else(|| "no trial".to_string());
+    }
     Ok(aggregate(trials, spec.aggregate))
 }
 

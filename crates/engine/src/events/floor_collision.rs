@@ -123,8 +123,8 @@ struct Hit {
     accel: f64,
     /// The surface's outward normal (`+y` on the flat floor).
     normal: DVec3,
-    /// The gap between the sphere and the surface, < 0 (on terrain: on
-    /// the flat floor it is read from the position).
+    /// The gap between the sphere and the surface, < 0 (used on terrain;
+    /// the flat floor reads it from the position).
     gap: f64,
 }
 

@@ -92,31 +92,9 @@ impl FloorContact {
         }
         let normal = -f.y;
         f.y = 0.0;
-        let m = p.mass[i];
         let vt = DVec3::new(v.x, 0.0, v.z);
         let ft = DVec3::new(f.x, 0.0, f.z);
-        let speed = vt.length();
-        if speed < self.static_speed {
-            // Static friction: hold the particle still (cancel the applied
-            // tangential force and the residual slip) if it can.
-            let hold = -ft - vt * (m / ctx.dt);
-            let needed = hold.length();
-            if needed <= p.mu_s[i] * normal {
-                *f += hold;
-                return;
-            }
-            // It breaks away: kinetic friction opposes the slip that the
-            // applied force produces (the direction of `-hold`), not a
-            // residual velocity that may be roundoff.
-            *f += hold * ((p.mu_k[i] * normal).min(needed) / needed);
-            return;
-        }
-        // Kinetic friction against the sliding, capped so that it never
-        // reverses the sliding within one step (thesis §3.1.2.7).
-        let dir = vt / speed;
-        let stop = m * speed / ctx.dt + ft.dot(dir); // friction that would just stop it
-        let kinetic = (p.mu_k[i] * normal).min(stop.max(0.0));
-        *f -= dir * kinetic;
+        *f += self.friction(ctx, i, vt, ft, normal);
     }
 }
 
@@ -150,21 +128,34 @@ impl FloorContact {
         let residual = if vn.abs() <= ROUNDING_SPEED { vn } else { 0.0 };
         *f = ft - n * (residual * m / ctx.dt);
         let vt = v - n * vn;
+        *f += self.friction(ctx, i, vt, ft, normal);
+    }
+
+    /// The friction on resting sphere `i` sliding at `vt` under the
+    /// tangential force `ft`, pressed with `normal` (thesis §3.1.2.7):
+    /// below `static_speed` static friction holds it (cancels the applied
+    /// tangential force and the residual slip) up to `μs N`, and past that
+    /// kinetic friction `μk N` opposes the slip the applied force produces
+    /// (the direction of the hold, not a residual velocity that may be
+    /// roundoff); otherwise kinetic friction against the sliding, capped
+    /// so that it never reverses the sliding within one step.
+    #[inline(always)]
+    fn friction(&self, ctx: &ForceContext, i: usize, vt: DVec3, ft: DVec3, normal: f64) -> DVec3 {
+        let p = &ctx.particles;
+        let m = p.mass[i];
         let speed = vt.length();
         if speed < self.static_speed {
             let hold = -ft - vt * (m / ctx.dt);
             let needed = hold.length();
             if needed <= p.mu_s[i] * normal {
-                *f += hold;
-                return;
+                return hold;
             }
-            *f += hold * ((p.mu_k[i] * normal).min(needed) / needed);
-            return;
+            return hold * ((p.mu_k[i] * normal).min(needed) / needed);
         }
         let dir = vt / speed;
-        let stop = m * speed / ctx.dt + ft.dot(dir);
+        let stop = m * speed / ctx.dt + ft.dot(dir); // friction that would just stop it
         let kinetic = (p.mu_k[i] * normal).min(stop.max(0.0));
-        *f -= dir * kinetic;
+        -(dir * kinetic)
     }
 
     /// [`Force::apply`], split like the world's per-particle loops when
