@@ -442,12 +442,13 @@ fn report_schedule(
     let eval_sum: f64 = evaluations.iter().sum();
     let batches = s.work.last().map_or(0, |w| w.batch + 1);
     println!(
-        "schedule: {} evaluations ({:.3} s, mean {:.2} ms, longest {:.2} ms) and {:.3} s of asks and tells in {batches} batches; {work:.3} s of work in {wall:.3} s on {threads} threads",
+        "schedule: {} evaluations ({:.3} s, mean {:.2} ms, longest {:.2} ms) and {:.3} s of asks and tells in {batches} batches; {work:.3} s of work in {wall:.3} s on {threads} threads (busy {:.1} % of the time)",
         evaluations.len(),
         eval_sum,
         1e3 * eval_sum / evaluations.len().max(1) as f64,
         1e3 * evaluations.iter().cloned().fold(0.0, f64::max),
         work - eval_sum,
+        100.0 * work / (wall * threads as f64).max(1e-12),
     );
     println!(
         "  critical path {:.3} s with batch barriers, {:.3} s without; predicted on {threads} threads {:.3} s (measured {wall:.3} s)",
