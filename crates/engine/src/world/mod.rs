@@ -441,9 +441,22 @@ impl World {
     /// terrain; the plane y = 0 without a floor), m: negative when it is
     /// inside it. On a heightfield, more than 8 cells from the surface,
     /// it is the distance to the surface within 8 cells across.
+    #[inline]
     pub fn clearance(&self, p: ParticleId) -> f64 {
+        // The flat floor's contact force answers without a search (the
+        // roobot asks several times a step).
+        if let Some(f) = &self.forces.floor {
+            if f.terrain.is_flat() {
+                return self.position(p).y - self.particles().radius[p.index()];
+            }
+        }
+        self.clearance_searched(p)
+    }
+
+    /// [`World::clearance`] from the floor's collision event.
+    #[inline(never)]
+    fn clearance_searched(&self, p: ParticleId) -> f64 {
         let (x, r) = (self.position(p), self.particles().radius[p.index()]);
-        // The contact force holds the same terrain, without a search.
         let terrain = match &self.forces.floor {
             Some(f) => Some(&*f.terrain),
             None => self.terrain(),
