@@ -389,21 +389,14 @@ impl Cameras {
             return;
         }
         let radius = &stage.scene().world.particles().radius;
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for &i in &self.watched {
-            let (p, r) = (at_start.positions[i], radius[i]);
-            lo = lo.min(p - DVec3::splat(r));
-            hi = hi.max(p + DVec3::splat(r));
-        }
-        let extent = hi - lo;
-        let across = DVec3::new(extent.x, 0.0, extent.z).length().max(0.05);
-        let tall = extent.y.max(0.05);
-        let tan = (0.5 * args.fov.to_radians()).tan();
         let aspect = f64::from(args.width) / f64::from(args.height.max(1));
-        let distance = (across / (0.4 * 2.0 * tan * aspect))
-            .max(tall / (0.6 * 2.0 * tan))
-            .max(0.3);
-        let centre = 0.5 * (lo + hi);
+        let spheres = self
+            .watched
+            .iter()
+            .map(|&i| (at_start.positions[i], radius[i]));
+        let Some((centre, distance)) = animats_view::snug(spheres, args.fov, aspect) else {
+            return;
+        };
         self.base = Camera::framing(DVec3::new(centre.x, centre.y.max(0.0), centre.z), distance);
     }
 

@@ -70,11 +70,6 @@ impl Default for Tracer {
 }
 
 impl Tracer {
-    /// Starts timing a piece (the instant to hand back to [`Tracer::done`]).
-    pub fn begin(&self) -> Instant {
-        Instant::now()
-    }
-
     /// Records a piece that started at `began`.
     pub fn done(&self, lane: usize, generation: u64, piece: Piece, began: Instant) {
         let seconds = began.elapsed().as_secs_f64();

@@ -106,6 +106,19 @@ fn obs<'py>(py: Python<'py>, e: &dyn animats_creatures::env::Env) -> Bound<'py, 
 #[pyclass(module = "animats")]
 pub struct Env {
     env: Mutex<SceneEnv>,
+    /// The moving spheres (centre, radius) at the reset, which `render`
+    /// frames.
+    body: Mutex<Vec<(animats_engine::DVec3, f64)>>,
+}
+
+/// The moving spheres of `env`'s world now, (centre, radius).
+fn body(env: &SceneEnv) -> Vec<(animats_engine::DVec3, f64)> {
+    let w = &env.scene().world;
+    let p = w.particles();
+    w.particle_ids()
+        .filter(|id| p.inv_mass[id.index()] > 0.0)
+        .map(|id| (w.position(id), p.radius[id.index()]))
+        .collect()
 }
 
 impl Env {
@@ -141,6 +154,7 @@ impl Env {
         let env =
             Recipe::new(scene, seconds, dt, frame_skip, act_hz, observation)?.make_scene(noise)?;
         Ok(Env {
+            body: Mutex::new(body(&env)),
             env: Mutex::new(env),
         })
     }
@@ -178,7 +192,8 @@ impl Env {
 
     /// The scene now, drawn by the software renderer (`animats render`'s):
     /// a `(height, width, 3)` uint8 array, the camera following the
-    /// `[evolve]` particles and framing the body as it was at the reset.
+    /// `[evolve]` particles and framing the body as it was at the reset
+    /// (`animats render`'s snug framing).
     #[pyo3(signature = (width = 480, height = 320))]
     fn render<'py>(
         &self,
@@ -191,13 +206,12 @@ impl Env {
                 "width and height must be between 16 and 4096 pixels, got {width} × {height}"
             )));
         }
-        let (picture, camera) = {
-            let e = self.lock()?;
-            picture(
-                &e,
-                e.framing_distance(50.0, f64::from(width) / f64::from(height)),
-            )
+        let aspect = f64::from(width) / f64::from(height);
+        let distance = {
+            let start = self.body.lock().map_err(|_| runtime_error("poisoned"))?;
+            animats_view::snug(start.iter().copied(), 50.0, aspect).map_or(3.0, |(_, d)| d)
         };
+        let (picture, camera) = picture(&*self.lock()?, distance);
         let rgb = py.detach(|| animats_render::render(&picture, &camera, width, height).rgb);
         let a = Array3::from_shape_vec((height as usize, width as usize, 3), rgb)
             .map_err(runtime_error)?;
@@ -209,6 +223,7 @@ impl Env {
     fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let mut e = self.lock()?;
         e.reset(seed).map_err(runtime_error)?;
+        *self.body.lock().map_err(|_| runtime_error("poisoned"))? = body(&e);
         Ok(obs(py, &*e))
     }
 

@@ -57,7 +57,6 @@ pub struct SceneEnv {
     observations: Vec<String>,
     start: DVec3,
     last: DVec3,
-    steps: u64,
     fitness: f64,
     over: bool,
     /// The step, when it is not the scene's.
@@ -74,8 +73,6 @@ pub struct SceneEnv {
     physics_steps: u64,
     /// Why the episode ended, once it has.
     ended: Option<Ended>,
-    /// The moving particles' bounding box at the reset (spheres included).
-    extent: (DVec3, DVec3),
 }
 
 impl SceneEnv {
@@ -121,7 +118,6 @@ impl SceneEnv {
             observations,
             start: DVec3::ZERO,
             last: DVec3::ZERO,
-            steps: 0,
             fitness: 0.0,
             over: false,
             dt: None,
@@ -131,7 +127,6 @@ impl SceneEnv {
             work: Work::default(),
             physics_steps: 0,
             ended: None,
-            extent: (DVec3::ZERO, DVec3::ZERO),
         };
         // A scene without sensors observes its state.
         if env.scene.nervous.sensors.is_empty() {
@@ -276,21 +271,6 @@ impl SceneEnv {
         self.spec.centre(&self.scene.world)
     }
 
-    /// How far a camera with a vertical field of view of `fov` degrees on
-    /// a picture `aspect` wide per unit high stands so that the body's
-    /// extent at the reset fills 40 % of the width (or 60 % of the height),
-    /// as `animats render` frames a creature; at least 0.3 m.
-    pub fn framing_distance(&self, fov: f64, aspect: f64) -> f64 {
-        let (lo, hi) = (self.extent.0, self.extent.1);
-        let extent = hi - lo;
-        let across = DVec3::new(extent.x, 0.0, extent.z).length().max(0.05);
-        let tall = extent.y.max(0.05);
-        let tan = (0.5 * fov.to_radians()).tan();
-        (across / (0.4 * 2.0 * tan * aspect))
-            .max(tall / (0.6 * 2.0 * tan))
-            .max(0.3)
-    }
-
     /// Whether the episode's physics steps are all taken.
     pub fn physics_done(&self) -> bool {
         self.physics_steps >= self.physics_limit() || self.over
@@ -399,20 +379,7 @@ impl Env for SceneEnv {
         self.last = self.start;
         self.ended = self.spec.ending(&scene.world);
         self.over = self.ended.is_some();
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        let radius = &scene.world.particles().radius;
-        for p in &self.moving {
-            let (x, r) = (scene.world.position(*p), radius[p.index()]);
-            lo = lo.min(x - DVec3::splat(r));
-            hi = hi.max(x + DVec3::splat(r));
-        }
-        self.extent = if lo.is_finite() {
-            (lo, hi)
-        } else {
-            (DVec3::ZERO, DVec3::ZERO)
-        };
         self.scene = scene;
-        self.steps = 0;
         self.physics_steps = 0;
         self.work = Work::default();
         self.fitness = 0.0;
@@ -466,7 +433,6 @@ impl Env for SceneEnv {
                 break;
             }
         }
-        self.steps += 1;
         let fitness = self.score(blew_up);
         let reward = fitness - self.fitness;
         self.fitness = fitness;

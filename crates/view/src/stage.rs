@@ -184,6 +184,35 @@ pub fn framing(pos: &[DVec3], floor: bool) -> ([f64; 3], f64) {
     ([c.x, c.y.max(0.2), c.z], 1.2 * size + 0.5)
 }
 
+/// `animats render`'s close framing of a creature: the box around the
+/// spheres (`(centre, radius)`) and, for a camera with a vertical field
+/// of view of `fov` degrees on a picture `aspect` wide per unit high, the
+/// distance at which the box fills 40 % of the width, or 60 % of the
+/// height if that is the tighter (at least 0.3 m, as seen from the usual
+/// direction); `None` without spheres.
+pub fn snug(
+    spheres: impl IntoIterator<Item = (DVec3, f64)>,
+    fov: f64,
+    aspect: f64,
+) -> Option<(DVec3, f64)> {
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    for (p, r) in spheres {
+        lo = lo.min(p - DVec3::splat(r));
+        hi = hi.max(p + DVec3::splat(r));
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return None;
+    }
+    let extent = hi - lo;
+    let across = DVec3::new(extent.x, 0.0, extent.z).length().max(0.05);
+    let tall = extent.y.max(0.05);
+    let tan = (0.5 * fov.to_radians()).tan();
+    let distance = (across / (0.4 * 2.0 * tan * aspect))
+        .max(tall / (0.6 * 2.0 * tan))
+        .max(0.3);
+    Some((0.5 * (lo + hi), distance))
+}
+
 impl Stage for SceneStage {
     fn describe(&self) -> Describe {
         let w = &self.scene.world;
