@@ -14,6 +14,8 @@
 //! against each sphere wandering its own way).
 //!
 //! `cargo run --release -p animats-bench --example pile_rest -- --rows 8`
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use animats_bench::pile::{outside_ring, pile_walled_with};
 use animats_engine::{SphereContact, SphereContactDef};

@@ -1,6 +1,8 @@
 //! The mass-spring workloads `cloth-N` and `chain-64` (`docs/WORKLOADS.md` §1),
 //! built through the engine's public API, and the plain hand-written
 //! structure-of-arrays loop they are compared with.
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{
     ByPieces, DVec3, DiscreteEvent, EventContext, EventState, IntegratorKind, ParticleDef,

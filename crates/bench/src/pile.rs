@@ -1,5 +1,7 @@
 //! `contacts`: spheres falling into a pile (issue 12), the broad phase's
 //! cost against the number of spheres.
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use crate::{Check, Row, Timing};
 use animats_engine::{DVec3, FloorDef, IntegratorKind, ParticleDef, SphereContactDef, World};

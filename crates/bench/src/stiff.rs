@@ -5,6 +5,8 @@
 //! that implicit Euler stays finite and never gains energy at ten times the
 //! largest step at which symplectic Euler is stable; and the race of the
 //! two on a stiff, damped curtain of cloth-128 ([`race`]).
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use crate::mass_spring::{self, spring_world, DAMPING, SPACING, STIFFNESS};
 use crate::stability::{self, largest_stable_world_step};

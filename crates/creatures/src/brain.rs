@@ -167,7 +167,7 @@ pub fn network_inputs(x: &mut Vec<f64>, inputs: &[f64], clock: Option<f64>, t: f
     x.extend(inputs.iter().map(|v| 2.0 * v - 1.0));
     if let Some(f) = clock {
         let w = std::f64::consts::TAU * f * t;
-        x.push(libm::sin(w));
-        x.push(libm::cos(w));
+        x.push(animats_engine::math::sin(w));
+        x.push(animats_engine::math::cos(w));
     }
 }

@@ -1,6 +1,8 @@
 //! The controller kinds a scene declares, against their definitions:
 //! the oscillator's formula, a network computed by hand, FSM timing and
 //! thresholds, and genomes that round-trip.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_creatures::brain::Brain;
 use animats_creatures::brains::{Condition, Fsm, FsmState, Neural, Oscillator, Transition};

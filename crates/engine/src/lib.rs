@@ -37,6 +37,7 @@ pub mod forces;
 pub mod guard;
 pub mod integrators;
 pub mod jacobian;
+pub mod math;
 mod parallel;
 pub mod particle;
 pub mod pin;

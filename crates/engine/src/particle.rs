@@ -155,7 +155,7 @@ pub fn sphere_volume(r: f64) -> f64 {
 
 /// Radius of a sphere of volume `v`.
 pub fn sphere_radius(v: f64) -> f64 {
-    (3.0 * v / (4.0 * PI)).cbrt()
+    crate::math::cbrt(3.0 * v / (4.0 * PI))
 }
 
 pub(crate) fn finite(field: &'static str, x: f64) -> Result<(), ModelError> {

@@ -162,7 +162,7 @@ impl Terrain {
     pub fn height(&self, x: f64, z: f64) -> f64 {
         match self {
             Terrain::Flat => 0.0,
-            Terrain::Slope(s) => s.angle.tan() * (s.uphill.x * x + s.uphill.z * z),
+            Terrain::Slope(s) => crate::math::tan(s.angle) * (s.uphill.x * x + s.uphill.z * z),
             Terrain::Steps(s) => s.profile(s.direction.x * x + s.direction.z * z),
             Terrain::Heightfield(h) => h.height(x, z),
         }
@@ -176,7 +176,7 @@ impl Terrain {
         match self {
             Terrain::Flat => (p.y <= reach).then_some((p.y, UP)),
             Terrain::Slope(s) => {
-                let (sin, cos) = s.angle.sin_cos();
+                let (sin, cos) = crate::math::sincos(s.angle);
                 let n = UP * cos - s.uphill * sin;
                 let d = p.dot(n);
                 (d <= reach).then_some((d, n))

@@ -1,4 +1,6 @@
 //! Forces against physics: orbits, conservation laws, fluids, nails.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{
     AngleJointDef, Current, FluidMedium, Force, ForceContext, IntegratorKind, NBodyGravity,

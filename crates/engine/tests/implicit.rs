@@ -9,6 +9,8 @@
 //! - A user force without a Jacobian still acts (explicitly).
 //! - Linear drag: `v` falls by exactly `1/(1 + h b/m)` a step (RK4: by its
 //!   stability polynomial).
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{
     AngleJointDef, Force, ForceContext, IntegratorKind, LinearDrag, ParticleDef, Solver, SpringDef,

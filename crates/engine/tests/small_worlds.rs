@@ -5,6 +5,8 @@
 //! free particles that touch nothing (which put it on the other path); its
 //! trajectory must be identical, for every explicit integrator, and a blow-up must
 //! be caught and named on both paths.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{DVec3, IntegratorKind, ParticleDef, SimError, SpringDef, World};
 

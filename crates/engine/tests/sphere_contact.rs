@@ -17,6 +17,8 @@
 //! - Spheres flung far away neither break the grid nor hide a collision.
 //!
 //! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{
     FloorDef, IntegratorKind, ParticleDef, SphereContact, SphereContactDef, SpringDef, World,

@@ -1,6 +1,8 @@
 //! Terrain: spheres meet a slope, steps and a heightfield as they meet the
 //! flat floor — the same located impacts, restitution, resting and
 //! friction — along the surface's normal.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_engine::{
     FloorCollision, FloorDef, Heightfield, IntegratorKind, ParticleDef, ParticleId, Slope, Steps,

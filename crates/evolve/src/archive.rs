@@ -332,7 +332,7 @@ impl GridArchive {
                 let cur = old.map_or(tmin, |(t, _)| t);
                 let n = list.len() as f64;
                 let mean = list.iter().map(|&i| batch[i].objective).sum::<f64>() / n;
-                let ratio = libm::pow(1.0 - self.grid.learning_rate, n);
+                let ratio = animats_engine::math::pow(1.0 - self.grid.learning_rate, n);
                 ratio * cur + mean * (1.0 - ratio)
             };
             let c = &batch[top];

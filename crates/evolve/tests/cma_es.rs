@@ -5,6 +5,8 @@
 //! (same start, step size and population; see the script). Also: the
 //! optimiser is a pure function of its seed, and a checkpointed state
 //! resumes to the same bits.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_evolve::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 

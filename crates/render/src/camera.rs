@@ -1,4 +1,6 @@
 //! A pinhole camera: where it is, what it looks at, and how wide it sees.
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use glam::DVec3;
 

@@ -1,5 +1,7 @@
 //! The software renderer puts things where the camera says they are, hides
 //! what is behind, shades, and gives the same bytes every time.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_render::camera::View;
 use animats_render::gif_file::encode_gif;

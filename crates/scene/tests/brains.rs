@@ -1,6 +1,8 @@
 //! Brains in scene files: actuators drive what they name, sensors read what
 //! they name, controllers act every step, every mistake is refused naming
 //! its entry and field, and `[evolve]` evaluations score what they say.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_scene::evaluate::{evaluate, Ended, SceneProblem};
 use std::f64::consts::{PI, TAU};

@@ -2,6 +2,8 @@
 //! in the controllers' place: replaying what the controller ordered gives
 //! the same trajectory, bit for bit, and rewards that add up to the
 //! evaluation's fitness.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_creatures::env::Env;
 use animats_scene::env::{Observation, SceneEnv};

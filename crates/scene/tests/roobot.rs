@@ -9,6 +9,8 @@
 //! leap → launch → flight → stance on every hop; the hip motor acts only in
 //! flight and the ankle motor only in stance. Raibert's controller does
 //! what each of its parts is for.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_creatures::env::Env;
 use animats_creatures::roobot::{foot_down, raibert, HopParams};

@@ -4,6 +4,8 @@
 //! server sends it ([`Drawing`] with the scene, [`BellShape`]s with every
 //! frame) and the software renderer what it is given; neither computes a
 //! shape of its own.
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use crate::model::CreatureState;
 use animats_engine::DVec3;

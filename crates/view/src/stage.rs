@@ -1,5 +1,7 @@
 //! What is shown: a [`Stage`] advances a world and describes it.
 //! [`SceneStage`] plays a scene file.
+// std's transcendental functions: this code draws or benchmarks, off the step path
+#![allow(clippy::disallowed_methods)]
 
 use crate::model::{CreatureState, Describe, Dome, Part};
 use animats_engine::DVec3;

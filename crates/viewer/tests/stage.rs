@@ -1,6 +1,8 @@
 //! What the viewer runs: a scene file's stage (moving the food steers the
 //! jellyfish; the pile's overlay counts its sleeping rocks) and the
 //! exhibition of an evolution's best brain.
+// std's transcendental functions: an independent reference here
+#![allow(clippy::disallowed_methods)]
 
 use animats_viewer::{Exhibition, SceneStage, Stage};
 use std::path::PathBuf;

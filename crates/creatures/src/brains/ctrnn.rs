@@ -170,7 +170,7 @@ pub struct Ctrnn {
 
 /// The logistic function.
 pub fn sigma(z: f64) -> f64 {
-    1.0 / (1.0 + libm::exp(-z))
+    1.0 / (1.0 + animats_engine::math::exp(-z))
 }
 
 impl Ctrnn {

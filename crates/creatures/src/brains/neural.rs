@@ -161,9 +161,9 @@ impl Brain for Neural {
                     a += w * xi;
                 }
                 y.push(if l + 1 == layers {
-                    1.0 / (1.0 + libm::exp(-a))
+                    1.0 / (1.0 + animats_engine::math::exp(-a))
                 } else {
-                    libm::tanh(a)
+                    animats_engine::math::tanh(a)
                 });
             }
             k = biases + n_out;

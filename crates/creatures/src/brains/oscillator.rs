@@ -78,7 +78,8 @@ impl Brain for Oscillator {
         let w = TAU * self.frequency * t;
         for (i, out) in outputs.iter_mut().enumerate() {
             // libm: the same bits on every platform (reproducible evolution).
-            *out = self.offset[i] + self.amplitude[i] * libm::sin(w + self.phase[i]);
+            *out =
+                self.offset[i] + self.amplitude[i] * animats_engine::math::sin(w + self.phase[i]);
         }
     }
 

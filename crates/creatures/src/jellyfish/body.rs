@@ -30,6 +30,7 @@
 //! keys `pulse_force` and `steer_force` set Appendix B's absolute values.
 //! See docs/SEAWORLD.md for the measurements.
 
+use animats_engine::math;
 use animats_engine::{
     ConstantForceId, DVec3, ModelError, ParticleDef, ParticleId, SpringDef, SpringId, World,
 };
@@ -196,7 +197,7 @@ pub fn build(world: &mut World, c: &JellyfishConstants, at: DVec3) -> Result<Bod
     let mut dome = Vec::with_capacity(n);
     for i in 0..n {
         let a = TAU * i as f64 / n as f64;
-        let x = at + DVec3::new(a.cos(), 0.0, a.sin()) * c.dome_radius;
+        let x = at + DVec3::new(math::cos(a), 0.0, math::sin(a)) * c.dome_radius;
         dome.push(world.add_particle(sphere(c.dome_mass, c.dome_density, x))?);
     }
     let mut ring = Vec::with_capacity(n);

@@ -40,6 +40,7 @@
 //! amplitude: at full amplitude it alone can overturn the dome. See
 //! docs/SEAWORLD.md for the measurements.
 
+use animats_engine::math;
 use std::f64::consts::TAU;
 use std::fmt;
 
@@ -152,7 +153,7 @@ impl JellyfishFsm {
     /// The pulse level at the current phase: `0.5 + ½ sin φ`, with the
     /// recovery half (sin φ < 0) at a tenth of the strength.
     fn pulse_level(&self) -> f64 {
-        let p = 0.5 * self.phase.sin();
+        let p = 0.5 * math::sin(self.phase);
         0.5 + if p < 0.0 { 0.1 * p } else { p }
     }
 
@@ -213,7 +214,7 @@ impl JellyfishFsm {
                         // Appendix B: the far side pushes in step with the pulse.
                         pulse.abs() - 0.5
                     } else {
-                        let wobble = 0.5 * (i as f64 * 5.0 * s.time + s.depth).sin();
+                        let wobble = 0.5 * math::sin(i as f64 * 5.0 * s.time + s.depth);
                         self.wobble * wobble * pulse.abs()
                     };
                 }

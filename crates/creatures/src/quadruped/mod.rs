@@ -23,6 +23,7 @@
 //! The thesis gives no dimensions; ours are a dog-sized frame (docs/SEAWORLD.md).
 
 use crate::controller::{Actor, Status};
+use animats_engine::math;
 use animats_engine::{
     AngleJointDef, DVec3, ModelError, ParticleDef, ParticleId, SpringDef, SpringId, TorqueJointDef,
     TorqueJointId, World,
@@ -154,7 +155,7 @@ impl Quadruped {
         base: DVec3,
         heading: f64,
     ) -> Result<Quadruped, ModelError> {
-        let f = DVec3::new(heading.cos(), 0.0, -heading.sin());
+        let f = DVec3::new(math::cos(heading), 0.0, -math::sin(heading));
         let side = f.cross(DVec3::Y); // to the right
         let (l, w) = (c.torso.0 / 2.0, c.torso.1 / 2.0);
         let centre = DVec3::new(base.x, c.height, base.z);

@@ -13,6 +13,7 @@
 //! hopping within 100 generations in most lanes. Every constant is in
 //! [`BodyConstants::STANDARD`].
 
+use animats_engine::math;
 use animats_engine::{
     AngleJointDef, DVec3, ModelError, ParticleDef, ParticleId, PlaneConstraint, SpringDef,
     SpringId, TorqueJointDef, TorqueJointId, World,
@@ -200,7 +201,7 @@ impl Body {
 /// Horizontal unit vector at `heading` radians from +x, turning towards -z
 /// (counter-clockwise seen from above, the usual sense about +y).
 pub fn forward(heading: f64) -> DVec3 {
-    DVec3::new(heading.cos(), 0.0, -heading.sin())
+    DVec3::new(math::cos(heading), 0.0, -math::sin(heading))
 }
 
 /// Builds a roobot standing upright with its foot on the floor at `base`

@@ -157,7 +157,7 @@ impl Brain for Raibert {
             let v = inputs[4];
             let length = inputs[5].max(1e-3);
             let ahead = v * self.last_stance / 2.0 + g[2] * (v - g[3]);
-            let target = -libm::asin((ahead / length).clamp(-0.9, 0.9));
+            let target = -animats_engine::math::asin((ahead / length).clamp(-0.9, 0.9));
             let tau = -g[4] * (angle - target) - g[5] * rate;
             out[1] = level(tau, self.hip_torque);
             out[2] = 0.5;
@@ -229,7 +229,7 @@ impl Senses for RaibertSenses {
         let hip = world.velocity(self.hip);
         out[0] = levels[self.foot_height];
         out[1] = self.angle.angle(world);
-        out[2] = libm::atan2(v.y, v.dot(self.forward));
+        out[2] = animats_engine::math::atan2(v.y, v.dot(self.forward));
         out[3] = hip.y;
         out[4] = hip.dot(self.forward);
         out[5] = (world.position(self.hip) - world.position(self.foot)).length();

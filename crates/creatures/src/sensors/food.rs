@@ -3,6 +3,7 @@
 //! clamped to [0, 1] (full strength within 10 cm).
 
 use crate::sensor::{unit, Sensor};
+use animats_engine::math;
 use animats_engine::{ParticleId, World};
 
 /// Food concentration at `sensor`, from `food`.
@@ -18,7 +19,7 @@ impl FoodSensor {
     /// Horizontal distance from the sensor to the food, m.
     pub fn distance(&self, world: &World) -> f64 {
         let d = world.position(self.food) - world.position(self.sensor);
-        d.x.hypot(d.z)
+        math::hypot(d.x, d.z)
     }
 }
 

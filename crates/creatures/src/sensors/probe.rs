@@ -63,7 +63,7 @@ impl Probe {
             Probe::Tilt(a, b) => {
                 let v = p(b) - p(a);
                 let horizontal = (v.x * v.x + v.z * v.z).sqrt();
-                libm::atan2(horizontal, v.y)
+                animats_engine::math::atan2(horizontal, v.y)
             }
         }
     }

@@ -31,7 +31,7 @@ impl TiltSensor {
     pub fn angle(&self, world: &World) -> f64 {
         let v = world.position(self.tip) - world.position(self.base);
         // libm: the same bits on every platform, for reproducible evolution.
-        libm::atan2(v.dot(self.forward), v.y)
+        animats_engine::math::atan2(v.dot(self.forward), v.y)
     }
 }
 

@@ -89,7 +89,7 @@ pub struct AngleJoint {
 pub fn angle_at(a: DVec3, j: DVec3, b: DVec3) -> f64 {
     let (ra, rb) = (a - j, b - j);
     // atan2 of |a×b| and a·b is accurate at every angle, unlike acos near 0 and π.
-    libm::atan2(ra.cross(rb).length(), ra.dot(rb))
+    crate::math::atan2(ra.cross(rb).length(), ra.dot(rb))
 }
 
 impl AngleJoint {
@@ -245,7 +245,7 @@ impl Force for AngleJoints {
                 continue; // collinear or degenerate: no plane of bending
             };
             let (a, j, b) = (jt.a as usize, jt.joint as usize, jt.b as usize);
-            let theta = libm::atan2(nl, ra.dot(rb));
+            let theta = crate::math::atan2(nl, ra.dot(rb));
             // With ĵ = n/|n|: ĵ × â = (n × a)/(|n||a|), since n ⊥ a. The
             // force on an end is T/|arm| along that unit vector, so
             // F_a = (n × a) T / (|n| |a|²): one square root per joint.

@@ -70,8 +70,8 @@ impl ReefWater {
         let dir = DVec3::new(self.direction.x, 0.0, self.direction.z).normalize_or_zero();
         let depth = (self.surface - p.y).max(0.0);
         // libm: the same bits on every platform, for reproducible runs.
-        let speed = self.amplitude * omega * libm::exp(-k * depth);
-        let (s, c) = libm::sincos(k * dir.dot(p) - omega * t);
+        let speed = self.amplitude * omega * crate::math::exp(-k * depth);
+        let (s, c) = crate::math::sincos(k * dir.dot(p) - omega * t);
         dir * (speed * c) + DVec3::Y * (speed * s) + self.drift
     }
 }

@@ -31,6 +31,7 @@
 //! candidate outside the box ranks below an equal one inside.
 
 use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use animats_engine::math;
 use serde::{Deserialize, Serialize};
 
 /// CMA-ES's whole state (what a checkpoint stores).
@@ -96,7 +97,10 @@ impl CmaEs {
             .max(2);
         let mu = lambda / 2;
         let raw: Vec<f64> = (0..lambda)
-            .map(|i| libm::log((lambda as f64 + 1.0) / 2.0) - libm::log(i as f64 + 1.0))
+            .map(|i| {
+                animats_engine::math::log((lambda as f64 + 1.0) / 2.0)
+                    - animats_engine::math::log(i as f64 + 1.0)
+            })
             .collect();
         let (pos, neg) = raw.split_at(mu);
         let mu_eff =
@@ -342,7 +346,7 @@ impl CmaEs {
         }
         let ps2: f64 = self.ps.iter().map(|v| v * v).sum();
         let gens = self.counteval as f64 / self.lambda as f64;
-        let hsig = ps2 / n as f64 / (1.0 - (1.0 - self.cs).powf(2.0 * gens))
+        let hsig = ps2 / n as f64 / (1.0 - math::pow(1.0 - self.cs, 2.0 * gens))
             < 2.0 + 4.0 / (n as f64 + 1.0);
         let hsig = if hsig { 1.0 } else { 0.0 };
         let kc = (self.cc * (2.0 - self.cc) * self.mueff).sqrt();
@@ -442,7 +446,8 @@ impl Optimiser for CmaEs {
         let (old, yw) = self.move_mean(&order);
         let (ps2, hsig) = self.update_paths(&yw);
         self.update_covariance(&order, &old, hsig);
-        self.sigma *= libm::exp((self.cs / self.damps) * (ps2.sqrt() / self.chi_n - 1.0));
+        self.sigma *=
+            animats_engine::math::exp((self.cs / self.damps) * (ps2.sqrt() / self.chi_n - 1.0));
         let (n, lambda) = (self.n as f64, self.lambda as f64);
         if (self.counteval - self.eigeneval) as f64 > lambda / (self.c1 + self.cmu) / n / 10.0 {
             self.eigeneval = self.counteval;

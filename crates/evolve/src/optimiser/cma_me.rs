@@ -62,7 +62,7 @@ pub struct CmaEmitter {
 fn params(n: usize, mu: usize) -> (Vec<f64>, f64, f64, f64, f64, f64) {
     let n = n as f64;
     let raw: Vec<f64> = (1..=mu)
-        .map(|i| libm::log(mu as f64 + 0.5) - libm::log(i as f64))
+        .map(|i| animats_engine::math::log(mu as f64 + 0.5) - animats_engine::math::log(i as f64))
         .collect();
     let total: f64 = raw.iter().sum();
     let w: Vec<f64> = raw.iter().map(|x| x / total).collect();
@@ -234,7 +234,7 @@ impl CmaEmitter {
             }
             let ps2: f64 = self.ps.iter().map(|v| v * v).sum();
             let gens = self.current_eval as f64 / self.batch as f64;
-            let left = ps2 / nf / (1.0 - libm::pow(1.0 - cs, 2.0 * gens));
+            let left = ps2 / nf / (1.0 - animats_engine::math::pow(1.0 - cs, 2.0 * gens));
             let hsig = if left < 2.0 + 4.0 / (nf + 1.0) {
                 1.0
             } else {
@@ -260,7 +260,8 @@ impl CmaEmitter {
                     self.cov[j * n + i] = v;
                 }
             }
-            self.sigma *= libm::exp((1.0f64).min(cs / damps * (ps2 / nf - 1.0) / 2.0));
+            self.sigma *=
+                animats_engine::math::exp((1.0f64).min(cs / damps * (ps2 / nf - 1.0) / 2.0));
         }
         let spread = match (order.first(), order.last()) {
             (Some(&a), Some(&b)) if order.len() >= 2 => {

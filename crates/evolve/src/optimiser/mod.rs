@@ -16,6 +16,7 @@ pub mod ga;
 pub mod hill_climber;
 pub mod map_elites;
 
+use animats_engine::math;
 use body_ga::{BodyGa, Variation};
 use cma_es::CmaEs;
 use ga::Ga;
@@ -152,7 +153,7 @@ impl OptimiserKind {
 
 /// Hansen's default population, `4 + floor(3 ln n)`.
 pub fn cma_default_lambda(dim: usize) -> usize {
-    4 + (3.0 * (dim.max(1) as f64).ln()).floor() as usize
+    4 + (3.0 * math::log(dim.max(1) as f64)).floor() as usize
 }
 
 /// What an optimiser starts from.
@@ -409,7 +410,8 @@ impl Optimiser for AnyOptimiser {
 pub fn gaussian(rng: &mut Random) -> f64 {
     let u1 = 1.0 - rng.uniform(); // (0, 1]
     let u2 = rng.uniform();
-    (-2.0 * libm::log(u1)).sqrt() * libm::cos(std::f64::consts::TAU * u2)
+    (-2.0 * animats_engine::math::log(u1)).sqrt()
+        * animats_engine::math::cos(std::f64::consts::TAU * u2)
 }
 
 /// Fitness with NaN mapped to −∞, so that it always sorts last.

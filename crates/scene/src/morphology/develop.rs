@@ -194,8 +194,8 @@ fn neural(body: &Body, outputs: &[String]) -> Table {
         let mut row = vec![0.0; n + 2];
         row[a] = mu.touch[0];
         row[b] = mu.touch[1];
-        row[n] = 4.0 * mu.amplitude * libm::cos(mu.phase);
-        row[n + 1] = 4.0 * mu.amplitude * libm::sin(mu.phase);
+        row[n] = 4.0 * mu.amplitude * animats_engine::math::cos(mu.phase);
+        row[n + 1] = 4.0 * mu.amplitude * animats_engine::math::sin(mu.phase);
         weights.extend(row);
     }
     for &(_, _, mu) in &muscles {

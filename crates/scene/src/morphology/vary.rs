@@ -33,7 +33,8 @@ pub const RETRIES: usize = 10;
 pub fn normal(rng: &mut Random) -> f64 {
     let u1 = 1.0 - rng.uniform();
     let u2 = rng.uniform();
-    (-2.0 * libm::log(u1)).sqrt() * libm::cos(std::f64::consts::TAU * u2)
+    (-2.0 * animats_engine::math::log(u1)).sqrt()
+        * animats_engine::math::cos(std::f64::consts::TAU * u2)
 }
 
 /// A whole number in `lo..=hi`.
@@ -51,7 +52,10 @@ fn nudge(rng: &mut Random, x: f64, (lo, hi): (f64, f64), scale: f64) -> f64 {
 
 /// Log-uniform in the range.
 fn log_between(rng: &mut Random, (lo, hi): (f64, f64)) -> f64 {
-    (libm::exp(rng.between(libm::log(lo), libm::log(hi)))).clamp(lo, hi)
+    (animats_engine::math::exp(
+        rng.between(animats_engine::math::log(lo), animats_engine::math::log(hi)),
+    ))
+    .clamp(lo, hi)
 }
 
 /// A muscle with random genes; a `neural` one's touch weights start small
@@ -237,7 +241,7 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
         7 => {
             if let Some(k) = edge {
                 let e = &mut body.edges[k];
-                e.stiffness = (e.stiffness * libm::exp(0.3 * normal(rng)))
+                e.stiffness = (e.stiffness * animats_engine::math::exp(0.3 * normal(rng)))
                     .clamp(m.stiffness.0, m.stiffness.1);
             }
         }
@@ -276,7 +280,7 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
 
 /// An angle into [−π, π].
 pub(crate) fn wrap(x: f64) -> f64 {
-    let y = libm::remainder(x, 2.0 * PI);
+    let y = animats_engine::math::remainder(x, 2.0 * PI);
     y.clamp(-PI, PI)
 }
 
