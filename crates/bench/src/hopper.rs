@@ -59,13 +59,13 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
         runs,
         || State::new(config.clone()).expect("valid configuration"),
         |s| {
-            // In batches, as `animats evolve` runs it.
-            let mut batch = animats_evolve::FIRST_BATCH;
+            // As `animats evolve` runs it: lanes that never wait for each
+            // other, stopping only for a checkpoint every 5 s.
             while !s.done() {
                 let begun = std::time::Instant::now();
-                pool.install(|| s.advance_with(evolved.as_ref(), batch))
+                let more = || begun.elapsed().as_secs_f64() < 5.0;
+                pool.install(|| s.advance_while(evolved.as_ref(), None, &more, &|_| ()))
                     .expect("evaluations succeed");
-                batch = animats_evolve::next_batch(batch, begun.elapsed());
             }
         },
     );

@@ -12,8 +12,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
-use std::time::Instant;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 /// Arguments of `animats evolve`.
 #[derive(clap::Args)]
@@ -319,6 +319,7 @@ struct Progress {
     last_line: Instant,
     start: Instant,
     evals_at_start: u64,
+    total: u64,
 }
 
 impl Progress {
@@ -343,24 +344,32 @@ impl Progress {
             last_line: Instant::now(),
             start: Instant::now(),
             evals_at_start: state.evaluations,
+            total: state.config.generations,
         }
     }
 
     fn show(&mut self, state: &State) {
-        let rate = (state.evaluations - self.evals_at_start) as f64
+        self.show_numbers(
+            state.generation(),
+            state.evaluations,
+            state.best_fitness(),
+            state.done(),
+        );
+    }
+
+    /// `generation`: the lowest lane's.
+    fn show_numbers(&mut self, generation: u64, evaluations: u64, best: Option<f64>, done: bool) {
+        let rate = evaluations.saturating_sub(self.evals_at_start) as f64
             / self.start.elapsed().as_secs_f64().max(1e-9);
-        self.bar.set_position(state.generation());
+        self.bar.set_position(generation);
         let message = format!(
             "{rate:.0} evals/s, best fitness {:.1}",
-            state.best_fitness().unwrap_or(f64::NAN)
+            best.unwrap_or(f64::NAN)
         );
-        if self.lines && (self.last_line.elapsed().as_secs_f64() >= PROGRESS_EVERY || state.done())
-        {
+        if self.lines && (self.last_line.elapsed().as_secs_f64() >= PROGRESS_EVERY || done) {
             eprintln!(
-                "generation {} of {}: {} evaluations, {message}",
-                state.generation(),
-                state.config.generations,
-                state.evaluations
+                "generation {generation} of {}: {evaluations} evaluations, {message}",
+                self.total
             );
             self.last_line = Instant::now();
         }
@@ -368,8 +377,11 @@ impl Progress {
     }
 }
 
-/// Advances the run to its end (or to Ctrl-C: then true), batch by batch,
-/// showing progress, publishing to the view and saving checkpoints.
+/// Advances the run to its end (or to Ctrl-C: then true), showing progress,
+/// publishing to the view and saving a checkpoint every
+/// `--checkpoint-every` seconds. No lane waits for another between
+/// checkpoints ([`State::advance_while`]): progress is watched from this
+/// thread while the pool's threads work.
 fn evolve(
     args: &Args,
     dir: &Path,
@@ -382,31 +394,124 @@ fn evolve(
     // Built once for the whole run (a scene is parsed and checked here).
     let problem = state.config.problem.build().map_err(input)?;
     let mut progress = Progress::new(state);
-    let mut last_save = Instant::now();
-    // Generations each lane advances between progress updates and Ctrl-C
-    // checks: one at first, then as many as take about a quarter of a
-    // second.
-    let mut batch = animats_evolve::FIRST_BATCH;
+    // Each stretch of work runs until the next checkpoint is due (at least
+    // a generation of every lane), or Ctrl-C.
+    let every = Duration::try_from_secs_f64(args.checkpoint_every).unwrap_or(Duration::MAX);
     while !state.done() {
         if stop.load(Ordering::SeqCst) {
             progress.bar.finish_and_clear();
             return Ok(true);
         }
         let begun = Instant::now();
-        pool.install(|| state.advance_traced(problem.as_ref(), batch, tracer))
-            .map_err(Failure::Other)?;
-        batch = animats_evolve::next_batch(batch, begun.elapsed());
+        let live = Mutex::new(Live::new(state));
+        let watcher = std::thread::current();
+        let finished = AtomicBool::new(false);
+        let problem = problem.as_ref();
+        let result = std::thread::scope(|scope| {
+            let work = scope.spawn(|| {
+                let more = || !stop.load(Ordering::SeqCst) && begun.elapsed() < every;
+                let seen = |row: &animats_evolve::LogRow| {
+                    if let Ok(mut l) = live.lock() {
+                        l.saw(row);
+                    }
+                };
+                let r = pool.install(|| state.advance_while(problem, tracer, &more, &seen));
+                finished.store(true, Ordering::SeqCst);
+                watcher.unpark();
+                r
+            });
+            while !finished.load(Ordering::SeqCst) {
+                std::thread::park_timeout(Duration::from_millis(250));
+                if let Ok(mut l) = live.lock() {
+                    progress.show_numbers(l.generation(), l.evaluations(), l.best_fitness(), false);
+                    if let Some(board) = board {
+                        l.publish(board);
+                    }
+                }
+            }
+            work.join()
+        });
+        match result {
+            Ok(r) => r.map_err(Failure::Other)?,
+            Err(_) => return Err(Failure::Other("an evaluation panicked".into())),
+        }
         if let Some(board) = board {
             publish(board, state);
         }
         progress.show(state);
-        if last_save.elapsed().as_secs_f64() >= args.checkpoint_every {
+        if !state.done() {
             save(dir, state, false)?;
-            last_save = Instant::now();
         }
     }
     progress.bar.finish_and_clear();
     Ok(false)
+}
+
+/// A run's progress as its lanes report their generations.
+struct Live {
+    generations: Vec<u64>,
+    evaluations: Vec<u64>,
+    total: u64,
+    /// The best so far: fitness, genome, lane.
+    best: Option<(f64, Vec<f64>, usize)>,
+    /// Whether `best` changed since it was last published.
+    fresh: bool,
+}
+
+impl Live {
+    fn new(state: &State) -> Live {
+        let best = state.best_lane().and_then(|l| {
+            l.best
+                .as_ref()
+                .map(|b| (b.fitness, b.genome.clone(), l.lane))
+        });
+        Live {
+            generations: state.lanes.iter().map(|l| l.generation).collect(),
+            evaluations: state.lanes.iter().map(|l| l.evaluations).collect(),
+            total: state.config.generations,
+            best,
+            fresh: false,
+        }
+    }
+
+    fn saw(&mut self, row: &animats_evolve::LogRow) {
+        if let Some(g) = self.generations.get_mut(row.lane) {
+            *g = row.generation;
+        }
+        if let Some(e) = self.evaluations.get_mut(row.lane) {
+            *e = row.evaluations;
+        }
+        if let Some(genome) = &row.improved {
+            // The lowest lane among equals, as State::best_lane.
+            let better = self.best.as_ref().is_none_or(|(f, _, lane)| {
+                row.best_fitness > *f || (row.best_fitness == *f && row.lane < *lane)
+            });
+            if better {
+                self.best = Some((row.best_fitness, genome.clone(), row.lane));
+                self.fresh = true;
+            }
+        }
+    }
+
+    fn generation(&self) -> u64 {
+        self.generations.iter().copied().min().unwrap_or(0)
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evaluations.iter().sum()
+    }
+
+    fn best_fitness(&self) -> Option<f64> {
+        self.best.as_ref().map(|b| b.0)
+    }
+
+    fn publish(&mut self, board: &BestBrain) {
+        if let (Some((f, genome, lane)), true) = (&self.best, self.fresh) {
+            board.set_best(genome, *f, *lane);
+            self.fresh = false;
+        }
+        board.set_generation(self.generation(), self.total);
+    }
 }
 
 /// Writes DIR/schedule.csv and prints the schedule model's predictions

@@ -171,6 +171,10 @@ fn wait_for_checkpoint(dir: &std::path::Path) {
 }
 
 fn generation_in_checkpoint(dir: &std::path::Path) -> u64 {
+    lane_generations(dir).into_iter().min().unwrap()
+}
+
+fn lane_generations(dir: &std::path::Path) -> Vec<u64> {
     let text = std::fs::read_to_string(dir.join("checkpoint.json")).unwrap();
     let state: serde_json::Value = serde_json::from_str(text.lines().nth(1).unwrap()).unwrap();
     state["lanes"]
@@ -178,23 +182,27 @@ fn generation_in_checkpoint(dir: &std::path::Path) -> u64 {
         .unwrap()
         .iter()
         .map(|l| l["generation"].as_u64().unwrap())
-        .min()
-        .unwrap()
+        .collect()
 }
 
 #[test]
 fn a_run_killed_part_way_and_resumed_logs_exactly_what_an_unstopped_run_does() {
+    // Three lanes on two threads, checkpoints every 20 ms: the lanes do not
+    // wait for each other between checkpoints, so a checkpoint may hold
+    // them at different generations.
     let base = scratch("evolve-kill");
     let (whole, killed) = (base.join("whole"), base.join("killed"));
     let args = [
         "--generations",
         "400",
         "--lanes",
+        "3",
+        "--threads",
         "2",
         "--seed",
         "3",
         "--checkpoint-every",
-        "0",
+        "0.02",
     ];
     let mut first: Vec<&str> = args.to_vec();
     first.extend(["--out", whole.to_str().unwrap()]);
@@ -212,6 +220,10 @@ fn a_run_killed_part_way_and_resumed_logs_exactly_what_an_unstopped_run_does() {
     child.kill().unwrap(); // SIGKILL: no chance to clean up
     child.wait().unwrap();
     let at = generation_in_checkpoint(&killed);
+    eprintln!(
+        "killed at the lanes' generations {:?}",
+        lane_generations(&killed)
+    );
     assert!(
         at < 400,
         "the run finished before it could be killed (generation {at})"

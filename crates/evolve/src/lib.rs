@@ -29,6 +29,4 @@ pub use optimiser::{cma_es, ga, hill_climber};
 
 pub use optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 pub use problem::{Outcome, Problem};
-pub use run::{
-    next_batch, Best, Choices, Config, Lane, LogMode, LogRow, ProblemSpec, State, FIRST_BATCH,
-};
+pub use run::{Best, Choices, Config, Lane, LogMode, LogRow, ProblemSpec, State};

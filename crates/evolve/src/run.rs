@@ -546,7 +546,38 @@ impl State {
             .iter()
             .map(|l| generations.min(target.saturating_sub(l.generation)))
             .collect();
-        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer)?;
+        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer, &|| true, None)?;
+        if let Some(t) = tracer {
+            t.next_batch();
+        }
+        self.extend_log(rows);
+        Ok(())
+    }
+
+    /// Advances every lane towards the configured total with no lane
+    /// waiting for another: each unfinished lane by at least one
+    /// generation, then on while `more()` says so (checked before each
+    /// further generation a thread takes); `seen` hears of each lane's
+    /// generation as it ends (progress). When it returns the lanes may
+    /// stand at different generations; each lane's generations still run
+    /// in order, so the log, the best and a checkpoint taken now or later
+    /// are the same bits on any number of threads. Its work is one batch
+    /// of `tracer`'s. `animats evolve` advances a run by these, saving
+    /// its checkpoint between them.
+    pub fn advance_while(
+        &mut self,
+        problem: &dyn Problem,
+        tracer: Option<&crate::schedule::Tracer>,
+        more: &(dyn Fn() -> bool + Sync),
+        seen: &(dyn Fn(&LogRow) + Sync),
+    ) -> Result<(), String> {
+        let target = self.config.generations;
+        let todo: Vec<u64> = self
+            .lanes
+            .iter()
+            .map(|l| target.saturating_sub(l.generation))
+            .collect();
+        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer, more, Some(seen))?;
         if let Some(t) = tracer {
             t.next_batch();
         }
@@ -621,8 +652,11 @@ impl State {
         if self.config.log == LogMode::Improvements {
             rows.retain(|r| r.improved.is_some());
         }
-        rows.sort_by_key(|r| (r.generation, r.lane));
+        // Lanes advanced by `advance_while` need not stand level: the log
+        // is kept in (generation, lane) order as a whole (a sort that finds
+        // the old rows already in order, so about linear).
         self.log.extend(rows);
+        self.log.sort_by_key(|r| (r.generation, r.lane));
     }
 
     /// `best.toml`, as `animats evolve` writes it: the whole scene with the
@@ -860,11 +894,16 @@ impl State {
 /// lanes on two threads, lanes of unequal cost: 4.66 s against 4.0 s for
 /// half the work of one thread). No thread ever blocks: one that finds every
 /// unfinished lane taken stops, since what is left is sequential.
+///
+/// Past each lane's first generation, a thread takes another only while
+/// `more()` says so; `seen` hears of each generation's row as it ends.
 fn advance_lanes(
     lanes: &mut [Lane],
     todo: &[u64],
     problem: &dyn Problem,
     tracer: Option<&crate::schedule::Tracer>,
+    more: &(dyn Fn() -> bool + Sync),
+    seen: Option<&(dyn Fn(&LogRow) + Sync)>,
 ) -> Result<Vec<LogRow>, String> {
     use std::sync::Mutex;
     struct Slot<'a> {
@@ -904,15 +943,25 @@ fn advance_lanes(
                 .enumerate()
                 .filter(|(_, s)| s.lane.is_some() && s.done < s.todo)
                 .min_by_key(|(k, s)| (s.done, *k))
-                .map(|(k, _)| k);
-            let Some(k) = next else { return };
+                .map(|(k, s)| (k, s.done));
+            let Some((k, done)) = next else { return };
+            // The fewest done first: a lane past its first generation
+            // means every free lane is, so `more` decides for all.
+            if done > 0 && !more() {
+                return;
+            }
             b.slots[k].lane.take().map(|lane| (k, lane))
         };
         let Some((k, lane)) = taken else { return };
         let result = advance_lane(lane, problem, 1, tracer);
         let Ok(mut b) = board.lock() else { return };
         match result {
-            Ok(rows) => b.rows.extend(rows),
+            Ok(rows) => {
+                if let Some(seen) = seen {
+                    rows.iter().for_each(seen);
+                }
+                b.rows.extend(rows)
+            }
             Err(e) => {
                 if b.error.as_ref().is_none_or(|(j, _)| k < *j) {
                     b.error = Some((k, e));
@@ -932,28 +981,6 @@ fn advance_lanes(
         Some((_, e)) => Err(e),
         None => Ok(board.rows),
     }
-}
-
-/// Generations the first batch of a run advanced batch by batch takes
-/// (`animats evolve`, `animats bench hopper`): one, since a generation of
-/// a long evaluation can take seconds; [`next_batch`] grows it.
-pub const FIRST_BATCH: u64 = 1;
-
-/// About how long a batch should take, s.
-const BATCH_SECONDS: f64 = 0.25;
-
-/// Generations for the next batch of a run advanced batch by batch (the
-/// caller reports progress, checks for Ctrl-C and saves checkpoints
-/// between batches) after a batch of `batch` generations took `took`: as
-/// many as take about a quarter of a second at that rate, at least one and
-/// at most four times as many as before. Each batch ends with the pool's
-/// threads waiting for the slowest lane and starts by waking them: on the
-/// 2-core test machine the thesis experiment took 13 % longer in batches
-/// of 10 generations than in one (measured 2026-11-25; git log). The batches never change the results: a lane's generations run
-/// in order whatever they are.
-pub fn next_batch(batch: u64, took: std::time::Duration) -> u64 {
-    let rate = batch as f64 / took.as_secs_f64().max(1e-6);
-    ((rate * BATCH_SECONDS) as u64).clamp(1, batch.saturating_mul(4).max(1))
 }
 
 /// How many lanes have generations to do.

@@ -4,9 +4,9 @@
 //! and the batch it ran in), and a [`Schedule`] replays that work on any
 //! number of workers under the run's own dependencies — a lane's
 //! generations one after another, a generation's evaluations after its
-//! `ask` and before its `tell`, and (as `animats evolve` runs) every
-//! worker waiting for the slowest lane at the end of each batch — to
-//! predict the run's wall time. `animats evolve --schedule` prints the
+//! `ask` and before its `tell`, and every worker waiting for the slowest
+//! lane at the end of each batch (`animats evolve` ends one only to save a
+//! checkpoint, every `--checkpoint-every` seconds) — to predict the run's wall time. `animats evolve --schedule` prints the
 //! prediction for 1 to 64 workers from a run on the cores at hand.
 //!
 //! The replay is greedy list scheduling (Graham's): a free worker takes the

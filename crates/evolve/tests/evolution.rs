@@ -6,6 +6,7 @@ use animats_evolve::hill_climber::HillClimber;
 use animats_evolve::optimiser::Optimiser;
 use animats_evolve::{checkpoint, Config, State};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
@@ -350,21 +351,55 @@ fn lanes_advance_together_and_a_failure_stops_the_batch() {
     }
 }
 
-/// A run advanced batch by batch grows its batches towards a quarter of a
-/// second's work, at most fourfold at a time, and never to zero.
+/// `advance_while` (how `animats evolve` runs): every lane one generation
+/// when `more` says no at once; lanes left at different generations when
+/// it stops them part way; and the same log, best and checkpoint, bit for
+/// bit, as lanes advanced together, on 1 to 3 threads.
 #[test]
-fn batches_grow_towards_a_quarter_second() {
-    use animats_evolve::next_batch;
-    use std::time::Duration;
-    // 10 generations in 10 ms: 250 would take 0.25 s; four times 10 first.
-    assert_eq!(next_batch(10, Duration::from_millis(10)), 40);
-    assert_eq!(next_batch(40, Duration::from_millis(40)), 160);
-    assert_eq!(next_batch(160, Duration::from_millis(160)), 250);
-    // Slower than that: fewer.
-    assert_eq!(next_batch(40, Duration::from_secs(1)), 10);
-    assert_eq!(next_batch(1, Duration::from_secs(10)), 1);
-    assert_eq!(next_batch(0, Duration::ZERO), 1);
-    assert!(next_batch(u64::MAX, Duration::ZERO) >= 1);
+fn lanes_that_never_wait_for_each_other_log_what_lanes_in_step_do() {
+    let config = Config::thesis(3, 30, 7);
+    let together = run(config.clone(), 1, 5);
+    let problem = config.problem.build().unwrap();
+
+    let mut s = State::new(config.clone()).unwrap();
+    pool(2)
+        .install(|| s.advance_while(problem.as_ref(), None, &|| false, &|_| ()))
+        .unwrap();
+    let gens: Vec<u64> = s.lanes.iter().map(|l| l.generation).collect();
+    assert_eq!(gens, vec![1, 1, 1]);
+
+    for threads in [1, 2, 3] {
+        let mut s = State::new(config.clone()).unwrap();
+        let (taken, rows) = (AtomicU64::new(0), AtomicU64::new(0));
+        // At most 17 generations more after each lane's first: a stop part
+        // way, whatever lane holds the last.
+        let more = || taken.fetch_add(1, Ordering::SeqCst) < 17;
+        let seen = |_: &animats_evolve::LogRow| {
+            rows.fetch_add(1, Ordering::SeqCst);
+        };
+        pool(threads)
+            .install(|| s.advance_while(problem.as_ref(), None, &more, &seen))
+            .unwrap();
+        let gens: Vec<u64> = s.lanes.iter().map(|l| l.generation).collect();
+        assert_eq!(
+            gens.iter().sum::<u64>(),
+            3 + 17,
+            "{threads} threads: {gens:?}"
+        );
+        assert_eq!(rows.load(Ordering::SeqCst), 20);
+        // A checkpoint now, resumed and run to the end.
+        // (20 generations over 3 lanes: never level.)
+        let path = scratch(&format!("uneven-{threads}")).join("checkpoint.json");
+        checkpoint::save(&path, &s).unwrap();
+        let mut back = checkpoint::load(&path).unwrap();
+        while !back.done() {
+            pool(threads)
+                .install(|| back.advance_while(problem.as_ref(), None, &|| true, &|_| ()))
+                .unwrap();
+        }
+        assert_eq!(back.log_csv(), together.log_csv(), "{threads} threads");
+        assert_eq!(back.best_toml(), together.best_toml(), "{threads} threads");
+    }
 }
 
 #[test]
