@@ -405,7 +405,6 @@ fn evolve(
         let begun = Instant::now();
         let live = Mutex::new(Live::new(state));
         let watcher = std::thread::current();
-        let finished = AtomicBool::new(false);
         let problem = problem.as_ref();
         let result = std::thread::scope(|scope| {
             let work = scope.spawn(|| {
@@ -416,11 +415,11 @@ fn evolve(
                     }
                 };
                 let r = pool.install(|| state.advance_while(problem, tracer, &more, &seen));
-                finished.store(true, Ordering::SeqCst);
                 watcher.unpark();
                 r
             });
-            while !finished.load(Ordering::SeqCst) {
+            // (Finished also when an evaluation panicked: then `join` says so.)
+            while !work.is_finished() {
                 std::thread::park_timeout(Duration::from_millis(250));
                 if let Ok(mut l) = live.lock() {
                     progress.show_numbers(l.generation(), l.evaluations(), l.best_fitness(), false);
