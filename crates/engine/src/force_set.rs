@@ -74,6 +74,15 @@ impl Forces {
         self.gravity.as_ref().map_or(DVec3::ZERO, |g| g.g)
     }
 
+    /// The forces added with [`crate::World::add_force`], in the order
+    /// they act (body forces, then contact forces).
+    pub fn user(&self) -> impl Iterator<Item = &dyn Force> {
+        self.user_body
+            .iter()
+            .chain(&self.user_contact)
+            .map(|f| f.as_ref())
+    }
+
     /// Whether evaluating splits work over the current rayon pool's
     /// threads, for a world of `n` particles (user forces aside: what they
     /// do inside is theirs).

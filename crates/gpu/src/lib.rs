@@ -1,0 +1,26 @@
+//! # animats-gpu
+//!
+//! The per-creature step of animats written a second time, in C
+//! (`kernel/step.h`), so that one GPU thread can step one creature of a
+//! batch that holds any mix of bodies — and proven equal to the Rust
+//! engine, bit for bit, by compiling the same C for the CPU (`build.rs`,
+//! contraction off) and comparing it with [`animats_engine::World::step`]
+//! on every test run (`tests/parity.rs`). The engine stays the one
+//! definition of the physics: a change to it that the C does not follow
+//! fails those tests.
+//!
+//! - [`Batch::pack`] lays worlds out as the C's structure of arrays with
+//!   per-creature offsets, refusing (naming the world and the entry) what
+//!   the C does not step yet.
+//! - [`Batch::run_cpu`] steps every creature with the C compiled for this
+//!   CPU.
+//!
+//! What the C covers today: particles, uniform gravity, damped springs,
+//! and the explicit integrators (Euler, midpoint, RK4, symplectic Euler) in
+//! worlds without events. The GPU launch (cudarc, NVRTC), the floor,
+//! joints, fluids, contacts, sensors, brains and fitness are issue 42's
+//! next steps; docs/GPU.md says where it stands.
+
+mod pack;
+
+pub use pack::Batch;

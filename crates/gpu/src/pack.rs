@@ -1,0 +1,248 @@
+//! Worlds laid out for the C step (`kernel/step.h`): structure of arrays,
+//! each creature's particles and springs a contiguous run found through
+//! per-creature offsets, so one batch holds bodies of any sizes.
+
+use animats_engine::{DVec3, IntegratorKind, World};
+use std::os::raw::{c_double, c_int, c_longlong};
+
+/// The C's `an_batch`: pointers into a [`Batch`]'s vectors.
+#[repr(C)]
+struct Raw {
+    first_particle: *const c_longlong,
+    first_spring: *const c_longlong,
+    inv_mass: *const c_double,
+    mass: *const c_double,
+    pos: *mut c_double,
+    vel: *mut c_double,
+    spring_a: *const c_int,
+    spring_b: *const c_int,
+    stiffness: *const c_double,
+    damping: *const c_double,
+    rest_length: *const c_double,
+    scratch: *mut c_double,
+    gx: c_double,
+    gy: c_double,
+    gz: c_double,
+    gravity: c_int,
+    integrator: c_int,
+    dt: c_double,
+}
+
+extern "C" {
+    fn animats_step_batch(batch: *const Raw, creatures: c_longlong, steps: c_longlong);
+}
+
+/// Doubles of scratch per particle the C step uses.
+const SCRATCH: usize = 15;
+
+/// Many worlds (creatures) as one batch of the C step's arrays.
+#[derive(Clone, Debug)]
+pub struct Batch {
+    first_particle: Vec<i64>,
+    first_spring: Vec<i64>,
+    inv_mass: Vec<f64>,
+    mass: Vec<f64>,
+    pos: Vec<f64>,
+    vel: Vec<f64>,
+    spring_a: Vec<i32>,
+    spring_b: Vec<i32>,
+    stiffness: Vec<f64>,
+    damping: Vec<f64>,
+    rest_length: Vec<f64>,
+    scratch: Vec<f64>,
+    g: DVec3,
+    gravity: bool,
+    integrator: IntegratorKind,
+    dt: f64,
+}
+
+impl Batch {
+    /// The worlds' current states and models, to be stepped by `dt`. Every
+    /// world must share the first one's gravity and integrator, and hold
+    /// only what the C steps (particles, gravity on every particle, damped
+    /// springs; no events): anything else is refused with a message naming
+    /// the world and what it holds.
+    pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
+        if !(dt > 0.0 && dt.is_finite()) {
+            return Err(format!(
+                "dt = {dt}: the step must be a positive number of seconds"
+            ));
+        }
+        let Some(first) = worlds.first() else {
+            return Err("no worlds to pack".into());
+        };
+        let (g, gravity, integrator) = (
+            first.forces().g(),
+            first.forces().gravity().is_some(),
+            first.integrator(),
+        );
+        let mut b = Batch {
+            first_particle: vec![0],
+            first_spring: vec![0],
+            inv_mass: Vec::new(),
+            mass: Vec::new(),
+            pos: Vec::new(),
+            vel: Vec::new(),
+            spring_a: Vec::new(),
+            spring_b: Vec::new(),
+            stiffness: Vec::new(),
+            damping: Vec::new(),
+            rest_length: Vec::new(),
+            scratch: Vec::new(),
+            g,
+            gravity,
+            integrator,
+            dt,
+        };
+        for (k, w) in worlds.iter().enumerate() {
+            supported(w).map_err(|what| format!("world {k}: {what}"))?;
+            let same_gravity = w.forces().gravity().is_some() == gravity
+                && w.forces().g().to_array().map(f64::to_bits) == g.to_array().map(f64::to_bits);
+            if !same_gravity || w.integrator() != integrator {
+                return Err(format!(
+                    "world {k}: a batch shares one gravity and one integrator; world 0 has g = {g} and {integrator:?}, this one g = {} and {:?}",
+                    w.forces().g(),
+                    w.integrator()
+                ));
+            }
+            let n = w.len();
+            if n > i32::MAX as usize {
+                return Err(format!(
+                    "world {k}: {n} particles are more than a batch indexes"
+                ));
+            }
+            let props = w.particles();
+            b.inv_mass.extend_from_slice(&props.inv_mass);
+            b.mass.extend_from_slice(&props.mass);
+            for p in &w.state().pos {
+                b.pos.extend(p.to_array());
+            }
+            for v in &w.state().vel {
+                b.vel.extend(v.to_array());
+            }
+            for s in w.forces().springs.iter() {
+                let (a, c) = s.ends();
+                b.spring_a.push(a.index() as i32);
+                b.spring_b.push(c.index() as i32);
+                b.stiffness.push(s.stiffness);
+                b.damping.push(s.damping);
+                b.rest_length.push(s.rest_length);
+            }
+            b.first_particle.push(b.mass.len() as i64);
+            b.first_spring.push(b.stiffness.len() as i64);
+        }
+        b.scratch = vec![0.0; SCRATCH * b.mass.len()];
+        Ok(b)
+    }
+
+    /// Creatures in the batch.
+    pub fn creatures(&self) -> usize {
+        self.first_particle.len() - 1
+    }
+
+    /// Creature `c`'s particle `i`: its position and velocity (`None` for
+    /// a creature or particle the batch does not have).
+    pub fn state(&self, c: usize, i: usize) -> Option<(DVec3, DVec3)> {
+        let (first, end) = (
+            *self.first_particle.get(c)?,
+            *self.first_particle.get(c + 1)?,
+        );
+        let p = first as usize + i;
+        if p >= end as usize {
+            return None;
+        }
+        let k = 3 * p;
+        Some((
+            DVec3::from_slice(&self.pos[k..k + 3]),
+            DVec3::from_slice(&self.vel[k..k + 3]),
+        ))
+    }
+
+    /// Steps every creature `steps` times with the C step compiled for this
+    /// CPU.
+    pub fn run_cpu(&mut self, steps: u64) {
+        let raw = self.raw();
+        // SAFETY: `raw` points into this batch's vectors, which the C reads
+        // and writes within the bounds the offsets give (checked when
+        // packed: every spring's ends lie within its creature), and nothing
+        // else touches them while it runs.
+        unsafe {
+            animats_step_batch(
+                &raw,
+                self.creatures() as c_longlong,
+                steps.min(i64::MAX as u64) as c_longlong,
+            )
+        };
+    }
+
+    fn raw(&mut self) -> Raw {
+        Raw {
+            first_particle: self.first_particle.as_ptr(),
+            first_spring: self.first_spring.as_ptr(),
+            inv_mass: self.inv_mass.as_ptr(),
+            mass: self.mass.as_ptr(),
+            pos: self.pos.as_mut_ptr(),
+            vel: self.vel.as_mut_ptr(),
+            spring_a: self.spring_a.as_ptr(),
+            spring_b: self.spring_b.as_ptr(),
+            stiffness: self.stiffness.as_ptr(),
+            damping: self.damping.as_ptr(),
+            rest_length: self.rest_length.as_ptr(),
+            scratch: self.scratch.as_mut_ptr(),
+            gx: self.g.x,
+            gy: self.g.y,
+            gz: self.g.z,
+            gravity: c_int::from(self.gravity),
+            integrator: match self.integrator {
+                IntegratorKind::Euler => 0,
+                IntegratorKind::Midpoint => 1,
+                IntegratorKind::Rk4 => 2,
+                _ => 3,
+            },
+            dt: self.dt,
+        }
+    }
+}
+
+/// Whether the C steps world `w` as the engine does: `Err` names the first
+/// thing it holds that the C does not step.
+fn supported(w: &World) -> Result<(), String> {
+    use animats_engine::Targets;
+    let f = w.forces();
+    let refuse = |what: &str| Err(format!("{what} is not in the GPU step yet"));
+    match w.integrator() {
+        IntegratorKind::Euler
+        | IntegratorKind::Midpoint
+        | IntegratorKind::Rk4
+        | IntegratorKind::Symplectic => {}
+        other => return refuse(&format!("the {other:?} integrator")),
+    }
+    if let Some(e) = w.events().first() {
+        return refuse(&format!("the event `{}`", e.name()));
+    }
+    if f.gravity().is_some_and(|g| g.targets != Targets::All) {
+        return refuse("gravity on some particles only");
+    }
+    if !f.angle_joints.is_empty() {
+        return refuse("an angle joint");
+    }
+    if !f.torque_joints.is_empty() {
+        return refuse("a torque joint");
+    }
+    if !f.constant_forces.is_empty() {
+        return refuse("a constant force");
+    }
+    if !f.fluids().is_empty() {
+        return refuse("a fluid");
+    }
+    if !f.nbody().is_empty() {
+        return refuse("n-body gravity");
+    }
+    if f.floor().is_some() {
+        return refuse("the floor's contact force");
+    }
+    if let Some(u) = f.user().next() {
+        return refuse(&format!("the user force `{}`", u.name()));
+    }
+    Ok(())
+}

@@ -1,0 +1,200 @@
+//! The C step (kernel/step.h, compiled for this CPU) against the engine,
+//! bit for bit: every particle's position and velocity after every step
+//! count checked, for each integrator the C covers, on a hanging chain and
+//! on batches of random spring bodies of mixed sizes (2 to 40 particles:
+//! both of the engine's paths, below and above its 16-particle "small
+//! world" loop), with and without gravity.
+
+use animats_engine::{DVec3, IntegratorKind, ParticleDef, SpringDef, World};
+use animats_gpu::Batch;
+
+const INTEGRATORS: [IntegratorKind; 4] = [
+    IntegratorKind::Euler,
+    IntegratorKind::Midpoint,
+    IntegratorKind::Rk4,
+    IntegratorKind::Symplectic,
+];
+
+/// A reproducible stream of numbers in [0, 1).
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn between(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next()
+    }
+    fn vec(&mut self, scale: f64) -> DVec3 {
+        DVec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * scale
+    }
+}
+
+/// A random body of `n` particles: a ring of springs through them all,
+/// then as many again between random pairs, each of its own stiffness,
+/// damping and rest length; random masses, positions and velocities.
+fn random_body(rng: &mut Lcg, n: usize, gravity: bool, kind: IntegratorKind) -> World {
+    let mut w = World::new();
+    if gravity {
+        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+    }
+    w.set_integrator(kind);
+    let ids: Vec<_> = (0..n)
+        .map(|_| {
+            let def = ParticleDef::new(rng.between(0.1, 3.0))
+                .at(rng.vec(2.0))
+                .with_velocity(rng.vec(1.0));
+            w.add_particle(def).unwrap()
+        })
+        .collect();
+    for i in 0..2 * n {
+        let (a, b) = if i < n {
+            (i, (i + 1) % n)
+        } else {
+            let a = (rng.next() * n as f64) as usize;
+            (a, (a + 1 + (rng.next() * (n - 1) as f64) as usize) % n)
+        };
+        if a == b {
+            continue;
+        }
+        let def = SpringDef::new(
+            ids[a],
+            ids[b],
+            rng.between(10.0, 400.0),
+            rng.between(0.0, 2.0),
+        )
+        .with_rest_length(rng.between(0.2, 1.5));
+        w.add_spring(def).unwrap();
+    }
+    w
+}
+
+/// Steps `worlds` with the engine and a batch of them with the C, `steps`
+/// at a time, `rounds` times, and asserts every coordinate equal.
+fn assert_same(worlds: &mut [World], dt: f64, steps: u64, rounds: usize, what: &str) {
+    let refs: Vec<&World> = worlds.iter().collect();
+    let mut batch = Batch::pack(&refs, dt).unwrap();
+    for round in 1..=rounds {
+        for w in worlds.iter_mut() {
+            for _ in 0..steps {
+                w.step(dt).unwrap();
+            }
+        }
+        batch.run_cpu(steps);
+        for (c, w) in worlds.iter().enumerate() {
+            for i in 0..w.len() {
+                let (x, v) = batch.state(c, i).unwrap();
+                let (ex, ev) = (w.state().pos[i], w.state().vel[i]);
+                let bits = |a: DVec3| a.to_array().map(f64::to_bits);
+                assert!(
+                    bits(x) == bits(ex) && bits(v) == bits(ev),
+                    "{what}: creature {c}, particle {i}, after {} steps: C x = {x}, v = {v}; engine x = {ex}, v = {ev}",
+                    round as u64 * steps
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_hanging_chain_is_the_engine_s_to_the_bit_under_every_integrator() {
+    for kind in INTEGRATORS {
+        let mut w = World::new();
+        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+        w.set_integrator(kind);
+        let ids: Vec<_> = (0..8)
+            .map(|i| {
+                w.add_particle(ParticleDef::new(0.5).at(DVec3::new(0.3 * i as f64, 2.0, 0.0)))
+                    .unwrap()
+            })
+            .collect();
+        for pair in ids.windows(2) {
+            w.add_spring(SpringDef::new(pair[0], pair[1], 200.0, 0.5).with_rest_length(0.3))
+                .unwrap();
+        }
+        assert_same(&mut [w], 1e-3, 500, 4, &format!("chain, {kind:?}"));
+    }
+}
+
+#[test]
+fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
+    let mut rng = Lcg(42);
+    for kind in INTEGRATORS {
+        for gravity in [true, false] {
+            let mut worlds: Vec<World> = (0..24)
+                .map(|_| {
+                    let n = 2 + (rng.next() * 39.0) as usize;
+                    random_body(&mut rng, n, gravity, kind)
+                })
+                .collect();
+            let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
+            assert!(sizes.iter().any(|&n| n < 16) && sizes.iter().any(|&n| n >= 16));
+            assert_same(
+                &mut worlds,
+                5e-4,
+                400,
+                3,
+                &format!("random bodies {sizes:?}, {kind:?}, gravity {gravity}"),
+            );
+        }
+    }
+}
+
+#[test]
+fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
+    let plain = || {
+        let mut w = World::new();
+        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+        let a = w.add_particle(ParticleDef::new(1.0).at(DVec3::Y)).unwrap();
+        let b = w.add_particle(ParticleDef::new(1.0).at(DVec3::X)).unwrap();
+        w.add_spring(SpringDef::new(a, b, 10.0, 0.1)).unwrap();
+        w
+    };
+    let mut floor = plain();
+    floor.add_floor(Default::default()).unwrap();
+    let err = Batch::pack(&[&plain(), &floor], 1e-3).unwrap_err();
+    assert!(
+        err.starts_with("world 1: ") && err.contains("not in the GPU step yet"),
+        "{err}"
+    );
+
+    let mut joint = plain();
+    let c = joint.add_particle(ParticleDef::new(1.0)).unwrap();
+    let ids: Vec<_> = joint.particle_ids().collect();
+    joint
+        .add_angle_joint(animats_engine::AngleJointDef::new(
+            ids[0], ids[1], c, 5.0, 0.1,
+        ))
+        .unwrap();
+    let err = Batch::pack(&[&joint], 1e-3).unwrap_err();
+    assert_eq!(err, "world 0: an angle joint is not in the GPU step yet");
+
+    let mut implicit = plain();
+    implicit.set_integrator(IntegratorKind::Implicit);
+    let err = Batch::pack(&[&implicit], 1e-3).unwrap_err();
+    assert!(
+        err.contains("Implicit integrator is not in the GPU step yet"),
+        "{err}"
+    );
+
+    let mut weightless = plain();
+    weightless.set_gravity_force(None).unwrap();
+    let err = Batch::pack(&[&plain(), &weightless], 1e-3).unwrap_err();
+    assert!(
+        err.starts_with("world 1: a batch shares one gravity"),
+        "{err}"
+    );
+
+    for dt in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(Batch::pack(&[&plain()], dt).is_err(), "dt {dt}");
+    }
+    assert!(Batch::pack(&[], 1e-3).is_err());
+    let batch = Batch::pack(&[&plain()], 1e-3).unwrap();
+    assert!(batch.state(0, 1).is_some());
+    assert_eq!(batch.state(0, 2), None);
+    assert_eq!(batch.state(1, 0), None);
+}
