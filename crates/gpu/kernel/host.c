@@ -6,3 +6,9 @@ void animats_step_batch(const an_batch *b, long long creatures, long long steps)
         an_step_creature(b, c, steps);
     }
 }
+
+/* The ported functions, for their tests against the `libm` crate. */
+#include "libm.h"
+
+double animats_atan(double x) { return an_atan(x); }
+double animats_atan2(double y, double x) { return an_atan2(y, x); }

@@ -16,11 +16,13 @@
 //!   CPU.
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
-//! and the explicit integrators (Euler, midpoint, RK4, symplectic Euler) in
-//! worlds without events. The GPU launch (cudarc, NVRTC), the floor,
+//! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
+//! torque joints, and the explicit integrators (Euler, midpoint, RK4,
+//! symplectic Euler) in worlds without events. The GPU launch (cudarc, NVRTC), the floor,
 //! joints, fluids, contacts, sensors, brains and fitness are issue 42's
 //! next steps; docs/GPU.md says where it stands.
 
 mod pack;
+pub mod ported;
 
 pub use pack::Batch;

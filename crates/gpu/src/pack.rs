@@ -20,6 +20,18 @@ struct Raw {
     damping: *const c_double,
     rest_length: *const c_double,
     scratch: *mut c_double,
+    first_joint: *const c_longlong,
+    joint_a: *const c_int,
+    joint_j: *const c_int,
+    joint_b: *const c_int,
+    joint_stiffness: *const c_double,
+    joint_damping: *const c_double,
+    joint_rest: *const c_double,
+    first_motor: *const c_longlong,
+    motor_end: *const c_int,
+    motor_joint: *const c_int,
+    motor_axis: *const c_double,
+    motor_torque: *const c_double,
     gx: c_double,
     gy: c_double,
     gz: c_double,
@@ -50,6 +62,18 @@ pub struct Batch {
     damping: Vec<f64>,
     rest_length: Vec<f64>,
     scratch: Vec<f64>,
+    first_joint: Vec<i64>,
+    joint_a: Vec<i32>,
+    joint_j: Vec<i32>,
+    joint_b: Vec<i32>,
+    joint_stiffness: Vec<f64>,
+    joint_damping: Vec<f64>,
+    joint_rest: Vec<f64>,
+    first_motor: Vec<i64>,
+    motor_end: Vec<i32>,
+    motor_joint: Vec<i32>,
+    motor_axis: Vec<f64>,
+    motor_torque: Vec<f64>,
     g: DVec3,
     gravity: bool,
     integrator: IntegratorKind,
@@ -60,7 +84,8 @@ impl Batch {
     /// The worlds' current states and models, to be stepped by `dt`. Every
     /// world must share the first one's gravity and integrator, and hold
     /// only what the C steps (particles, gravity on every particle, damped
-    /// springs; no events): anything else is refused with a message naming
+    /// springs, angle joints, torque joints at their present torques; no
+    /// events): anything else is refused with a message naming
     /// the world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
@@ -89,6 +114,18 @@ impl Batch {
             damping: Vec::new(),
             rest_length: Vec::new(),
             scratch: Vec::new(),
+            first_joint: vec![0],
+            joint_a: Vec::new(),
+            joint_j: Vec::new(),
+            joint_b: Vec::new(),
+            joint_stiffness: Vec::new(),
+            joint_damping: Vec::new(),
+            joint_rest: Vec::new(),
+            first_motor: vec![0],
+            motor_end: Vec::new(),
+            motor_joint: Vec::new(),
+            motor_axis: Vec::new(),
+            motor_torque: Vec::new(),
             g,
             gravity,
             integrator,
@@ -128,8 +165,26 @@ impl Batch {
                 b.damping.push(s.damping);
                 b.rest_length.push(s.rest_length);
             }
+            for jt in w.forces().angle_joints.iter() {
+                let (a, j, e) = jt.particles();
+                b.joint_a.push(a.index() as i32);
+                b.joint_j.push(j.index() as i32);
+                b.joint_b.push(e.index() as i32);
+                b.joint_stiffness.push(jt.stiffness);
+                b.joint_damping.push(jt.damping);
+                b.joint_rest.push(jt.rest_angle);
+            }
+            for m in w.forces().torque_joints.iter() {
+                let (e, j) = m.particles();
+                b.motor_end.push(e.index() as i32);
+                b.motor_joint.push(j.index() as i32);
+                b.motor_axis.extend(m.axis().to_array());
+                b.motor_torque.push(m.torque);
+            }
             b.first_particle.push(b.mass.len() as i64);
             b.first_spring.push(b.stiffness.len() as i64);
+            b.first_joint.push(b.joint_a.len() as i64);
+            b.first_motor.push(b.motor_end.len() as i64);
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         Ok(b)
@@ -189,6 +244,18 @@ impl Batch {
             damping: self.damping.as_ptr(),
             rest_length: self.rest_length.as_ptr(),
             scratch: self.scratch.as_mut_ptr(),
+            first_joint: self.first_joint.as_ptr(),
+            joint_a: self.joint_a.as_ptr(),
+            joint_j: self.joint_j.as_ptr(),
+            joint_b: self.joint_b.as_ptr(),
+            joint_stiffness: self.joint_stiffness.as_ptr(),
+            joint_damping: self.joint_damping.as_ptr(),
+            joint_rest: self.joint_rest.as_ptr(),
+            first_motor: self.first_motor.as_ptr(),
+            motor_end: self.motor_end.as_ptr(),
+            motor_joint: self.motor_joint.as_ptr(),
+            motor_axis: self.motor_axis.as_ptr(),
+            motor_torque: self.motor_torque.as_ptr(),
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -222,12 +289,6 @@ fn supported(w: &World) -> Result<(), String> {
     }
     if f.gravity().is_some_and(|g| g.targets != Targets::All) {
         return refuse("gravity on some particles only");
-    }
-    if !f.angle_joints.is_empty() {
-        return refuse("an angle joint");
-    }
-    if !f.torque_joints.is_empty() {
-        return refuse("a torque joint");
     }
     if !f.constant_forces.is_empty() {
         return refuse("a constant force");

@@ -1,0 +1,21 @@
+//! The C port of the step's transcendental functions (`kernel/libm.h`),
+//! callable from Rust so its tests can hold it to the `libm` crate's bits.
+
+use std::os::raw::c_double;
+
+extern "C" {
+    fn animats_atan(x: c_double) -> c_double;
+    fn animats_atan2(y: c_double, x: c_double) -> c_double;
+}
+
+/// `atan x` as the C step computes it.
+pub fn atan(x: f64) -> f64 {
+    // SAFETY: a pure function of its argument.
+    unsafe { animats_atan(x) }
+}
+
+/// `atan2(y, x)` as the C step computes it.
+pub fn atan2(y: f64, x: f64) -> f64 {
+    // SAFETY: a pure function of its arguments.
+    unsafe { animats_atan2(y, x) }
+}

@@ -1,0 +1,87 @@
+//! The C port of the step's transcendental functions (kernel/libm.h)
+//! against the engine's (`animats_engine::math`, the `libm` crate), bit for
+//! bit, on more than a million arguments each: every special value, then
+//! random ones spread over every binade and sign, then random bit patterns.
+
+use animats_engine::math;
+use animats_gpu::ported;
+
+/// Random 64-bit patterns.
+struct Bits(u64);
+
+impl Bits {
+    fn next(&mut self) -> u64 {
+        // splitmix64
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// A double of random sign, mantissa and exponent in 2^lo … 2^hi.
+    fn spread(&mut self, lo: i32, hi: i32) -> f64 {
+        let b = self.next();
+        let e = lo + (b % (hi - lo + 1) as u64) as i32;
+        let m = 1.0 + (b >> 12) as f64 / (1u64 << 52) as f64;
+        let v = m * 2f64.powi(e);
+        if b & 1 == 0 {
+            v
+        } else {
+            -v
+        }
+    }
+}
+
+const SPECIAL: [f64; 14] = [
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    0.4375,
+    1.1875,
+    2.4375,
+    f64::MIN_POSITIVE,
+    5e-324,
+    f64::MAX,
+    -f64::MAX,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    f64::NAN,
+];
+
+fn same(a: f64, b: f64) -> bool {
+    a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan())
+}
+
+#[test]
+fn atan_is_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(1);
+    let mut args: Vec<f64> = SPECIAL.to_vec();
+    args.extend((0..600_000).map(|_| r.spread(-40, 70)));
+    args.extend((0..500_000).map(|_| f64::from_bits(r.next())));
+    for x in args {
+        let (c, rust) = (ported::atan(x), math::atan(x));
+        assert!(same(c, rust), "atan({x:e}): C {c:e}, libm {rust:e}");
+    }
+}
+
+#[test]
+fn atan2_is_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(2);
+    for &y in &SPECIAL {
+        for &x in &SPECIAL {
+            let (c, rust) = (ported::atan2(y, x), math::atan2(y, x));
+            assert!(same(c, rust), "atan2({y:e}, {x:e}): C {c:e}, libm {rust:e}");
+        }
+    }
+    for i in 0..1_100_000 {
+        let (y, x) = match i % 3 {
+            // Near each other (the angle joints' case), far apart, anything.
+            0 => (r.spread(-4, 4), r.spread(-4, 4)),
+            1 => (r.spread(-80, 80), r.spread(-80, 80)),
+            _ => (f64::from_bits(r.next()), f64::from_bits(r.next())),
+        };
+        let (c, rust) = (ported::atan2(y, x), math::atan2(y, x));
+        assert!(same(c, rust), "atan2({y:e}, {x:e}): C {c:e}, libm {rust:e}");
+    }
+}
