@@ -13,8 +13,8 @@
  * follow fails crates/gpu/tests/parity.rs.
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
- * (their atan2 ported from the `libm` crate, libm.h), torque joints, and
- * the explicit integrators (Euler, midpoint, RK4, symplectic Euler), in
+ * (their atan2 ported from the `libm` crate, libm.h), torque joints, still
+ * fluids on every particle, and the explicit integrators (Euler, midpoint, RK4, symplectic Euler), in
  * worlds without events. Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
  */
@@ -37,8 +37,9 @@ enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
  * per-creature offsets: creature c owns particles first_particle[c] ..
  * first_particle[c + 1] - 1 and springs first_spring[c] ..
  * first_spring[c + 1] - 1, whose ends are indices within the creature.
- * Angle joints (first_joint, ends a and b, joint j) and torque joints
- * (first_motor, end and joint, unit axis, torque) likewise. Vectors are
+ * Angle joints (first_joint, ends a and b, joint j), torque joints
+ * (first_motor, end and joint, unit axis, torque) and still fluids on
+ * every particle (first_fluid) likewise. Vectors are
  * stored x, y, z per particle. `scratch` holds 15 doubles per particle
  * (force, and RK4's start and sums).
  */
@@ -67,6 +68,11 @@ typedef struct {
     const int *motor_joint;
     const double *motor_axis; /* 3 per motor */
     const double *motor_torque;
+    const long long *first_fluid;
+    const double *fluid_drag;    /* -0.5 C rho pi, as the engine forms it */
+    const double *fluid_density;
+    const double *radius;
+    const double *volume;
     double gx, gy, gz;
     int gravity; /* 1: gravity pulls every particle; 0: none */
     int integrator;
@@ -152,9 +158,34 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
     }
 }
 
+/* Still fluids q0 .. q0 + nq - 1 on every particle of the creature
+ * (forces/fluid.rs, `force_on`): quadratic drag and buoyancy. */
+AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0, long long nq,
+                     const double *v, double *f) {
+    double g[3] = {b->gx, b->gy, b->gz};
+    if (!b->gravity) {
+        g[0] = 0.0;
+        g[1] = 0.0;
+        g[2] = 0.0;
+    }
+    for (long long q = q0; q < q0 + nq; q++) {
+        double drag = b->fluid_drag[q], density = b->fluid_density[q];
+        for (long long i = 0; i < n; i++) {
+            double r = b->radius[p0 + i];
+            const double *vr = v + 3 * i;
+            double speed = sqrt(an_dot(vr, vr));
+            double s = drag * r * r * speed;
+            double lift = -b->volume[p0 + i] * density;
+            for (int k = 0; k < 3; k++) {
+                f[3 * i + k] += vr[k] * s + g[k] * lift;
+            }
+        }
+    }
+}
+
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints. */
+ * joints, torque joints, fluids. */
 AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, long long s0,
                      long long ns, const double *x, const double *v, double *f) {
     for (long long i = 0; i < n; i++) {
@@ -193,6 +224,8 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
     long long j0 = b->first_joint[c], m0 = b->first_motor[c];
     an_angle_joints(b, j0, b->first_joint[c + 1] - j0, x, v, f);
     an_motors(b, m0, b->first_motor[c + 1] - m0, x, f);
+    long long q0 = b->first_fluid[c];
+    an_fluids(b, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
 }
 
 /* `steps` steps of creature c. */

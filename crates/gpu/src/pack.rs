@@ -32,6 +32,11 @@ struct Raw {
     motor_joint: *const c_int,
     motor_axis: *const c_double,
     motor_torque: *const c_double,
+    first_fluid: *const c_longlong,
+    fluid_drag: *const c_double,
+    fluid_density: *const c_double,
+    radius: *const c_double,
+    volume: *const c_double,
     gx: c_double,
     gy: c_double,
     gz: c_double,
@@ -74,6 +79,11 @@ pub struct Batch {
     motor_joint: Vec<i32>,
     motor_axis: Vec<f64>,
     motor_torque: Vec<f64>,
+    first_fluid: Vec<i64>,
+    fluid_drag: Vec<f64>,
+    fluid_density: Vec<f64>,
+    radius: Vec<f64>,
+    volume: Vec<f64>,
     g: DVec3,
     gravity: bool,
     integrator: IntegratorKind,
@@ -84,8 +94,8 @@ impl Batch {
     /// The worlds' current states and models, to be stepped by `dt`. Every
     /// world must share the first one's gravity and integrator, and hold
     /// only what the C steps (particles, gravity on every particle, damped
-    /// springs, angle joints, torque joints at their present torques; no
-    /// events): anything else is refused with a message naming
+    /// springs, angle joints, torque joints at their present torques,
+    /// still fluids about every particle; no events): anything else is refused with a message naming
     /// the world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
@@ -126,6 +136,11 @@ impl Batch {
             motor_joint: Vec::new(),
             motor_axis: Vec::new(),
             motor_torque: Vec::new(),
+            first_fluid: vec![0],
+            fluid_drag: Vec::new(),
+            fluid_density: Vec::new(),
+            radius: Vec::new(),
+            volume: Vec::new(),
             g,
             gravity,
             integrator,
@@ -181,10 +196,19 @@ impl Batch {
                 b.motor_axis.extend(m.axis().to_array());
                 b.motor_torque.push(m.torque);
             }
+            for fl in w.forces().fluids() {
+                // As FluidMedium::apply forms it.
+                b.fluid_drag
+                    .push(-0.5 * fl.drag_coefficient * fl.density * std::f64::consts::PI);
+                b.fluid_density.push(fl.density);
+            }
+            b.radius.extend_from_slice(&props.radius);
+            b.volume.extend_from_slice(&props.volume);
             b.first_particle.push(b.mass.len() as i64);
             b.first_spring.push(b.stiffness.len() as i64);
             b.first_joint.push(b.joint_a.len() as i64);
             b.first_motor.push(b.motor_end.len() as i64);
+            b.first_fluid.push(b.fluid_drag.len() as i64);
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         Ok(b)
@@ -256,6 +280,11 @@ impl Batch {
             motor_joint: self.motor_joint.as_ptr(),
             motor_axis: self.motor_axis.as_ptr(),
             motor_torque: self.motor_torque.as_ptr(),
+            first_fluid: self.first_fluid.as_ptr(),
+            fluid_drag: self.fluid_drag.as_ptr(),
+            fluid_density: self.fluid_density.as_ptr(),
+            radius: self.radius.as_ptr(),
+            volume: self.volume.as_ptr(),
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -293,8 +322,13 @@ fn supported(w: &World) -> Result<(), String> {
     if !f.constant_forces.is_empty() {
         return refuse("a constant force");
     }
-    if !f.fluids().is_empty() {
-        return refuse("a fluid");
+    for fl in f.fluids() {
+        if fl.targets != Targets::All {
+            return refuse("a fluid about some particles only");
+        }
+        if !matches!(fl.current, animats_engine::Current::Still) {
+            return refuse("a fluid's current");
+        }
     }
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");

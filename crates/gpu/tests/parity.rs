@@ -4,10 +4,11 @@
 //! on batches of random bodies of mixed sizes (2 to 40 particles: both of
 //! the engine's paths, below and above its 16-particle "small world"
 //! loop) of springs, angle joints and torque joints, with and without
-//! gravity.
+//! gravity, in water and air or not.
 
 use animats_engine::{
-    AngleJointDef, DVec3, IntegratorKind, ParticleDef, SpringDef, TorqueJointDef, World,
+    AngleJointDef, DVec3, FluidMedium, IntegratorKind, ParticleDef, SpringDef, TorqueJointDef,
+    World,
 };
 use animats_gpu::Batch;
 
@@ -41,7 +42,7 @@ impl Lcg {
 /// then as many again between random pairs, each of its own stiffness,
 /// damping and rest length; with `joints`, an angle joint (at rest at its
 /// first angle) and a torque joint (a random axis and torque) for every
-/// third particle; random masses, positions and velocities.
+/// third particle; random masses, radii, positions and velocities.
 fn random_body(
     rng: &mut Lcg,
     n: usize,
@@ -57,6 +58,7 @@ fn random_body(
     let ids: Vec<_> = (0..n)
         .map(|_| {
             let def = ParticleDef::new(rng.between(0.1, 3.0))
+                .with_radius(rng.between(0.02, 0.2))
                 .at(rng.vec(2.0))
                 .with_velocity(rng.vec(1.0));
             w.add_particle(def).unwrap()
@@ -155,11 +157,21 @@ fn a_hanging_chain_is_the_engine_s_to_the_bit_under_every_integrator() {
 fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
     let mut rng = Lcg(42);
     for kind in INTEGRATORS {
-        for (gravity, joints) in [(true, true), (false, true), (true, false)] {
+        for (gravity, joints, water) in [
+            (true, true, true),
+            (true, true, false),
+            (false, true, false),
+            (true, false, false),
+        ] {
             let mut worlds: Vec<World> = (0..24)
                 .map(|_| {
                     let n = 2 + (rng.next() * 39.0) as usize;
-                    random_body(&mut rng, n, gravity, joints, kind)
+                    let mut w = random_body(&mut rng, n, gravity, joints, kind);
+                    if water {
+                        w.add_fluid(FluidMedium::water()).unwrap();
+                        w.add_fluid(FluidMedium::air()).unwrap();
+                    }
+                    w
                 })
                 .collect();
             let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
@@ -169,7 +181,7 @@ fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
                 5e-4,
                 400,
                 3,
-                &format!("random bodies {sizes:?}, {kind:?}, gravity {gravity}, joints {joints}"),
+                &format!("random bodies {sizes:?}, {kind:?}, gravity {gravity}, joints {joints}, water {water}"),
             );
         }
     }
@@ -193,10 +205,11 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "{err}"
     );
 
-    let mut wet = plain();
-    wet.add_fluid(animats_engine::FluidMedium::water()).unwrap();
-    let err = Batch::pack(&[&wet], 1e-3).unwrap_err();
-    assert_eq!(err, "world 0: a fluid is not in the GPU step yet");
+    let mut pushed = plain();
+    let ids: Vec<_> = pushed.particle_ids().collect();
+    pushed.add_constant_force(ids, DVec3::X).unwrap();
+    let err = Batch::pack(&[&pushed], 1e-3).unwrap_err();
+    assert_eq!(err, "world 0: a constant force is not in the GPU step yet");
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);
