@@ -12,3 +12,8 @@ void animats_step_batch(const an_batch *b, long long creatures, long long steps)
 
 double animats_atan(double x) { return an_atan(x); }
 double animats_atan2(double y, double x) { return an_atan2(y, x); }
+
+#include "trig.h"
+
+double animats_sin(double x) { return an_sin(x); }
+double animats_cos(double x) { return an_cos(x); }

@@ -1,4 +1,5 @@
-//! The C port of the step's transcendental functions (`kernel/libm.h`),
+//! The C port of the step's transcendental functions (`kernel/libm.h`,
+//! `kernel/trig.h`),
 //! callable from Rust so its tests can hold it to the `libm` crate's bits.
 
 use std::os::raw::c_double;
@@ -6,6 +7,20 @@ use std::os::raw::c_double;
 extern "C" {
     fn animats_atan(x: c_double) -> c_double;
     fn animats_atan2(y: c_double, x: c_double) -> c_double;
+    fn animats_sin(x: c_double) -> c_double;
+    fn animats_cos(x: c_double) -> c_double;
+}
+
+/// `sin x` as the C step computes it.
+pub fn sin(x: f64) -> f64 {
+    // SAFETY: a pure function of its argument.
+    unsafe { animats_sin(x) }
+}
+
+/// `cos x` as the C step computes it.
+pub fn cos(x: f64) -> f64 {
+    // SAFETY: a pure function of its argument.
+    unsafe { animats_cos(x) }
 }
 
 /// `atan x` as the C step computes it.

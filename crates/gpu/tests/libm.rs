@@ -1,4 +1,5 @@
-//! The C port of the step's transcendental functions (kernel/libm.h)
+//! The C port of the step's transcendental functions (kernel/libm.h,
+//! kernel/trig.h)
 //! against the engine's (`animats_engine::math`, the `libm` crate), bit for
 //! bit, on more than a million arguments each: every special value, then
 //! random ones spread over every binade and sign, then random bit patterns.
@@ -83,5 +84,33 @@ fn atan2_is_the_libm_crate_s_to_the_bit() {
         };
         let (c, rust) = (ported::atan2(y, x), math::atan2(y, x));
         assert!(same(c, rust), "atan2({y:e}, {x:e}): C {c:e}, libm {rust:e}");
+    }
+}
+
+#[test]
+fn sin_and_cos_are_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(3);
+    let mut args: Vec<f64> = SPECIAL.to_vec();
+    // Near multiples of π/2 (the reduction's hard cases), small and
+    // medium arguments, huge ones (the long reduction), any bits.
+    args.extend((1..20_000).flat_map(|k| {
+        let x = k as f64 * std::f64::consts::FRAC_PI_2;
+        [
+            x,
+            f64::from_bits(x.to_bits() + 1),
+            f64::from_bits(x.to_bits() - 1),
+            -x,
+        ]
+    }));
+    args.extend((0..400_000).map(|_| r.spread(-30, 8)));
+    args.extend((0..300_000).map(|_| r.spread(8, 40)));
+    args.extend((0..100_000).map(|_| r.spread(40, 1023)));
+    args.extend((0..250_000).map(|_| f64::from_bits(r.next())));
+    assert!(args.len() > 1_000_000);
+    for x in args {
+        let (c, rust) = (ported::sin(x), math::sin(x));
+        assert!(same(c, rust), "sin({x:e}): C {c:e}, libm {rust:e}");
+        let (c, rust) = (ported::cos(x), math::cos(x));
+        assert!(same(c, rust), "cos({x:e}): C {c:e}, libm {rust:e}");
     }
 }
