@@ -14,15 +14,22 @@
 //!   the C does not step yet.
 //! - [`Batch::run_cpu`] steps every creature with the C compiled for this
 //!   CPU.
+//! - [`Device::open`] loads the NVIDIA driver and NVRTC at run time and
+//!   compiles the same C for the GPU (a CUBIN for its architecture,
+//!   `--fmad=false`); [`Device::run`] steps a batch there, one thread per
+//!   creature. Where no driver, device or NVRTC is found, `open` says
+//!   which. Not yet run on a GPU (docs/GPU.md).
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
 //! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
 //! torque joints, and the explicit integrators (Euler, midpoint, RK4,
-//! symplectic Euler) in worlds without events. The GPU launch (cudarc, NVRTC), the floor,
-//! joints, fluids, contacts, sensors, brains and fitness are issue 42's
-//! next steps; docs/GPU.md says where it stands.
+//! symplectic Euler) in worlds without events. The floor, contacts, sensors, brains and
+//! fitness are issue 42's next steps; docs/GPU.md says where it stands.
 
+pub mod bodies;
+pub mod cuda;
 mod pack;
 pub mod ported;
 
+pub use cuda::Device;
 pub use pack::Batch;

@@ -5,9 +5,10 @@
 use animats_engine::{DVec3, IntegratorKind, World};
 use std::os::raw::{c_double, c_int, c_longlong};
 
-/// The C's `an_batch`: pointers into a [`Batch`]'s vectors.
+/// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
+/// copies on a GPU).
 #[repr(C)]
-struct Raw {
+pub(crate) struct Raw {
     first_particle: *const c_longlong,
     first_spring: *const c_longlong,
     inv_mass: *const c_double,
@@ -255,36 +256,103 @@ impl Batch {
     }
 
     fn raw(&mut self) -> Raw {
+        let addresses: Vec<u64> = Array::ALL.iter().map(|&a| self.host_address(a)).collect();
+        self.raw_with(|a| addresses[a as usize])
+    }
+
+    /// The address of array `a` in this process.
+    fn host_address(&mut self, a: Array) -> u64 {
+        match a {
+            Array::Pos => self.pos.as_mut_ptr() as u64,
+            Array::Vel => self.vel.as_mut_ptr() as u64,
+            Array::Scratch => self.scratch.as_mut_ptr() as u64,
+            other => match self.array(other) {
+                Slice::F64(v) => v.as_ptr() as u64,
+                Slice::I32(v) => v.as_ptr() as u64,
+                Slice::I64(v) => v.as_ptr() as u64,
+            },
+        }
+    }
+
+    /// Array `a`.
+    pub(crate) fn array(&self, a: Array) -> Slice<'_> {
+        use Slice::{F64, I32, I64};
+        match a {
+            Array::FirstParticle => I64(&self.first_particle),
+            Array::FirstSpring => I64(&self.first_spring),
+            Array::InvMass => F64(&self.inv_mass),
+            Array::Mass => F64(&self.mass),
+            Array::Pos => F64(&self.pos),
+            Array::Vel => F64(&self.vel),
+            Array::SpringA => I32(&self.spring_a),
+            Array::SpringB => I32(&self.spring_b),
+            Array::Stiffness => F64(&self.stiffness),
+            Array::Damping => F64(&self.damping),
+            Array::RestLength => F64(&self.rest_length),
+            Array::Scratch => F64(&self.scratch),
+            Array::FirstJoint => I64(&self.first_joint),
+            Array::JointA => I32(&self.joint_a),
+            Array::JointJ => I32(&self.joint_j),
+            Array::JointB => I32(&self.joint_b),
+            Array::JointStiffness => F64(&self.joint_stiffness),
+            Array::JointDamping => F64(&self.joint_damping),
+            Array::JointRest => F64(&self.joint_rest),
+            Array::FirstMotor => I64(&self.first_motor),
+            Array::MotorEnd => I32(&self.motor_end),
+            Array::MotorJoint => I32(&self.motor_joint),
+            Array::MotorAxis => F64(&self.motor_axis),
+            Array::MotorTorque => F64(&self.motor_torque),
+            Array::FirstFluid => I64(&self.first_fluid),
+            Array::FluidDrag => F64(&self.fluid_drag),
+            Array::FluidDensity => F64(&self.fluid_density),
+            Array::Radius => F64(&self.radius),
+            Array::Volume => F64(&self.volume),
+        }
+    }
+
+    /// Positions and velocities written back (from a GPU).
+    pub(crate) fn set_state(&mut self, pos: &[f64], vel: &[f64]) {
+        let n = self.pos.len();
+        self.pos.copy_from_slice(&pos[..n]);
+        self.vel.copy_from_slice(&vel[..n]);
+    }
+
+    /// The C's struct with array `a` at address `at(a)`.
+    pub(crate) fn raw_with(&self, at: impl Fn(Array) -> u64) -> Raw {
+        let c = |a| at(a) as *const c_double;
+        let m = |a| at(a) as *mut c_double;
+        let i = |a| at(a) as *const c_int;
+        let l = |a| at(a) as *const c_longlong;
         Raw {
-            first_particle: self.first_particle.as_ptr(),
-            first_spring: self.first_spring.as_ptr(),
-            inv_mass: self.inv_mass.as_ptr(),
-            mass: self.mass.as_ptr(),
-            pos: self.pos.as_mut_ptr(),
-            vel: self.vel.as_mut_ptr(),
-            spring_a: self.spring_a.as_ptr(),
-            spring_b: self.spring_b.as_ptr(),
-            stiffness: self.stiffness.as_ptr(),
-            damping: self.damping.as_ptr(),
-            rest_length: self.rest_length.as_ptr(),
-            scratch: self.scratch.as_mut_ptr(),
-            first_joint: self.first_joint.as_ptr(),
-            joint_a: self.joint_a.as_ptr(),
-            joint_j: self.joint_j.as_ptr(),
-            joint_b: self.joint_b.as_ptr(),
-            joint_stiffness: self.joint_stiffness.as_ptr(),
-            joint_damping: self.joint_damping.as_ptr(),
-            joint_rest: self.joint_rest.as_ptr(),
-            first_motor: self.first_motor.as_ptr(),
-            motor_end: self.motor_end.as_ptr(),
-            motor_joint: self.motor_joint.as_ptr(),
-            motor_axis: self.motor_axis.as_ptr(),
-            motor_torque: self.motor_torque.as_ptr(),
-            first_fluid: self.first_fluid.as_ptr(),
-            fluid_drag: self.fluid_drag.as_ptr(),
-            fluid_density: self.fluid_density.as_ptr(),
-            radius: self.radius.as_ptr(),
-            volume: self.volume.as_ptr(),
+            first_particle: l(Array::FirstParticle),
+            first_spring: l(Array::FirstSpring),
+            inv_mass: c(Array::InvMass),
+            mass: c(Array::Mass),
+            pos: m(Array::Pos),
+            vel: m(Array::Vel),
+            spring_a: i(Array::SpringA),
+            spring_b: i(Array::SpringB),
+            stiffness: c(Array::Stiffness),
+            damping: c(Array::Damping),
+            rest_length: c(Array::RestLength),
+            scratch: m(Array::Scratch),
+            first_joint: l(Array::FirstJoint),
+            joint_a: i(Array::JointA),
+            joint_j: i(Array::JointJ),
+            joint_b: i(Array::JointB),
+            joint_stiffness: c(Array::JointStiffness),
+            joint_damping: c(Array::JointDamping),
+            joint_rest: c(Array::JointRest),
+            first_motor: l(Array::FirstMotor),
+            motor_end: i(Array::MotorEnd),
+            motor_joint: i(Array::MotorJoint),
+            motor_axis: c(Array::MotorAxis),
+            motor_torque: c(Array::MotorTorque),
+            first_fluid: l(Array::FirstFluid),
+            fluid_drag: c(Array::FluidDrag),
+            fluid_density: c(Array::FluidDensity),
+            radius: c(Array::Radius),
+            volume: c(Array::Volume),
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -340,4 +408,90 @@ fn supported(w: &World) -> Result<(), String> {
         return refuse(&format!("the user force `{}`", u.name()));
     }
     Ok(())
+}
+
+/// One of a batch's arrays, borrowed.
+pub(crate) enum Slice<'a> {
+    F64(&'a [f64]),
+    I32(&'a [i32]),
+    I64(&'a [i64]),
+}
+
+/// The arrays of a batch, in the order of the C's struct.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Array {
+    FirstParticle,
+    FirstSpring,
+    InvMass,
+    Mass,
+    Pos,
+    Vel,
+    SpringA,
+    SpringB,
+    Stiffness,
+    Damping,
+    RestLength,
+    Scratch,
+    FirstJoint,
+    JointA,
+    JointJ,
+    JointB,
+    JointStiffness,
+    JointDamping,
+    JointRest,
+    FirstMotor,
+    MotorEnd,
+    MotorJoint,
+    MotorAxis,
+    MotorTorque,
+    FirstFluid,
+    FluidDrag,
+    FluidDensity,
+    Radius,
+    Volume,
+}
+
+impl Array {
+    /// Every array, each at its own index (`a as usize`).
+    pub(crate) const ALL: [Array; 29] = [
+        Array::FirstParticle,
+        Array::FirstSpring,
+        Array::InvMass,
+        Array::Mass,
+        Array::Pos,
+        Array::Vel,
+        Array::SpringA,
+        Array::SpringB,
+        Array::Stiffness,
+        Array::Damping,
+        Array::RestLength,
+        Array::Scratch,
+        Array::FirstJoint,
+        Array::JointA,
+        Array::JointJ,
+        Array::JointB,
+        Array::JointStiffness,
+        Array::JointDamping,
+        Array::JointRest,
+        Array::FirstMotor,
+        Array::MotorEnd,
+        Array::MotorJoint,
+        Array::MotorAxis,
+        Array::MotorTorque,
+        Array::FirstFluid,
+        Array::FluidDrag,
+        Array::FluidDensity,
+        Array::Radius,
+        Array::Volume,
+    ];
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_array_is_listed_once_at_its_own_index() {
+        for (k, a) in super::Array::ALL.iter().enumerate() {
+            assert_eq!(*a as usize, k);
+        }
+    }
 }

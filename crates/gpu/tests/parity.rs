@@ -6,11 +6,11 @@
 //! loop) of springs, angle joints and torque joints, with and without
 //! gravity, in water and air or not.
 
-use animats_engine::{
-    AngleJointDef, DVec3, FluidMedium, IntegratorKind, ParticleDef, SpringDef, TorqueJointDef,
-    World,
-};
+use animats_engine::{DVec3, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
 use animats_gpu::Batch;
+
+mod common;
+use common::{random_body, Lcg};
 
 const INTEGRATORS: [IntegratorKind; 4] = [
     IntegratorKind::Euler,
@@ -18,93 +18,6 @@ const INTEGRATORS: [IntegratorKind; 4] = [
     IntegratorKind::Rk4,
     IntegratorKind::Symplectic,
 ];
-
-/// A reproducible stream of numbers in [0, 1).
-struct Lcg(u64);
-
-impl Lcg {
-    fn next(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn between(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-    fn vec(&mut self, scale: f64) -> DVec3 {
-        DVec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * scale
-    }
-}
-
-/// A random body of `n` particles: a ring of springs through them all,
-/// then as many again between random pairs, each of its own stiffness,
-/// damping and rest length; with `joints`, an angle joint (at rest at its
-/// first angle) and a torque joint (a random axis and torque) for every
-/// third particle; random masses, radii, positions and velocities.
-fn random_body(
-    rng: &mut Lcg,
-    n: usize,
-    gravity: bool,
-    joints: bool,
-    kind: IntegratorKind,
-) -> World {
-    let mut w = World::new();
-    if gravity {
-        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
-    }
-    w.set_integrator(kind);
-    let ids: Vec<_> = (0..n)
-        .map(|_| {
-            let def = ParticleDef::new(rng.between(0.1, 3.0))
-                .with_radius(rng.between(0.02, 0.2))
-                .at(rng.vec(2.0))
-                .with_velocity(rng.vec(1.0));
-            w.add_particle(def).unwrap()
-        })
-        .collect();
-    for i in 0..2 * n {
-        let (a, b) = if i < n {
-            (i, (i + 1) % n)
-        } else {
-            let a = (rng.next() * n as f64) as usize;
-            (a, (a + 1 + (rng.next() * (n - 1) as f64) as usize) % n)
-        };
-        if a == b {
-            continue;
-        }
-        let def = SpringDef::new(
-            ids[a],
-            ids[b],
-            rng.between(10.0, 400.0),
-            rng.between(0.0, 2.0),
-        )
-        .with_rest_length(rng.between(0.2, 1.5));
-        w.add_spring(def).unwrap();
-    }
-    if joints && n >= 3 {
-        for j in (0..n).step_by(3) {
-            let (a, b) = ((j + 1) % n, (j + 2) % n);
-            let def = AngleJointDef::new(
-                ids[a],
-                ids[j],
-                ids[b],
-                rng.between(0.5, 20.0),
-                rng.between(0.0, 0.5),
-            );
-            w.add_angle_joint(def).unwrap();
-            let motor = TorqueJointDef {
-                end: ids[a],
-                joint: ids[j],
-                axis: rng.vec(1.0) + DVec3::Y,
-                torque: rng.between(-3.0, 3.0),
-            };
-            w.add_torque_joint(motor).unwrap();
-        }
-    }
-    w
-}
 
 /// Steps `worlds` with the engine and a batch of them with the C, `steps`
 /// at a time, `rounds` times, and asserts every coordinate equal.
@@ -165,7 +78,7 @@ fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
         ] {
             let mut worlds: Vec<World> = (0..24)
                 .map(|_| {
-                    let n = 2 + (rng.next() * 39.0) as usize;
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
                     let mut w = random_body(&mut rng, n, gravity, joints, kind);
                     if water {
                         w.add_fluid(FluidMedium::water()).unwrap();

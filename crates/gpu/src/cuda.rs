@@ -1,0 +1,233 @@
+//! The C step on an NVIDIA GPU: the kernel (`kernel/*.h` and
+//! `kernel/kernel.cu`) compiled at run time by NVRTC to a CUBIN for the
+//! device's own architecture (never PTX, which a driver older than NVRTC
+//! refuses), with `--fmad=false` so that the GPU gives the CPU's bits, and
+//! launched with one thread per creature. The driver and NVRTC are loaded
+//! when a [`Device`] is opened; where either is missing, opening says which.
+//!
+//! Not yet run on a GPU: no session of this project has been lent one
+//! since it was written (docs/GPU.md). `bench/gpu.sh` checks it there.
+
+use crate::pack::{Array, Batch, Raw, Slice};
+use cudarc::driver::{
+    CudaContext, CudaFunction, CudaSlice, CudaStream, DevicePtr, DeviceRepr, LaunchConfig,
+    PushKernelArg,
+};
+use std::sync::Arc;
+
+/// The kernel's source: the headers in include order, then the entry.
+fn source() -> String {
+    let strip = |text: &str| {
+        text.lines()
+            .filter(|l| !l.trim_start().starts_with("#include"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    [
+        include_str!("../kernel/libm.h"),
+        include_str!("../kernel/trig.h"),
+        include_str!("../kernel/step.h"),
+        include_str!("../kernel/kernel.cu"),
+    ]
+    .iter()
+    .map(|t| strip(t))
+    .collect::<Vec<_>>()
+    .join("\n")
+}
+
+/// A GPU ready to step batches.
+pub struct Device {
+    stream: Arc<CudaStream>,
+    function: CudaFunction,
+    name: String,
+    arch: (i32, i32),
+}
+
+impl std::fmt::Debug for Device {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} (sm_{}{})", self.name, self.arch.0, self.arch.1)
+    }
+}
+
+impl Device {
+    /// The first GPU, with the kernel compiled for it; `Err` names what is
+    /// missing: the driver, a device, NVRTC, or the compilation's log.
+    pub fn open() -> Result<Device, String> {
+        // SAFETY: only looks for the library (dlopen), calls nothing in it.
+        if !unsafe { cudarc::driver::sys::is_culib_present() } {
+            return Err(
+                "no NVIDIA driver: libcuda.so cannot be loaded (a GPU machine with the NVIDIA driver installed is needed)"
+                    .into(),
+            );
+        }
+        let ctx = CudaContext::new(0).map_err(|e| format!("no CUDA device: {e}"))?;
+        // SAFETY: as above.
+        if !unsafe { cudarc::nvrtc::sys::is_culib_present() } {
+            return Err(
+                "NVRTC cannot be loaded (libnvrtc.so): install CUDA's NVRTC, e.g. the PyPI package nvidia-cuda-nvrtc, and put the folder holding libnvrtc.so and libnvrtc-builtins.so on LD_LIBRARY_PATH"
+                    .into(),
+            );
+        }
+        let arch = ctx
+            .compute_capability()
+            .map_err(|e| format!("the device's architecture: {e}"))?;
+        let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
+        let cubin = compile(arch)?;
+        let module = ctx
+            .load_module(cudarc::nvrtc::Ptx::from_binary(cubin))
+            .map_err(|e| format!("loading the compiled step on {name}: {e}"))?;
+        let function = module
+            .load_function("animats_step_kernel")
+            .map_err(|e| format!("the step's entry: {e}"))?;
+        Ok(Device {
+            stream: ctx.default_stream(),
+            function,
+            name,
+            arch,
+        })
+    }
+
+    /// The device's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Steps every creature of `batch` `steps` times on the GPU (one
+    /// thread each) and copies the positions and velocities back.
+    pub fn run(&self, batch: &mut Batch, steps: u64) -> Result<(), String> {
+        let s = &self.stream;
+        fn err(what: &'static str) -> impl Fn(cudarc::driver::DriverError) -> String {
+            move |e| format!("{what}: {e}")
+        }
+        // Every array on the device (an empty one as one element: no
+        // zero-size allocation).
+        let mut on_device = Vec::with_capacity(Array::ALL.len());
+        for a in Array::ALL {
+            let up = match batch.array(a) {
+                Slice::F64(v) => OnDevice::F64(
+                    s.clone_htod(if v.is_empty() { &[0.0][..] } else { v })
+                        .map_err(err("copying to the GPU"))?,
+                ),
+                Slice::I32(v) => OnDevice::I32(
+                    s.clone_htod(if v.is_empty() { &[0][..] } else { v })
+                        .map_err(err("copying to the GPU"))?,
+                ),
+                Slice::I64(v) => OnDevice::I64(
+                    s.clone_htod(if v.is_empty() { &[0][..] } else { v })
+                        .map_err(err("copying to the GPU"))?,
+                ),
+            };
+            on_device.push(up);
+        }
+        let addresses: Vec<u64> = on_device
+            .iter()
+            .map(|d| match d {
+                OnDevice::F64(x) => x.device_ptr(s).0,
+                OnDevice::I32(x) => x.device_ptr(s).0,
+                OnDevice::I64(x) => x.device_ptr(s).0,
+            })
+            .collect();
+        let raw = DeviceBatch(batch.raw_with(|a| addresses[a as usize]));
+        let creatures = batch.creatures() as i64;
+        let steps = steps.min(i64::MAX as u64) as i64;
+        let threads = 128u32;
+        let blocks = (creatures as u64).div_ceil(threads as u64).max(1);
+        let config = LaunchConfig {
+            grid_dim: (
+                u32::try_from(blocks).map_err(|_| "too many creatures for one launch")?,
+                1,
+                1,
+            ),
+            block_dim: (threads, 1, 1),
+            shared_mem_bytes: 0,
+        };
+        let mut launch = s.launch_builder(&self.function);
+        launch.arg(&raw).arg(&creatures).arg(&steps);
+        // SAFETY: the kernel reads and writes within the arrays just
+        // uploaded, at the offsets `Batch::pack` checked; the arguments
+        // match its signature (an_batch by value, two long longs).
+        unsafe { launch.launch(config) }.map_err(err("launching the step"))?;
+        let back = |a: Array| match &on_device[a as usize] {
+            OnDevice::F64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU")),
+            _ => Err("positions and velocities are doubles".to_string()),
+        };
+        let (pos, vel) = (back(Array::Pos)?, back(Array::Vel)?);
+        batch.set_state(&pos, &vel);
+        Ok(())
+    }
+}
+
+/// One of a batch's arrays on the device.
+enum OnDevice {
+    F64(CudaSlice<f64>),
+    I32(CudaSlice<i32>),
+    I64(CudaSlice<i64>),
+}
+
+/// The C's `an_batch` holding device pointers, passed by value.
+#[repr(transparent)]
+struct DeviceBatch(Raw);
+
+// SAFETY: a plain #[repr(C)] struct of pointers (device addresses), numbers
+// and ints, the layout of the kernel's `an_batch`.
+unsafe impl DeviceRepr for DeviceBatch {}
+
+/// NVRTC: the kernel to a CUBIN for `sm_{major}{minor}`, no contraction.
+fn compile((major, minor): (i32, i32)) -> Result<Vec<u8>, String> {
+    use cudarc::nvrtc::{result, sys};
+    let src = std::ffi::CString::new(source()).map_err(|e| format!("the kernel's source: {e}"))?;
+    let prog = result::create_program(&src, None).map_err(|e| format!("NVRTC: {e}"))?;
+    let options = [
+        format!("--gpu-architecture=sm_{major}{minor}"),
+        "--fmad=false".to_string(),
+        "--prec-div=true".to_string(),
+        "--prec-sqrt=true".to_string(),
+        "--ftz=false".to_string(),
+    ];
+    // SAFETY: `prog` is a live program; the options are valid C strings.
+    let compiled = unsafe { result::compile_program(prog, &options) };
+    if let Err(e) = compiled {
+        // SAFETY: as above.
+        let log = unsafe { result::get_program_log(prog) }.unwrap_or_default();
+        let log: String = log.iter().map(|&c| c as u8 as char).collect();
+        // SAFETY: as above; destroyed once.
+        let _ = unsafe { result::destroy_program(prog) };
+        return Err(format!(
+            "NVRTC could not compile the step for sm_{major}{minor}: {e}\n{log}"
+        ));
+    }
+    let mut size = 0usize;
+    // SAFETY: `prog` compiled; `size` receives the CUBIN's length.
+    let got = unsafe { sys::nvrtcGetCUBINSize(prog, &mut size) };
+    let mut cubin = vec![0u8; size];
+    // SAFETY: `cubin` holds `size` bytes.
+    let got2 = unsafe { sys::nvrtcGetCUBIN(prog, cubin.as_mut_ptr().cast()) };
+    // SAFETY: destroyed once.
+    let _ = unsafe { result::destroy_program(prog) };
+    if got != sys::nvrtcResult::NVRTC_SUCCESS
+        || got2 != sys::nvrtcResult::NVRTC_SUCCESS
+        || size == 0
+    {
+        return Err(format!(
+            "NVRTC gave no CUBIN for sm_{major}{minor} ({got:?}, {got2:?})"
+        ));
+    }
+    Ok(cubin)
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_kernel_source_has_every_piece_and_no_includes() {
+        let s = super::source();
+        for needle in [
+            "an_atan2",
+            "an_sin",
+            "an_step_creature",
+            "animats_step_kernel",
+        ] {
+            assert!(s.contains(needle), "{needle}");
+        }
+        assert!(!s.contains("#include"));
+    }
+}
