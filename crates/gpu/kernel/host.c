@@ -1,11 +1,5 @@
-/* The C step on the CPU: every creature of a batch, one after another. */
+/* The C step on the CPU. */
 #include "step.h"
-
-void animats_step_batch(const an_batch *b, long long creatures, long long steps) {
-    for (long long c = 0; c < creatures; c++) {
-        an_step_creature(b, c, steps);
-    }
-}
 
 /* The ported functions, for their tests against the `libm` crate. */
 #include "libm.h"
@@ -17,3 +11,11 @@ double animats_atan2(double y, double x) { return an_atan2(y, x); }
 
 double animats_sin(double x) { return an_sin(x); }
 double animats_cos(double x) { return an_cos(x); }
+
+/* Creatures first .. last - 1 of a batch: the CPU's threads each take a
+ * range (every creature writes only its own particles and scratch). */
+void animats_step_range(const an_batch *b, long long first, long long last, long long steps) {
+    for (long long c = first; c < last; c++) {
+        an_step_creature(b, c, steps);
+    }
+}

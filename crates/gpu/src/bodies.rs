@@ -24,7 +24,11 @@ impl Lcg {
     }
     /// Each coordinate uniform in [-scale/2, scale/2).
     pub fn vec(&mut self, scale: f64) -> DVec3 {
-        DVec3::new(self.uniform() - 0.5, self.uniform() - 0.5, self.uniform() - 0.5) * scale
+        DVec3::new(
+            self.uniform() - 0.5,
+            self.uniform() - 0.5,
+            self.uniform() - 0.5,
+        ) * scale
     }
 }
 

@@ -47,7 +47,29 @@ pub(crate) struct Raw {
 }
 
 extern "C" {
-    fn animats_step_batch(batch: *const Raw, creatures: c_longlong, steps: c_longlong);
+    fn animats_step_range(
+        batch: *const Raw,
+        first: c_longlong,
+        last: c_longlong,
+        steps: c_longlong,
+    );
+}
+
+/// Creatures a thread of [`Batch::run_cpu`] takes at a time.
+const CHUNK: usize = 64;
+
+/// The C's struct shared by the threads of [`Batch::run_cpu`].
+struct Shared(Raw);
+
+// SAFETY: the threads read the shared arrays and write only the positions,
+// velocities and scratch of their own creatures: disjoint ranges.
+unsafe impl Sync for Shared {}
+
+impl Shared {
+    /// (A method, so that closures capture the whole, which is `Sync`.)
+    fn get(&self) -> *const Raw {
+        &self.0
+    }
 }
 
 /// Doubles of scratch per particle the C step uses.
@@ -239,20 +261,24 @@ impl Batch {
     }
 
     /// Steps every creature `steps` times with the C step compiled for this
-    /// CPU.
+    /// CPU, on the threads of the current rayon pool (creatures are
+    /// independent: the same bits on any number of threads).
     pub fn run_cpu(&mut self, steps: u64) {
-        let raw = self.raw();
-        // SAFETY: `raw` points into this batch's vectors, which the C reads
-        // and writes within the bounds the offsets give (checked when
-        // packed: every spring's ends lie within its creature), and nothing
-        // else touches them while it runs.
-        unsafe {
-            animats_step_batch(
-                &raw,
-                self.creatures() as c_longlong,
-                steps.min(i64::MAX as u64) as c_longlong,
-            )
-        };
+        use rayon::prelude::*;
+        let shared = Shared(self.raw());
+        let steps = steps.min(i64::MAX as u64) as c_longlong;
+        let n = self.creatures();
+        (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|k| {
+            let (first, last) = (k * CHUNK, ((k + 1) * CHUNK).min(n));
+            // SAFETY: `shared` points into this batch's vectors, which
+            // live until the loop ends; the C reads and writes within the
+            // bounds the offsets give (every spring's and joint's ends lie
+            // within its creature, as packed), and creatures first..last
+            // are this task's alone.
+            unsafe {
+                animats_step_range(shared.get(), first as c_longlong, last as c_longlong, steps)
+            };
+        });
     }
 
     fn raw(&mut self) -> Raw {

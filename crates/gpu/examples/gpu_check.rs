@@ -1,0 +1,141 @@
+//! The GPU against the CPU (issue 42's checks 1 and 2, for the bodies the
+//! C steps today): a batch of random bodies stepped by the engine on every
+//! core (what `animats` does, strict), by the C on every core, and by the
+//! GPU; every coordinate compared as bits; throughput of each.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_check -- [CREATURES] [STEPS] [PARTICLES]
+//!
+//! PARTICLES 0 (the default) mixes sizes of 2 to 40. Exit 2 where no GPU
+//! can be used (the message says why), 1 if any bit differs.
+
+use animats_engine::{IntegratorKind, World};
+use animats_gpu::bodies::{random_body, Lcg};
+use animats_gpu::{Batch, Device};
+use rayon::prelude::*;
+use std::time::Instant;
+
+fn main() {
+    let arg = |k: usize, default: u64| -> u64 {
+        std::env::args()
+            .nth(k)
+            .map_or(Ok(default), |a| a.parse())
+            .unwrap_or_else(|_| {
+                eprintln!("usage: gpu_check [CREATURES] [STEPS] [PARTICLES]: whole numbers");
+                std::process::exit(2)
+            })
+    };
+    let (creatures, steps, particles) = (arg(1, 65_536), arg(2, 1000), arg(3, 20));
+    if creatures == 0 || creatures > 10_000_000 || particles == 1 || particles > 1000 {
+        eprintln!("gpu_check: 1 to 10,000,000 creatures of 2 to 1000 particles (0: mixed)");
+        std::process::exit(2);
+    }
+    let dt = 5e-4;
+    let mut rng = Lcg(42);
+    let mut worlds: Vec<World> = (0..creatures)
+        .map(|k| {
+            let n = if particles == 0 {
+                2 + (rng.uniform() * 39.0) as usize
+            } else {
+                particles as usize
+            };
+            random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4)
+        })
+        .collect();
+    let total_particles: usize = worlds.iter().map(World::len).sum();
+    let refs: Vec<&World> = worlds.iter().collect();
+    let packed = match Batch::pack(&refs, dt) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("gpu_check: {e}");
+            std::process::exit(2);
+        }
+    };
+    println!(
+        "{creatures} creatures ({total_particles} particles; {}), {steps} RK4 steps of {dt} s, {} CPU threads",
+        if particles == 0 { "2 to 40 particles each".to_string() } else { format!("{particles} particles each") },
+        rayon::current_num_threads()
+    );
+    let rate = |secs: f64| (creatures * steps) as f64 / secs;
+
+    let t = Instant::now();
+    worlds.par_iter_mut().for_each(|w| {
+        for _ in 0..steps {
+            if w.step(dt).is_err() {
+                break;
+            }
+        }
+    });
+    let engine = t.elapsed().as_secs_f64();
+    println!(
+        "engine, every core:  {engine:8.3} s  {:.3e} creature-steps/s",
+        rate(engine)
+    );
+
+    let mut cpu = packed.clone();
+    let t = Instant::now();
+    cpu.run_cpu(steps);
+    let c_cpu = t.elapsed().as_secs_f64();
+    println!(
+        "C, every core:       {c_cpu:8.3} s  {:.3e} creature-steps/s",
+        rate(c_cpu)
+    );
+    // Every creature's particles, the engine's, as bits.
+    let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
+    let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
+    let engine_bits: Vec<Vec<[[u64; 3]; 2]>> = worlds
+        .iter()
+        .map(|w| {
+            (0..w.len())
+                .map(|i| [bits(w.state().pos[i]), bits(w.state().vel[i])])
+                .collect()
+        })
+        .collect();
+    // Creatures of `b` whose bits differ from `reference(c, i)`'s.
+    let differ = |b: &Batch, reference: &dyn Fn(usize, usize) -> [[u64; 3]; 2]| -> usize {
+        (0..creatures as usize)
+            .filter(|&c| {
+                (0..sizes[c]).any(|i| {
+                    let (x, v) = b.state(c, i).unwrap_or_default();
+                    [bits(x), bits(v)] != reference(c, i)
+                })
+            })
+            .count()
+    };
+    let bad = differ(&cpu, &|c, i| engine_bits[c][i]);
+    println!("C on the CPU against the engine: {bad} of {creatures} creatures differ");
+
+    let device = match Device::open() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("gpu_check: {e}");
+            std::process::exit(if bad == 0 { 2 } else { 1 });
+        }
+    };
+    let mut gpu = packed.clone();
+    // Once to warm (the module is loaded; the first launch pays for it).
+    let mut warm = packed.clone();
+    if let Err(e) = device.run(&mut warm, 1) {
+        eprintln!("gpu_check: {e}");
+        std::process::exit(2);
+    }
+    let t = Instant::now();
+    if let Err(e) = device.run(&mut gpu, steps) {
+        eprintln!("gpu_check: {e}");
+        std::process::exit(2);
+    }
+    let on_gpu = t.elapsed().as_secs_f64();
+    println!(
+        "GPU ({}), copies included: {on_gpu:8.3} s  {:.3e} creature-steps/s: {:.1}x the engine on every core",
+        device.name(),
+        rate(on_gpu),
+        engine / on_gpu
+    );
+    let bad_gpu = differ(&gpu, &|c, i| {
+        let (x, v) = cpu.state(c, i).unwrap_or_default();
+        [bits(x), bits(v)]
+    });
+    println!("GPU against the C on the CPU: {bad_gpu} of {creatures} creatures differ");
+    if bad > 0 || bad_gpu > 0 {
+        std::process::exit(1);
+    }
+}
