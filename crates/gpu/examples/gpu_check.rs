@@ -1,14 +1,15 @@
 //! The GPU against the CPU (issue 42's checks 1 and 2, for the bodies the
-//! C steps today): a batch of random bodies stepped by the engine on every
-//! core (what `animats` does, strict), by the C on every core, and by the
-//! GPU; every coordinate compared as bits; throughput of each.
+//! C steps today): a batch of random bodies of springs and joints dropped
+//! onto the floor, stepped by the engine on every core (what `animats`
+//! does, strict), by the C on every core, and by the GPU; every coordinate
+//! compared as bits; throughput of each.
 //!
 //!     cargo run --release -p animats-gpu --example gpu_check -- [CREATURES] [STEPS] [PARTICLES]
 //!
 //! PARTICLES 0 (the default) mixes sizes of 2 to 40. Exit 2 where no GPU
 //! can be used (the message says why), 1 if any bit differs.
 
-use animats_engine::{IntegratorKind, World};
+use animats_engine::{FloorDef, IntegratorKind, World};
 use animats_gpu::bodies::{random_body, Lcg};
 use animats_gpu::{Batch, Device};
 use rayon::prelude::*;
@@ -29,7 +30,7 @@ fn main() {
         eprintln!("gpu_check: 1 to 10,000,000 creatures of 2 to 1000 particles (0: mixed)");
         std::process::exit(2);
     }
-    let dt = 5e-4;
+    let dt = 1e-3;
     let mut rng = Lcg(42);
     let mut worlds: Vec<World> = (0..creatures)
         .map(|k| {
@@ -38,7 +39,20 @@ fn main() {
             } else {
                 particles as usize
             };
-            random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4)
+            let mut w = random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4);
+            // Dropped onto the floor: bounces, backtracking, resting.
+            for p in w.particle_ids().collect::<Vec<_>>() {
+                let x = w.position(p) + animats_engine::DVec3::new(0.0, 1.2, 0.0);
+                if let Err(e) = w.set_position(p, x) {
+                    eprintln!("gpu_check: {e}");
+                    std::process::exit(2);
+                }
+            }
+            if let Err(e) = w.add_floor(FloorDef::default()) {
+                eprintln!("gpu_check: {e}");
+                std::process::exit(2);
+            }
+            w
         })
         .collect();
     let total_particles: usize = worlds.iter().map(World::len).sum();
@@ -51,7 +65,7 @@ fn main() {
         }
     };
     println!(
-        "{creatures} creatures ({total_particles} particles; {}), {steps} RK4 steps of {dt} s, {} CPU threads",
+        "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} RK4 steps of {dt} s, {} CPU threads",
         if particles == 0 { "2 to 40 particles each".to_string() } else { format!("{particles} particles each") },
         rayon::current_num_threads()
     );

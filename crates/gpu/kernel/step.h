@@ -14,8 +14,9 @@
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints, still
- * fluids on every particle, and the explicit integrators (Euler, midpoint, RK4, symplectic Euler), in
- * worlds without events. Everything else is refused when a world is packed
+ * fluids on every particle, the flat floor (its located collisions with
+ * backtracking, and its contact force), and the explicit integrators
+ * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
  */
 #ifndef ANIMATS_STEP_H
@@ -73,10 +74,18 @@ typedef struct {
     const double *fluid_density;
     const double *radius;
     const double *volume;
+    const double *restitution;
+    const double *mu_s;
+    const double *mu_k;
+    long long *failed; /* per creature: 0, or the step that gave a non-finite state */
     double gx, gy, gz;
     int gravity; /* 1: gravity pulls every particle; 0: none */
     int integrator;
     double dt;
+    int floor;         /* 1: the plane y = 0 (collisions); 0: none */
+    int floor_contact; /* 1: and its contact force (reaction, friction) */
+    double envelope, rest_speed, static_speed, contact_tolerance;
+    double flight_shift; /* IntegratorKind::free_flight_shift */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */
@@ -183,11 +192,61 @@ AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0,
     }
 }
 
+/* The flat floor's contact force on particle i (forces/floor_contact.rs,
+ * `contact` and `friction`): a sphere resting on the plane and pressed
+ * into it is held up, and rubs. h is the trial's step. */
+AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, const double *v,
+                            double *f, double h) {
+    if (b->inv_mass[p] == 0.0 || x[1] - b->radius[p] > b->contact_tolerance) {
+        return;
+    }
+    if (v[1] > 0.0 || v[1] < -b->rest_speed || f[1] >= 0.0) {
+        return;
+    }
+    double normal = -f[1];
+    f[1] = 0.0;
+    double vt[3] = {v[0], 0.0, v[2]}, ft[3] = {f[0], 0.0, f[2]}, fr[3];
+    double m = b->mass[p];
+    double speed = sqrt(an_dot(vt, vt));
+    if (speed < b->static_speed) {
+        double hold[3];
+        double k = m / h;
+        for (int q = 0; q < 3; q++) {
+            hold[q] = -ft[q] - vt[q] * k;
+        }
+        double needed = sqrt(an_dot(hold, hold));
+        if (needed <= b->mu_s[p] * normal) {
+            for (int q = 0; q < 3; q++) {
+                fr[q] = hold[q];
+            }
+        } else {
+            double cap = b->mu_k[p] * normal;
+            double s = (cap < needed ? cap : needed) / needed;
+            for (int q = 0; q < 3; q++) {
+                fr[q] = hold[q] * s;
+            }
+        }
+    } else {
+        double dir[3] = {vt[0] / speed, vt[1] / speed, vt[2] / speed};
+        double stop = m * speed / h + an_dot(ft, dir);
+        double cap = b->mu_k[p] * normal;
+        double pos = stop > 0.0 ? stop : 0.0;
+        double kinetic = cap < pos ? cap : pos;
+        for (int q = 0; q < 3; q++) {
+            fr[q] = -(dir[q] * kinetic);
+        }
+    }
+    for (int q = 0; q < 3; q++) {
+        f[q] += fr[q];
+    }
+}
+
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints, fluids. */
+ * joints, torque joints, fluids, the floor's contact force. h: the step
+ * of the trial. */
 AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, long long s0,
-                     long long ns, const double *x, const double *v, double *f) {
+                     long long ns, const double *x, const double *v, double *f, double h) {
     for (long long i = 0; i < n; i++) {
         if (b->gravity) {
             double m = b->mass[p0 + i];
@@ -226,89 +285,203 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
     an_motors(b, m0, b->first_motor[c + 1] - m0, x, f);
     long long q0 = b->first_fluid[c];
     an_fluids(b, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
+    if (b->floor && b->floor_contact) {
+        for (long long i = 0; i < n; i++) {
+            an_floor_contact(b, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);
+        }
+    }
 }
 
-/* `steps` steps of creature c. */
+/* One integrator step of size h from (x0, v0) into (x1, v1)
+ * (integrators/*.rs); f, dx, dv: scratch. */
+AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long n, long long s0,
+                        long long ns, double h, const double *x0, const double *v0, double *x1,
+                        double *v1, double *f, double *dx, double *dv) {
+    long long m3 = 3 * n;
+    const double *w = b->inv_mass + p0;
+    switch (b->integrator) {
+    case AN_EULER:
+        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        for (long long k = 0; k < m3; k++) {
+            x1[k] = x0[k] + h * v0[k];
+            v1[k] = v0[k] + (h * w[k / 3]) * f[k];
+        }
+        break;
+    case AN_MIDPOINT: {
+        double half = 0.5 * h;
+        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        for (long long k = 0; k < m3; k++) {
+            x1[k] = x0[k] + half * v0[k];
+            v1[k] = v0[k] + (half * w[k / 3]) * f[k];
+        }
+        an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+        for (long long k = 0; k < m3; k++) {
+            double vm = v1[k];
+            x1[k] = x0[k] + h * vm;
+            v1[k] = v0[k] + (h * w[k / 3]) * f[k];
+        }
+        break;
+    }
+    case AN_RK4: {
+        double half = 0.5 * h;
+        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        for (long long k = 0; k < m3; k++) {
+            double a = f[k] * w[k / 3];
+            dx[k] = v0[k];
+            dv[k] = a;
+            x1[k] = x0[k] + v0[k] * half;
+            v1[k] = v0[k] + a * half;
+        }
+        for (int stage = 0; stage < 2; stage++) {
+            double to = stage == 0 ? half : h;
+            an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+            for (long long k = 0; k < m3; k++) {
+                double a = f[k] * w[k / 3];
+                double vi = v1[k];
+                dx[k] += vi * 2.0;
+                dv[k] += a * 2.0;
+                x1[k] = x0[k] + vi * to;
+                v1[k] = v0[k] + a * to;
+            }
+        }
+        an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+        double sixth = h / 6.0;
+        for (long long k = 0; k < m3; k++) {
+            double a = f[k] * w[k / 3];
+            double xe = x0[k] + (dx[k] + v1[k]) * sixth;
+            double ve = v0[k] + (dv[k] + a) * sixth;
+            x1[k] = xe;
+            v1[k] = ve;
+        }
+        break;
+    }
+    default: /* AN_SYMPLECTIC */
+        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        for (long long k = 0; k < m3; k++) {
+            double vk = v0[k] + f[k] * (h * w[k / 3]);
+            v1[k] = vk;
+            x1[k] = x0[k] + vk * h;
+        }
+        break;
+    }
+}
+
+/* What the floor makes of a trial (events/floor_collision.rs, `state`). */
+enum { AN_NONE = 0, AN_OCCURRING = 1, AN_MISSED = 2 };
+
+/* The flat floor's check of a trial: the deepest sphere below the plane. */
+AN_FN int an_floor_check(const an_batch *b, long long p0, long long n, const double *x1) {
+    double deepest = 0.0;
+    int any = 0;
+    for (long long i = 0; i < n; i++) {
+        double gap = x1[3 * i + 1] - b->radius[p0 + i];
+        if (gap < 0.0 && b->inv_mass[p0 + i] != 0.0) {
+            any = 1;
+            deepest = deepest < gap ? deepest : gap;
+        }
+    }
+    if (!any) {
+        return AN_NONE;
+    }
+    return deepest < -b->envelope ? AN_MISSED : AN_OCCURRING;
+}
+
+/* The flat floor's handling of a trial of step h (part of the step
+ * `step`): each sphere below the plane moved up onto it and its impact
+ * resolved (`resolve` and `normal_speed`). */
+AN_FN void an_floor_handle(const an_batch *b, long long p0, long long n, double h, double step,
+                           const double *v0, double *x1, double *v1) {
+    for (long long i = 0; i < n; i++) {
+        long long p = p0 + i;
+        double r = b->radius[p];
+        double gap = x1[3 * i + 1] - r;
+        if (!(gap < 0.0) || b->inv_mass[p] == 0.0) {
+            continue;
+        }
+        double accel = (v1[3 * i + 1] - v0[3 * i + 1]) / h;
+        double shift = b->flight_shift * accel * step;
+        double e = b->restitution[p];
+        double depth = r - x1[3 * i + 1];
+        x1[3 * i + 1] = r;
+        double vn = v1[3 * i + 1];
+        double under = vn * vn + 2.0 * accel * depth;
+        double at_plane = sqrt(under > 0.0 ? under : 0.0);
+        if (vn >= 0.0) {
+            v1[3 * i + 1] = at_plane;
+            continue;
+        }
+        double wv = vn + shift;
+        double wunder = wv * wv + 2.0 * accel * depth;
+        double w_at_plane = sqrt(wunder > 0.0 ? wunder : 0.0);
+        double r1 = e * at_plane, r2 = e * w_at_plane - shift;
+        double rebound = r1 < r2 ? r1 : r2;
+        double flight = accel < 0.0 ? 2.0 * rebound / -accel : INFINITY;
+        v1[3 * i + 1] = (at_plane < b->rest_speed || flight <= step) ? 0.0 : rebound;
+    }
+}
+
+/* Whether every coordinate is finite. */
+AN_FN int an_finite(const double *x, long long m3) {
+    for (long long k = 0; k < m3; k++) {
+        if (!(x[k] - x[k] == 0.0)) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* `steps` steps of creature c (world/step.rs: a trial of the whole step;
+ * after a missed collision, the step again in pieces, halved while one is
+ * missed down to 1/1024 of the step, and grown back once they line up).
+ * A non-finite state stops the creature at its last finite state, as the
+ * engine's step refuses it; `failed[c]` records the step (1-based). */
 AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
     long long m3 = 3 * n;
     double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0;
-    const double *w = b->inv_mass + p0;
     double *sc = b->scratch + 15 * p0;
-    double *f = sc, *x0 = sc + m3, *v0 = sc + 2 * m3, *dx = sc + 3 * m3, *dv = sc + 4 * m3;
-    double h = b->dt;
+    double *f = sc, *x1 = sc + m3, *v1 = sc + 2 * m3, *dx = sc + 3 * m3, *dv = sc + 4 * m3;
+    double dt = b->dt;
+    const long long total = 1LL << 10; /* MAX_BACKTRACK_DEPTH */
+    if (b->failed[c] != 0) {
+        return;
+    }
     for (long long step = 0; step < steps; step++) {
-        switch (b->integrator) {
-        case AN_EULER:
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            for (long long k = 0; k < m3; k++) {
-                double wk = w[k / 3];
-                double vk = v[k];
-                x[k] = x[k] + h * vk;
-                v[k] = vk + (h * wk) * f[k];
-            }
-            break;
-        case AN_MIDPOINT: {
-            double half = 0.5 * h;
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            for (long long k = 0; k < m3; k++) {
-                x0[k] = x[k];
-                v0[k] = v[k];
-                x[k] = x0[k] + half * v0[k];
-                v[k] = v0[k] + (half * w[k / 3]) * f[k];
-            }
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            for (long long k = 0; k < m3; k++) {
-                double vm = v[k];
-                x[k] = x0[k] + h * vm;
-                v[k] = v0[k] + (h * w[k / 3]) * f[k];
-            }
-            break;
-        }
-        case AN_RK4: {
-            double half = 0.5 * h;
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            for (long long k = 0; k < m3; k++) {
-                double a = f[k] * w[k / 3];
-                x0[k] = x[k];
-                v0[k] = v[k];
-                dx[k] = v0[k];
-                dv[k] = a;
-                x[k] = x0[k] + v0[k] * half;
-                v[k] = v0[k] + a * half;
-            }
-            for (int stage = 0; stage < 2; stage++) {
-                double to = stage == 0 ? half : h;
-                an_forces(b, c, p0, n, s0, ns, x, v, f);
-                for (long long k = 0; k < m3; k++) {
-                    double a = f[k] * w[k / 3];
-                    double vi = v[k];
-                    dx[k] += vi * 2.0;
-                    dv[k] += a * 2.0;
-                    x[k] = x0[k] + vi * to;
-                    v[k] = v0[k] + a * to;
+        long long done = 0, piece = total;
+        while (done < total) {
+            double h = piece == total ? dt : dt * ((double)piece / (double)total);
+            an_integrate(b, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
+            int state = b->floor ? an_floor_check(b, p0, n, x1) : AN_NONE;
+            if (state == AN_MISSED) {
+                if (piece == total) {
+                    piece = total / 2; /* the step again, in pieces */
+                    continue;
                 }
+                if (piece > 1) {
+                    piece /= 2;
+                    continue;
+                }
+                state = AN_OCCURRING; /* cannot split further */
             }
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            double sixth = h / 6.0;
+            if (state != AN_NONE) {
+                an_floor_handle(b, p0, n, h, dt, v, x1, v1);
+            }
+            if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
+                b->failed[c] = step + 1;
+                return;
+            }
             for (long long k = 0; k < m3; k++) {
-                double a = f[k] * w[k / 3];
-                double x1 = x0[k] + (dx[k] + v[k]) * sixth;
-                double v1 = v0[k] + (dv[k] + a) * sixth;
-                x[k] = x1;
-                v[k] = v1;
+                x[k] = x1[k];
+                v[k] = v1[k];
             }
-            break;
-        }
-        default: /* AN_SYMPLECTIC */
-            an_forces(b, c, p0, n, s0, ns, x, v, f);
-            for (long long k = 0; k < m3; k++) {
-                double vk = v[k] + f[k] * (h * w[k / 3]);
-                v[k] = vk;
-                x[k] = x[k] + vk * h;
+            if (piece == total) {
+                break;
             }
-            break;
+            done += piece;
+            if (piece < total && done % (2 * piece) == 0) {
+                piece *= 2;
+            }
         }
     }
 }

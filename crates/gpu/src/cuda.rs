@@ -152,7 +152,11 @@ impl Device {
             _ => Err("positions and velocities are doubles".to_string()),
         };
         let (pos, vel) = (back(Array::Pos)?, back(Array::Vel)?);
-        batch.set_state(&pos, &vel);
+        let failed: Vec<i64> = match &on_device[Array::Failed as usize] {
+            OnDevice::I64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU"))?,
+            _ => return Err("failures are 64-bit integers".into()),
+        };
+        batch.set_state(&pos, &vel, &failed);
         Ok(())
     }
 }

@@ -2,7 +2,7 @@
 //! each creature's particles and springs a contiguous run found through
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
-use animats_engine::{DVec3, IntegratorKind, World};
+use animats_engine::{DVec3, FloorCollision, IntegratorKind, World};
 use std::os::raw::{c_double, c_int, c_longlong};
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
@@ -38,12 +38,23 @@ pub(crate) struct Raw {
     fluid_density: *const c_double,
     radius: *const c_double,
     volume: *const c_double,
+    restitution: *const c_double,
+    mu_s: *const c_double,
+    mu_k: *const c_double,
+    failed: *mut c_longlong,
     gx: c_double,
     gy: c_double,
     gz: c_double,
     gravity: c_int,
     integrator: c_int,
     dt: c_double,
+    floor: c_int,
+    floor_contact: c_int,
+    envelope: c_double,
+    rest_speed: c_double,
+    static_speed: c_double,
+    contact_tolerance: c_double,
+    flight_shift: c_double,
 }
 
 extern "C" {
@@ -107,6 +118,11 @@ pub struct Batch {
     fluid_density: Vec<f64>,
     radius: Vec<f64>,
     volume: Vec<f64>,
+    restitution: Vec<f64>,
+    mu_s: Vec<f64>,
+    mu_k: Vec<f64>,
+    failed: Vec<i64>,
+    floor: Option<Floor>,
     g: DVec3,
     gravity: bool,
     integrator: IntegratorKind,
@@ -164,6 +180,11 @@ impl Batch {
             fluid_density: Vec::new(),
             radius: Vec::new(),
             volume: Vec::new(),
+            restitution: Vec::new(),
+            mu_s: Vec::new(),
+            mu_k: Vec::new(),
+            failed: vec![0; worlds.len()],
+            floor: floor_of(first).map_err(|e| format!("world 0: {e}"))?,
             g,
             gravity,
             integrator,
@@ -173,6 +194,13 @@ impl Batch {
             supported(w).map_err(|what| format!("world {k}: {what}"))?;
             let same_gravity = w.forces().gravity().is_some() == gravity
                 && w.forces().g().to_array().map(f64::to_bits) == g.to_array().map(f64::to_bits);
+            let floor = floor_of(w).map_err(|e| format!("world {k}: {e}"))?;
+            if floor != b.floor {
+                return Err(format!(
+                    "world {k}: a batch shares one floor; world 0 has {:?}, this one {floor:?}",
+                    b.floor
+                ));
+            }
             if !same_gravity || w.integrator() != integrator {
                 return Err(format!(
                     "world {k}: a batch shares one gravity and one integrator; world 0 has g = {g} and {integrator:?}, this one g = {} and {:?}",
@@ -227,6 +255,9 @@ impl Batch {
             }
             b.radius.extend_from_slice(&props.radius);
             b.volume.extend_from_slice(&props.volume);
+            b.restitution.extend_from_slice(&props.restitution);
+            b.mu_s.extend_from_slice(&props.mu_s);
+            b.mu_k.extend_from_slice(&props.mu_k);
             b.first_particle.push(b.mass.len() as i64);
             b.first_spring.push(b.stiffness.len() as i64);
             b.first_joint.push(b.joint_a.len() as i64);
@@ -292,6 +323,7 @@ impl Batch {
             Array::Pos => self.pos.as_mut_ptr() as u64,
             Array::Vel => self.vel.as_mut_ptr() as u64,
             Array::Scratch => self.scratch.as_mut_ptr() as u64,
+            Array::Failed => self.failed.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -333,14 +365,29 @@ impl Batch {
             Array::FluidDensity => F64(&self.fluid_density),
             Array::Radius => F64(&self.radius),
             Array::Volume => F64(&self.volume),
+            Array::Restitution => F64(&self.restitution),
+            Array::MuS => F64(&self.mu_s),
+            Array::MuK => F64(&self.mu_k),
+            Array::Failed => I64(&self.failed),
         }
     }
 
-    /// Positions and velocities written back (from a GPU).
-    pub(crate) fn set_state(&mut self, pos: &[f64], vel: &[f64]) {
+    /// Positions, velocities and failures written back (from a GPU).
+    pub(crate) fn set_state(&mut self, pos: &[f64], vel: &[f64], failed: &[i64]) {
         let n = self.pos.len();
         self.pos.copy_from_slice(&pos[..n]);
         self.vel.copy_from_slice(&vel[..n]);
+        let c = self.failed.len();
+        self.failed.copy_from_slice(&failed[..c]);
+    }
+
+    /// The step (1-based, counted over every run) at which creature `c`'s
+    /// state stopped being finite, where the engine's step returns
+    /// `SimError::NonFinite`; it is not stepped further.
+    pub fn failed(&self, c: usize) -> Option<u64> {
+        self.failed
+            .get(c)
+            .and_then(|&s| (s > 0).then_some(s as u64))
     }
 
     /// The C's struct with array `a` at address `at(a)`.
@@ -379,6 +426,10 @@ impl Batch {
             fluid_density: c(Array::FluidDensity),
             radius: c(Array::Radius),
             volume: c(Array::Volume),
+            restitution: c(Array::Restitution),
+            mu_s: c(Array::MuS),
+            mu_k: c(Array::MuK),
+            failed: at(Array::Failed) as *mut c_longlong,
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -390,6 +441,13 @@ impl Batch {
                 _ => 3,
             },
             dt: self.dt,
+            floor: c_int::from(self.floor.is_some()),
+            floor_contact: c_int::from(self.floor.is_some_and(|f| f.contact.is_some())),
+            envelope: self.floor.map_or(0.0, |f| f.envelope),
+            rest_speed: self.floor.map_or(0.0, |f| f.rest_speed),
+            static_speed: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.0),
+            contact_tolerance: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.1),
+            flight_shift: self.integrator.free_flight_shift(),
         }
     }
 }
@@ -407,8 +465,10 @@ fn supported(w: &World) -> Result<(), String> {
         | IntegratorKind::Symplectic => {}
         other => return refuse(&format!("the {other:?} integrator")),
     }
-    if let Some(e) = w.events().first() {
-        return refuse(&format!("the event `{}`", e.name()));
+    for e in w.events() {
+        if !e.as_any().is::<FloorCollision>() {
+            return refuse(&format!("the event `{}`", e.name()));
+        }
     }
     if f.gravity().is_some_and(|g| g.targets != Targets::All) {
         return refuse("gravity on some particles only");
@@ -426,9 +486,6 @@ fn supported(w: &World) -> Result<(), String> {
     }
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");
-    }
-    if f.floor().is_some() {
-        return refuse("the floor's contact force");
     }
     if let Some(u) = f.user().next() {
         return refuse(&format!("the user force `{}`", u.name()));
@@ -475,11 +532,15 @@ pub(crate) enum Array {
     FluidDensity,
     Radius,
     Volume,
+    Restitution,
+    MuS,
+    MuK,
+    Failed,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 29] = [
+    pub(crate) const ALL: [Array; 33] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -509,6 +570,10 @@ impl Array {
         Array::FluidDensity,
         Array::Radius,
         Array::Volume,
+        Array::Restitution,
+        Array::MuS,
+        Array::MuK,
+        Array::Failed,
     ];
 }
 
@@ -520,4 +585,46 @@ mod tests {
             assert_eq!(*a as usize, k);
         }
     }
+}
+
+/// A batch's floor: the plane y = 0 under every particle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Floor {
+    envelope: f64,
+    rest_speed: f64,
+    /// The contact force's static speed and contact tolerance, if it has one.
+    contact: Option<(f64, f64)>,
+}
+
+/// World `w`'s floor, if it has one the C steps (flat, under every
+/// particle); `Err` names what it does not.
+fn floor_of(w: &World) -> Result<Option<Floor>, String> {
+    use animats_engine::Targets;
+    let collision = w
+        .events()
+        .iter()
+        .find_map(|e| e.as_any().downcast_ref::<FloorCollision>());
+    let contact = w.forces().floor();
+    let Some(collision) = collision else {
+        return match contact {
+            None => Ok(None),
+            Some(_) => Err(
+                "a floor contact force without its collisions is not in the GPU step yet".into(),
+            ),
+        };
+    };
+    if !collision.terrain().is_flat() {
+        return Err("terrain is not in the GPU step yet".into());
+    }
+    if collision.targets != Targets::All || contact.is_some_and(|c| c.targets != Targets::All) {
+        return Err("a floor under some particles only is not in the GPU step yet".into());
+    }
+    if contact.is_some_and(|c| c.rest_speed.to_bits() != collision.rest_speed.to_bits()) {
+        return Err("a floor whose contact and collisions rest at different speeds is not in the GPU step yet".into());
+    }
+    Ok(Some(Floor {
+        envelope: collision.envelope,
+        rest_speed: collision.rest_speed,
+        contact: contact.map(|c| (c.static_speed, c.contact_tolerance)),
+    }))
 }

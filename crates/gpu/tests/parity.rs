@@ -6,7 +6,7 @@
 //! loop) of springs, angle joints and torque joints, with and without
 //! gravity, in water and air or not.
 
-use animats_engine::{DVec3, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
+use animats_engine::{DVec3, FloorDef, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
 use animats_gpu::Batch;
 
 mod common;
@@ -100,6 +100,51 @@ fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Bodies dropped onto the floor from up to 2.2 m: bounces (located by
+/// backtracking when a sphere passes the envelope inside a step), rest,
+/// the contact force's reaction and friction.
+#[test]
+fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
+    let mut rng = Lcg(9);
+    for kind in INTEGRATORS {
+        for (contact, air) in [(true, false), (true, true), (false, false)] {
+            let mut worlds: Vec<World> = (0..24)
+                .map(|k| {
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
+                    let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind);
+                    for p in w.particle_ids().collect::<Vec<_>>() {
+                        let x = w.position(p) + DVec3::new(0.0, 1.2, 0.0);
+                        w.set_position(p, x).unwrap();
+                    }
+                    let floor = FloorDef {
+                        contact,
+                        ..FloorDef::default()
+                    };
+                    w.add_floor(floor).unwrap();
+                    if air {
+                        w.add_fluid(FluidMedium::air()).unwrap();
+                    }
+                    w
+                })
+                .collect();
+            assert_same(
+                &mut worlds,
+                1e-3,
+                500,
+                4,
+                &format!("bodies on the floor, {kind:?}, contact {contact}, air {air}"),
+            );
+            let backtracked: u64 = worlds.iter().map(|w| w.stats().backtracks).sum();
+            let down = worlds
+                .iter()
+                .filter(|w| w.state().pos.iter().any(|x| x.y < 0.21))
+                .count();
+            eprintln!("{kind:?}, contact {contact}, air {air}: {backtracked} backtracks; {down} of 24 bodies down");
+            assert!(down > 12, "{kind:?}: only {down} bodies reached the floor");
+        }
+    }
+}
+
 #[test]
 fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let plain = || {
@@ -110,11 +155,24 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         w.add_spring(SpringDef::new(a, b, 10.0, 0.1)).unwrap();
         w
     };
+    let mut slope = plain();
+    let terrain = animats_engine::Terrain::Slope(animats_engine::Slope {
+        angle: 0.2,
+        uphill: DVec3::X,
+    });
+    slope
+        .add_floor(FloorDef {
+            terrain,
+            ..FloorDef::default()
+        })
+        .unwrap();
+    let err = Batch::pack(&[&slope], 1e-3).unwrap_err();
+    assert_eq!(err, "world 0: terrain is not in the GPU step yet");
     let mut floor = plain();
-    floor.add_floor(Default::default()).unwrap();
+    floor.add_floor(FloorDef::default()).unwrap();
     let err = Batch::pack(&[&plain(), &floor], 1e-3).unwrap_err();
     assert!(
-        err.starts_with("world 1: ") && err.contains("not in the GPU step yet"),
+        err.starts_with("world 1: a batch shares one floor"),
         "{err}"
     );
 
