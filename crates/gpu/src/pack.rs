@@ -131,11 +131,12 @@ pub struct Batch {
 
 impl Batch {
     /// The worlds' current states and models, to be stepped by `dt`. Every
-    /// world must share the first one's gravity and integrator, and hold
-    /// only what the C steps (particles, gravity on every particle, damped
-    /// springs, angle joints, torque joints at their present torques,
-    /// still fluids about every particle; no events): anything else is refused with a message naming
-    /// the world and what it holds.
+    /// world must share the first one's gravity, floor and integrator, and
+    /// hold only what the C steps (particles, gravity on every particle,
+    /// damped springs, angle joints, torque joints at their present
+    /// torques, still fluids about every particle, the flat floor under
+    /// every particle): anything else is refused with a message naming the
+    /// world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(format!(
