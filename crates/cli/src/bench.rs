@@ -158,7 +158,7 @@ fn print_row(r: &Row) {
     } else {
         format!("  {} sim-s/s", si(r.sim_per_wall()))
     };
-    println!(
+    say!(
         "{:<14} {:<34} {:>10} ms [{}–{}]  {}{}  | baseline {}",
         r.workload,
         r.variant,
@@ -189,9 +189,10 @@ fn print_row(r: &Row) {
             Bound::TargetAtMost(max) => format!("goal at most {max}"),
             Bound::Info => String::new(),
         };
-        println!(
+        say!(
             "    {:<30} {:>+.10e}  {against}  {verdict}",
-            c.name, c.value
+            c.name,
+            c.value
         );
     }
 }
@@ -218,7 +219,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     };
     let (machine, date) = (machine(), today());
     if !args.json {
-        println!(
+        say!(
         "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}; vectors: {}",
         opts.runs,
         if opts.quick { " (quick)" } else { "" },
@@ -230,7 +231,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let rows = animats_bench::run(n, opts).map_err(Failure::Input)?;
         for r in &rows {
             if args.json {
-                println!("{}", json_row(r, opts.quick, &machine, &date));
+                say!("{}", json_row(r, opts.quick, &machine, &date));
             } else {
                 print_row(r);
             }

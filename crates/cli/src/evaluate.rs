@@ -88,12 +88,12 @@ fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Fail
         if !e.terms.is_empty() {
             out["terms"] = serde_json::json!(e.terms);
         }
-        println!("{out}");
+        say!("{out}");
     } else {
-        println!("fitness   {fitness}");
-        println!("distance  {distance} m");
-        println!("time      {time} s");
-        println!("ended     {ended}");
+        say!("fitness   {fitness}");
+        say!("distance  {distance} m");
+        say!("time      {time} s");
+        say!("ended     {ended}");
         let list = |v: &[f64]| {
             v.iter()
                 .map(|x| x.to_string())
@@ -101,16 +101,16 @@ fn report(e: animats_scene::evaluate::Evaluation, json: bool) -> Result<(), Fail
                 .join(" ")
         };
         if !e.measures.is_empty() {
-            println!("measures  {}", list(&e.measures));
+            say!("measures  {}", list(&e.measures));
         }
         if let Some(j) = e.energy {
-            println!("energy    {j} J");
+            say!("energy    {j} J");
         }
         if let Some(d) = e.target_distance {
-            println!("target    {d} m");
+            say!("target    {d} m");
         }
         if !e.terms.is_empty() {
-            println!("terms     {}", list(&e.terms));
+            say!("terms     {}", list(&e.terms));
         }
     }
     Ok(())

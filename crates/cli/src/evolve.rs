@@ -545,7 +545,7 @@ fn report_schedule(
         .collect();
     let eval_sum: f64 = evaluations.iter().sum();
     let batches = s.work.last().map_or(0, |w| w.batch + 1);
-    println!(
+    say!(
         "schedule: {} evaluations ({:.3} s, mean {:.2} ms, longest {:.2} ms) and {:.3} s of asks and tells in {batches} batches; {work:.3} s of work in {wall:.3} s on {threads} threads (busy {:.1} % of the time)",
         evaluations.len(),
         eval_sum,
@@ -554,23 +554,23 @@ fn report_schedule(
         work - eval_sum,
         100.0 * work / (wall * threads as f64).max(1e-12),
     );
-    println!(
+    say!(
         "  critical path {:.3} s with batch barriers, {:.3} s without; predicted on {threads} threads {:.3} s (measured {wall:.3} s)",
         s.critical_path(true),
         s.critical_path(false),
         s.makespan(threads, true)
     );
-    println!("  workers   predicted wall   speed-up   without barriers");
+    say!("  workers   predicted wall   speed-up   without barriers");
     let one = s.makespan(1, true);
     for w in [1usize, 2, 4, 8, 16, 32, 64] {
         let (a, b) = (s.makespan(w, true), s.makespan(w, false));
-        println!(
+        say!(
             "  {w:>7}   {a:>12.3} s   {:>7.2}×   {b:>9.3} s {:>6.2}×",
             one / a,
             one / b
         );
     }
-    println!("wrote {}/schedule.csv", dir.display());
+    say!("wrote {}/schedule.csv", dir.display());
     Ok(())
 }
 
@@ -610,7 +610,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let wall = start.elapsed().as_secs_f64();
     save(&dir, &state, true)?;
     let evals = state.evaluations - evals_at_start;
-    println!(
+    say!(
         "{} lanes, generation {} of {}, seed {}: {evals} evaluations in {wall:.2} s ({:.0}/s, {threads} threads)",
         state.config.lanes,
         state.generation(),
@@ -620,15 +620,19 @@ pub fn run(args: Args) -> Result<(), Failure> {
     );
     for l in &state.lanes {
         let Some(b) = &l.best else { continue };
-        println!(
+        say!(
             "  lane {}: best fitness {:>8.2}  time {:>6.3} s  distance {:>7.3} m  ({})",
-            l.lane, b.fitness, b.time, b.distance, b.ended
+            l.lane,
+            b.fitness,
+            b.time,
+            b.distance,
+            b.ended
         );
     }
     if let Some((by, kept)) = state.refusals() {
         let total: u64 = by.values().sum();
         let reasons: Vec<String> = by.iter().map(|(r, n)| format!("{r} {n}")).collect();
-        println!(
+        say!(
             "  refused: {total} variations ({}); {kept} children kept their parent after {} tries",
             if reasons.is_empty() {
                 "none".to_string()
@@ -640,7 +644,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     if let Some(a) = state.archive() {
         let s = a.stats();
-        println!(
+        say!(
             "  archive: {} of {} cells ({:.1} %), QD score {}, best {}",
             s.elites,
             a.cells(),
@@ -649,7 +653,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
             s.obj_max.unwrap_or(f64::NAN)
         );
     }
-    println!(
+    say!(
         "wrote {}/log.csv, best.toml, {}{}fitness.png, {CHECKPOINT}",
         dir.display(),
         if state.config.lanes > 1 {
@@ -668,7 +672,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     if let Some((_, thread)) = viewing {
         if !interrupted {
-            println!("the view stays open: Ctrl-C to stop");
+            say!("the view stays open: Ctrl-C to stop");
         }
         let served = thread
             .join()

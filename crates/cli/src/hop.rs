@@ -126,38 +126,36 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if let Some(e) = write_error {
         return Err(Failure::Other(e));
     }
-    println!(
+    say!(
         "parameters: {}{}",
         args.params,
         args.lane.map_or(String::new(), |l| format!(" (lane {l})"))
     );
-    println!(
+    say!(
         "fitness:    {:.4}  (time upright + 50 × distance)",
         e.fitness
     );
-    println!("upright:    {:.3} s", e.time);
-    println!("distance:   {:.4} m", e.distance);
-    println!(
-        "hops:       {hops} (landings the brain counted: its FSM going from flight to stance)"
-    );
+    say!("upright:    {:.3} s", e.time);
+    say!("distance:   {:.4} m", e.distance);
+    say!("hops:       {hops} (landings the brain counted: its FSM going from flight to stance)");
     let speed = if e.time > 0.0 {
         e.distance / e.time
     } else {
         0.0
     };
-    println!("speed:      {speed:.4} m/s (mean forward)");
-    println!("ended:      {}", e.ended);
+    say!("speed:      {speed:.4} m/s (mean forward)");
+    say!("ended:      {}", e.ended);
     match gait.stance_summary() {
-        Some((lo, mid, hi)) => println!(
+        Some((lo, mid, hi)) => say!(
             "stances:    {} (FSM stance, s: min {lo:.3}, median {mid:.3}, max {hi:.3})",
             gait.stances.len()
         ),
-        None => println!("stances:    0"),
+        None => say!("stances:    0"),
     }
     if let (Some((lo, mid, hi)), Some((_, slide_mid, slide_max))) =
         (gait.contact_summary(), gait.slide_summary())
     {
-        println!(
+        say!(
             "contacts:   {} (times the foot came down on the floor, as the physics saw it; fewer than hops when the brain's flight ends without the foot leaving the floor. On the floor, s: min {lo:.3}, median {mid:.3}, max {hi:.3}; slide median {:.1} mm, max {:.1} mm)",
             gait.contacts.len(),
             slide_mid * 1e3,
@@ -167,7 +165,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     if let Some(t) = trajectory {
         let frames = t.frames();
         let path = t.finish().map_err(Failure::Other)?;
-        println!("wrote {frames} recorded steps to {}", path.display());
+        say!("wrote {frames} recorded steps to {}", path.display());
     }
     Ok(())
 }

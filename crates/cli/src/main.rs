@@ -5,6 +5,16 @@
 //! unwritable outputs, corrupt checkpoints), 3 the simulation blew up,
 //! 130 interrupted by Ctrl-C (after saving), 1 anything else.
 
+/// `println!` for the command's report on stdout, where a reader that has
+/// gone away (`animats simulate ... | head`, a test harness that stopped
+/// reading) costs the line, not a panic.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($arg)*);
+    }};
+}
+
 mod bench;
 mod evaluate;
 mod evolve;

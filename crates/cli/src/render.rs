@@ -502,7 +502,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
         .collect();
     write(&args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
-    println!(
+    say!(
         "{}: {} frame{} of {}x{} rendered in {:.2} s, to t = {:.2} s; wrote {} ({size} bytes)",
         args.scene.display(),
         frames.len(),
@@ -664,7 +664,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
     let (w, h) = frames.first().map_or((0, 0), |f| (f.width, f.height));
     write(args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
-    println!(
+    say!(
         "{}{}: {} {}, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
         dir.display(),
         if several {
@@ -680,7 +680,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
         args.out.display()
     );
     for (k, (run, _, _, fitness, lane)) in bodies.iter().enumerate() {
-        println!(
+        say!(
             "  #{}: fitness {fitness} ({}{} {lane})",
             k + 1,
             if several {

@@ -94,14 +94,14 @@ pub fn run(args: Args) -> Result<(), Failure> {
         } else {
             e1 - e0
         };
-        println!("energy: E0 = {e0:.12e} J, E = {e1:.12e} J, drift {rel:+.3e} (relative)");
+        say!("energy: E0 = {e0:.12e} J, E = {e1:.12e} J, drift {rel:+.3e} (relative)");
     } else {
-        println!("energy: not reported (the scene has dissipative or driven forces or events)");
+        say!("energy: not reported (the scene has dissipative or driven forces or events)");
     }
     if let Some(t) = trajectory {
         let frames = t.frames();
         let path = t.finish().map_err(Failure::Other)?;
-        println!("wrote {frames} recorded steps to {}", path.display());
+        say!("wrote {frames} recorded steps to {}", path.display());
     }
     Ok(())
 }
@@ -182,7 +182,7 @@ fn report(
     wall: f64,
 ) {
     let world = &scene.world;
-    println!(
+    say!(
         "{}: {} particles, {} springs, {} angle joints, {} torque joints",
         args.scene.display(),
         world.len(),
@@ -190,14 +190,14 @@ fn report(
         world.forces().angle_joints.len(),
         world.forces().torque_joints.len()
     );
-    println!(
+    say!(
         "integrator {}, dt {dt} s, {steps} steps to t = {} s",
         world.integrator(),
         world.time()
     );
     match limit {
         Some(l) => {
-            println!(
+            say!(
             "recommended step for {}: {:.3e} s (spring modes up to {:.1} rad/s, at particle `{}`)",
             world.integrator(),
             l.dt,
@@ -206,36 +206,36 @@ fn report(
         )
         }
         None if world.integrator().is_explicit() => {
-            println!("recommended step: no spring limits it")
+            say!("recommended step: no spring limits it")
         }
         None => {
             let explicit = world.recommended_dt(IntegratorKind::Symplectic);
-            println!(
+            say!(
                 "recommended step for implicit: any (stable at every step{})",
                 explicit.map_or(String::new(), |h| format!(
                     "; symplectic Euler would need below {h:.3e} s"
                 ))
             );
-            println!(
+            say!(
                 "linear solves: {:.1} conjugate-gradient iterations a step (tolerance {:e})",
                 iterations as f64 / steps as f64,
                 world.solver().tolerance
             );
         }
     }
-    println!("backtracks: {}", world.stats().backtracks);
+    say!("backtracks: {}", world.stats().backtracks);
     if let Some(c) = world.event::<animats_engine::SphereContact>() {
         let asleep = if c.def().sleep_speed > 0.0 {
             format!(", {} spheres asleep", c.sleeping())
         } else {
             String::new()
         };
-        println!(
+        say!(
             "sphere contacts at the end: {} pairs touching{asleep}",
             c.touching()
         );
     }
-    println!(
+    say!(
         "wall time: {wall:.4} s ({:.1} simulated s per wall s)",
         world.time() / wall.max(1e-9)
     );
@@ -271,7 +271,7 @@ fn realtime(args: Args) -> Result<(), Failure> {
     let (mut second_start, mut frames, mut sim_at_second) = (start, 0u64, 0.0);
     let mut steps = 0u64;
     let mut busy = Duration::ZERO;
-    println!(
+    say!(
         "{}: real time at {} frames/s, steps of at most {max_dt} s; Ctrl-C to stop",
         args.scene.display(),
         args.fps
@@ -309,7 +309,7 @@ fn realtime(args: Args) -> Result<(), Failure> {
             let interval = second_start.elapsed().as_secs_f64();
             if interval >= 1.0 {
                 let sim = scene.world.time() - sim_at_second;
-                println!(
+                say!(
                     "t = {:7.2} s  {:5.1} frames/s  simulated/real {:.3}  step {:.5} s  CPU {:.1}%",
                     scene.world.time(),
                     frames as f64 / interval,
@@ -328,9 +328,9 @@ fn realtime(args: Args) -> Result<(), Failure> {
     if let Some(t) = trajectory {
         let written = t.frames();
         let path = t.finish().map_err(Failure::Other)?;
-        println!("wrote {written} recorded steps to {}", path.display());
+        say!("wrote {written} recorded steps to {}", path.display());
     }
-    println!(
+    say!(
         "{steps} steps to t = {:.3} s in {:.2} s of wall time",
         scene.world.time(),
         start.elapsed().as_secs_f64()

@@ -38,7 +38,7 @@ impl Serving {
         })
         .map_err(Failure::Input)?;
         let url = server.url().map_err(Failure::Other)?;
-        println!("animats view: watching at {url} (paused until a tab connects; Ctrl-C to stop)");
+        say!("animats view: watching at {url} (paused until a tab connects; Ctrl-C to stop)");
         Ok(server)
     }
 }
@@ -119,7 +119,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let s = server
         .serve(Box::new(stage), stop)
         .map_err(Failure::Other)?;
-    println!(
+    say!(
         "simulated {:.2} s in {:.2} s ({:.1}x real time, {} steps), {} frames streamed",
         s.simulated,
         s.wall,
