@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Evolution's scaling with threads (issue 41): the three runs of the issue
+# Evolution's scaling with threads (issue 41): the issue's three runs and a
+# [morphology] run (bodies and brains evolving)
 # at 1, 2, 4, 8 and 16 threads, wall time and speed-up each, every log
 # checked identical; then the schedule model's prediction (`evolve
 # --schedule`) from each row's 1-thread run, to set beside the measured.
@@ -8,7 +9,7 @@
 # a many-core machine in an ignored folder):
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
-# About 2 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
+# About 3 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ANIMATS:-target/carry/animats}
@@ -22,6 +23,7 @@ rows=(
   "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
   "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
   "quadruped3|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1"
+  "bodies_walk|scenes/bodies_walk.toml --lanes 16 --generations 2 --seed 1"
 )
 header="| run |"; rule="|---|"
 for t in $THREADS; do header+=" $t |"; rule+="---|"; done
