@@ -58,7 +58,8 @@ pub struct Args {
     /// Worker threads [default: every core].
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1024))]
     threads: Option<u64>,
-    /// Seconds between checkpoints (0: after every batch of generations).
+    /// Seconds between checkpoints (0: after each generation of every lane);
+    /// the lanes never wait for each other between them.
     #[arg(long, default_value_t = 5.0, value_parser = crate::non_negative_f64)]
     checkpoint_every: f64,
     /// Watch it live in the browser: the scene driven by its best brain so
