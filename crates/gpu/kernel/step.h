@@ -13,8 +13,8 @@
  * follow fails crates/gpu/tests/parity.rs.
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
- * (their atan2 ported from the `libm` crate, libm.h), torque joints, still
- * fluids on every particle, the flat floor (its located collisions with
+ * (their atan2 ported from the `libm` crate, libm.h), torque joints,
+ * constant forces, still fluids on every particle, the flat floor (its located collisions with
  * backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
@@ -39,8 +39,9 @@ enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
  * first_particle[c + 1] - 1 and springs first_spring[c] ..
  * first_spring[c + 1] - 1, whose ends are indices within the creature.
  * Angle joints (first_joint, ends a and b, joint j), torque joints
- * (first_motor, end and joint, unit axis, torque) and still fluids on
- * every particle (first_fluid) likewise. Vectors are
+ * (first_motor, end and joint, unit axis, torque), constant forces (as
+ * pushes: first_push, a particle and a vector each, in the engine's order)
+ * and still fluids on every particle (first_fluid) likewise. Vectors are
  * stored x, y, z per particle. `scratch` holds 15 doubles per particle
  * (force, and RK4's start and sums).
  */
@@ -78,6 +79,9 @@ typedef struct {
     const double *mu_s;
     const double *mu_k;
     long long *failed; /* per creature: 0, or the step that gave a non-finite state */
+    const long long *first_push; /* per creature: its constant forces' pushes */
+    const int *push_particle;    /* one push: a constant force on one particle */
+    const double *push_force;    /* 3 per push */
     double gx, gy, gz;
     int gravity; /* 1: gravity pulls every particle; 0: none */
     int integrator;
@@ -243,7 +247,8 @@ AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, con
 
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints, fluids, the floor's contact force. h: the step
+ * joints, torque joints, constant forces, fluids, the floor's contact
+ * force. h: the step
  * of the trial. */
 AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, long long s0,
                      long long ns, const double *x, const double *v, double *f, double h) {
@@ -283,6 +288,12 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
     long long j0 = b->first_joint[c], m0 = b->first_motor[c];
     an_angle_joints(b, j0, b->first_joint[c + 1] - j0, x, v, f);
     an_motors(b, m0, b->first_motor[c + 1] - m0, x, f);
+    for (long long q = b->first_push[c]; q < b->first_push[c + 1]; q++) {
+        long long p = b->push_particle[q];
+        for (int k = 0; k < 3; k++) {
+            f[3 * p + k] += b->push_force[3 * q + k];
+        }
+    }
     long long q0 = b->first_fluid[c];
     an_fluids(b, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
     if (b->floor && b->floor_contact) {

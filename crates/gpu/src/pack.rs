@@ -42,6 +42,9 @@ pub(crate) struct Raw {
     mu_s: *const c_double,
     mu_k: *const c_double,
     failed: *mut c_longlong,
+    first_push: *const c_longlong,
+    push_particle: *const c_int,
+    push_force: *const c_double,
     gx: c_double,
     gy: c_double,
     gz: c_double,
@@ -122,6 +125,9 @@ pub struct Batch {
     mu_s: Vec<f64>,
     mu_k: Vec<f64>,
     failed: Vec<i64>,
+    first_push: Vec<i64>,
+    push_particle: Vec<i32>,
+    push_force: Vec<f64>,
     floor: Option<Floor>,
     g: DVec3,
     gravity: bool,
@@ -134,7 +140,7 @@ impl Batch {
     /// world must share the first one's gravity, floor and integrator, and
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
-    /// torques, still fluids about every particle, the flat floor under
+    /// torques, constant forces, still fluids about every particle, the flat floor under
     /// every particle): anything else is refused with a message naming the
     /// world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
@@ -185,6 +191,9 @@ impl Batch {
             mu_s: Vec::new(),
             mu_k: Vec::new(),
             failed: vec![0; worlds.len()],
+            first_push: vec![0],
+            push_particle: Vec::new(),
+            push_force: Vec::new(),
             floor: floor_of(first).map_err(|e| format!("world 0: {e}"))?,
             g,
             gravity,
@@ -248,6 +257,12 @@ impl Batch {
                 b.motor_axis.extend(m.axis().to_array());
                 b.motor_torque.push(m.torque);
             }
+            for cf in w.forces().constant_forces.iter() {
+                for p in cf.particles() {
+                    b.push_particle.push(p.index() as i32);
+                    b.push_force.extend(cf.force.to_array());
+                }
+            }
             for fl in w.forces().fluids() {
                 // As FluidMedium::apply forms it.
                 b.fluid_drag
@@ -264,6 +279,7 @@ impl Batch {
             b.first_joint.push(b.joint_a.len() as i64);
             b.first_motor.push(b.motor_end.len() as i64);
             b.first_fluid.push(b.fluid_drag.len() as i64);
+            b.first_push.push(b.push_particle.len() as i64);
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         Ok(b)
@@ -370,6 +386,9 @@ impl Batch {
             Array::MuS => F64(&self.mu_s),
             Array::MuK => F64(&self.mu_k),
             Array::Failed => I64(&self.failed),
+            Array::FirstPush => I64(&self.first_push),
+            Array::PushParticle => I32(&self.push_particle),
+            Array::PushForce => F64(&self.push_force),
         }
     }
 
@@ -431,6 +450,9 @@ impl Batch {
             mu_s: c(Array::MuS),
             mu_k: c(Array::MuK),
             failed: at(Array::Failed) as *mut c_longlong,
+            first_push: l(Array::FirstPush),
+            push_particle: i(Array::PushParticle),
+            push_force: c(Array::PushForce),
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -473,9 +495,6 @@ fn supported(w: &World) -> Result<(), String> {
     }
     if f.gravity().is_some_and(|g| g.targets != Targets::All) {
         return refuse("gravity on some particles only");
-    }
-    if !f.constant_forces.is_empty() {
-        return refuse("a constant force");
     }
     for fl in f.fluids() {
         if fl.targets != Targets::All {
@@ -537,11 +556,14 @@ pub(crate) enum Array {
     MuS,
     MuK,
     Failed,
+    FirstPush,
+    PushParticle,
+    PushForce,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 33] = [
+    pub(crate) const ALL: [Array; 36] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -575,6 +597,9 @@ impl Array {
         Array::MuS,
         Array::MuK,
         Array::Failed,
+        Array::FirstPush,
+        Array::PushParticle,
+        Array::PushForce,
     ];
 }
 

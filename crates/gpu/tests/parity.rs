@@ -100,9 +100,10 @@ fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
     }
 }
 
-/// Bodies dropped onto the floor from up to 2.2 m: bounces (located by
-/// backtracking when a sphere passes the envelope inside a step), rest,
-/// the contact force's reaction and friction.
+/// Bodies dropped onto the floor from up to 2.2 m, pushed by constant
+/// forces: bounces (located by backtracking when a sphere passes the
+/// envelope inside a step), rest, the contact force's reaction and
+/// friction.
 #[test]
 fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
     let mut rng = Lcg(9);
@@ -124,6 +125,12 @@ fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
                     if air {
                         w.add_fluid(FluidMedium::air()).unwrap();
                     }
+                    // A wind on every other particle, and a second push on
+                    // the first (the same particle twice, in order).
+                    let ids: Vec<_> = w.particle_ids().collect();
+                    let some: Vec<_> = ids.iter().copied().step_by(2).collect();
+                    w.add_constant_force(some, rng.vec(3.0)).unwrap();
+                    w.add_constant_force(vec![ids[0]], rng.vec(5.0)).unwrap();
                     w
                 })
                 .collect();
@@ -176,11 +183,16 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "{err}"
     );
 
-    let mut pushed = plain();
-    let ids: Vec<_> = pushed.particle_ids().collect();
-    pushed.add_constant_force(ids, DVec3::X).unwrap();
-    let err = Batch::pack(&[&pushed], 1e-3).unwrap_err();
-    assert_eq!(err, "world 0: a constant force is not in the GPU step yet");
+    let mut pulled = plain();
+    pulled
+        .add_nbody(animats_engine::NBodyGravity::new(
+            1.0,
+            0.0,
+            Default::default(),
+        ))
+        .unwrap();
+    let err = Batch::pack(&[&pulled], 1e-3).unwrap_err();
+    assert_eq!(err, "world 0: n-body gravity is not in the GPU step yet");
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);
