@@ -22,10 +22,10 @@
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
 //! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
-//! torque joints, constant forces, still fluids, the flat floor (collisions located by
-//! backtracking, contact force), and the explicit integrators (Euler,
-//! midpoint, RK4, symplectic Euler). Sensors, brains and fitness are issue
-//! 42's next steps; docs/GPU.md says where it stands.
+//! torque joints, constant forces, still fluids, the flat floor (collisions
+//! located by backtracking, contact force), and the explicit integrators
+//! (Euler, midpoint, RK4, symplectic Euler). Sensors, brains and fitness
+//! are issue 42's next steps; docs/GPU.md says where it stands.
 
 pub mod bodies;
 pub mod cuda;
