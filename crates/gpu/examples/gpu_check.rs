@@ -9,8 +9,9 @@
 //! PARTICLES 0 (the default) mixes sizes of 2 to 40. Exit 2 where no GPU
 //! can be used (the message says why), 1 if any bit differs.
 
+use animats_creatures::random::Random;
 use animats_engine::{FloorDef, IntegratorKind, World};
-use animats_gpu::bodies::{random_body, Lcg};
+use animats_gpu::bodies::random_body;
 use animats_gpu::{Batch, Device};
 use rayon::prelude::*;
 use std::time::Instant;
@@ -31,7 +32,7 @@ fn main() {
         std::process::exit(2);
     }
     let dt = 1e-3;
-    let mut rng = Lcg(42);
+    let mut rng = Random::for_entry(42, 0);
     let mut worlds: Vec<World> = (0..creatures)
         .map(|k| {
             let n = if particles == 0 {
@@ -39,7 +40,13 @@ fn main() {
             } else {
                 particles as usize
             };
-            let mut w = random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4);
+            let mut w = match random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4) {
+                Ok(w) => w,
+                Err(e) => {
+                    eprintln!("gpu_check: {e}");
+                    std::process::exit(2);
+                }
+            };
             // Dropped onto the floor: bounces, backtracking, resting.
             for p in w.particle_ids().collect::<Vec<_>>() {
                 let x = w.position(p) + animats_engine::DVec3::new(0.0, 1.2, 0.0);

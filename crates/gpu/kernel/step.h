@@ -79,6 +79,7 @@ typedef struct {
     const double *mu_s;
     const double *mu_k;
     long long *failed; /* per creature: 0, or the step that gave a non-finite state */
+    long long steps_before; /* steps the batch has taken in earlier runs */
     const long long *first_push; /* per creature: its constant forces' pushes */
     const int *push_particle;    /* one push: a constant force on one particle */
     const double *push_force;    /* 3 per push */
@@ -445,7 +446,8 @@ AN_FN int an_finite(const double *x, long long m3) {
  * after a missed collision, the step again in pieces, halved while one is
  * missed down to 1/1024 of the step, and grown back once they line up).
  * A non-finite state stops the creature at its last finite state, as the
- * engine's step refuses it; `failed[c]` records the step (1-based). */
+ * engine's step refuses it; `failed[c]` records the step (1-based, counted
+ * over every run of the batch). */
 AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
@@ -479,7 +481,7 @@ AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
                 an_floor_handle(b, p0, n, h, dt, v, x1, v1);
             }
             if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
-                b->failed[c] = step + 1;
+                b->failed[c] = b->steps_before + step + 1;
                 return;
             }
             for (long long k = 0; k < m3; k++) {

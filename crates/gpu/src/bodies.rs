@@ -2,34 +2,18 @@
 //! parity tests step on both sides, and what the GPU benchmark
 //! (`examples/gpu_check.rs`) evaluates by the thousand.
 
+use animats_creatures::random::Random;
 use animats_engine::{
-    AngleJointDef, DVec3, IntegratorKind, ParticleDef, SpringDef, TorqueJointDef, World,
+    AngleJointDef, DVec3, IntegratorKind, ModelError, ParticleDef, SpringDef, TorqueJointDef, World,
 };
 
-/// A reproducible stream of numbers in [0, 1) (a 64-bit LCG).
-pub struct Lcg(pub u64);
-
-impl Lcg {
-    /// The next number.
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self
-            .0
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Uniform in [lo, hi).
-    pub fn between(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.uniform()
-    }
-    /// Each coordinate uniform in [-scale/2, scale/2).
-    pub fn vec(&mut self, scale: f64) -> DVec3 {
-        DVec3::new(
-            self.uniform() - 0.5,
-            self.uniform() - 0.5,
-            self.uniform() - 0.5,
-        ) * scale
-    }
+/// Each coordinate uniform in [-scale/2, scale/2).
+pub fn random_vec(rng: &mut Random, scale: f64) -> DVec3 {
+    DVec3::new(
+        rng.uniform() - 0.5,
+        rng.uniform() - 0.5,
+        rng.uniform() - 0.5,
+    ) * scale
 }
 
 /// A random body of `n` particles: a ring of springs through them all,
@@ -38,12 +22,12 @@ impl Lcg {
 /// first angle) and a torque joint (a random axis and torque) for every
 /// third particle; random masses, radii, positions and velocities.
 pub fn random_body(
-    rng: &mut Lcg,
+    rng: &mut Random,
     n: usize,
     gravity: bool,
     joints: bool,
     kind: IntegratorKind,
-) -> World {
+) -> Result<World, ModelError> {
     let mut w = World::new();
     if gravity {
         w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
@@ -53,11 +37,11 @@ pub fn random_body(
         .map(|_| {
             let def = ParticleDef::new(rng.between(0.1, 3.0))
                 .with_radius(rng.between(0.02, 0.2))
-                .at(rng.vec(2.0))
-                .with_velocity(rng.vec(1.0));
-            w.add_particle(def).unwrap()
+                .at(random_vec(rng, 2.0))
+                .with_velocity(random_vec(rng, 1.0));
+            w.add_particle(def)
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     for i in 0..2 * n {
         let (a, b) = if i < n {
             (i, (i + 1) % n)
@@ -75,7 +59,7 @@ pub fn random_body(
             rng.between(0.0, 2.0),
         )
         .with_rest_length(rng.between(0.2, 1.5));
-        w.add_spring(def).unwrap();
+        w.add_spring(def)?;
     }
     if joints && n >= 3 {
         for j in (0..n).step_by(3) {
@@ -87,15 +71,15 @@ pub fn random_body(
                 rng.between(0.5, 20.0),
                 rng.between(0.0, 0.5),
             );
-            w.add_angle_joint(def).unwrap();
+            w.add_angle_joint(def)?;
             let motor = TorqueJointDef {
                 end: ids[a],
                 joint: ids[j],
-                axis: rng.vec(1.0) + DVec3::Y,
+                axis: random_vec(rng, 1.0) + DVec3::Y,
                 torque: rng.between(-3.0, 3.0),
             };
-            w.add_torque_joint(motor).unwrap();
+            w.add_torque_joint(motor)?;
         }
     }
-    w
+    Ok(w)
 }

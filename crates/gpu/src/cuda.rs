@@ -157,6 +157,7 @@ impl Device {
             _ => return Err("failures are 64-bit integers".into()),
         };
         batch.set_state(&pos, &vel, &failed);
+        batch.ran(steps as u64);
         Ok(())
     }
 }

@@ -42,6 +42,7 @@ pub(crate) struct Raw {
     mu_s: *const c_double,
     mu_k: *const c_double,
     failed: *mut c_longlong,
+    steps_before: c_longlong,
     first_push: *const c_longlong,
     push_particle: *const c_int,
     push_force: *const c_double,
@@ -125,6 +126,8 @@ pub struct Batch {
     mu_s: Vec<f64>,
     mu_k: Vec<f64>,
     failed: Vec<i64>,
+    /// Steps taken by earlier runs (`failed` counts from the first).
+    steps_run: u64,
     first_push: Vec<i64>,
     push_particle: Vec<i32>,
     push_force: Vec<f64>,
@@ -191,6 +194,7 @@ impl Batch {
             mu_s: Vec::new(),
             mu_k: Vec::new(),
             failed: vec![0; worlds.len()],
+            steps_run: 0,
             first_push: vec![0],
             push_particle: Vec::new(),
             push_force: Vec::new(),
@@ -327,6 +331,7 @@ impl Batch {
                 animats_step_range(shared.get(), first as c_longlong, last as c_longlong, steps)
             };
         });
+        self.steps_run = self.steps_run.saturating_add(steps as u64);
     }
 
     fn raw(&mut self) -> Raw {
@@ -401,6 +406,11 @@ impl Batch {
         self.failed.copy_from_slice(&failed[..c]);
     }
 
+    /// Counts `steps` more taken (by a GPU run).
+    pub(crate) fn ran(&mut self, steps: u64) {
+        self.steps_run = self.steps_run.saturating_add(steps);
+    }
+
     /// The step (1-based, counted over every run) at which creature `c`'s
     /// state stopped being finite, where the engine's step returns
     /// `SimError::NonFinite`; it is not stepped further.
@@ -450,6 +460,7 @@ impl Batch {
             mu_s: c(Array::MuS),
             mu_k: c(Array::MuK),
             failed: at(Array::Failed) as *mut c_longlong,
+            steps_before: self.steps_run.min(i64::MAX as u64) as c_longlong,
             first_push: l(Array::FirstPush),
             push_particle: i(Array::PushParticle),
             push_force: c(Array::PushForce),

@@ -5,8 +5,8 @@
 use animats_engine::{FluidMedium, IntegratorKind, World};
 use animats_gpu::{Batch, Device};
 
-mod common;
-use common::{random_body, Lcg};
+use animats_creatures::random::Random;
+use animats_gpu::bodies::random_body;
 
 #[test]
 fn the_gpu_steps_every_creature_as_the_cpu_does_or_says_what_is_missing() {
@@ -21,12 +21,12 @@ fn the_gpu_steps_every_creature_as_the_cpu_does_or_says_what_is_missing() {
             return;
         }
     };
-    let mut rng = Lcg(7);
+    let mut rng = Random::for_entry(7, 0);
     for kind in [IntegratorKind::Rk4, IntegratorKind::Symplectic] {
         let worlds: Vec<World> = (0..300)
             .map(|k| {
                 let n = 2 + (rng.uniform() * 39.0) as usize;
-                let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind);
+                let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind).unwrap();
                 if k % 3 == 0 {
                     w.add_fluid(FluidMedium::air()).unwrap();
                 }
