@@ -211,6 +211,11 @@ fn bad_requests_are_refused() {
         ("bins = [20, 20]", "bins = [20]", "archive.bins"),
         (
             "bins = [20, 20]",
+            "bins = [20, 20]\ntournament = 0",
+            "archive.tournament",
+        ),
+        (
+            "bins = [20, 20]",
             "bins = [20000, 20000]",
             "at most 10000000",
         ),

@@ -146,6 +146,32 @@ mod pairs {
     }
 }
 
+/// The cell of `measures` in `grid` along each measure (pyribs's grid
+/// index).
+pub fn grid_index(grid: &Grid, measures: &[f64]) -> Vec<u64> {
+    measures
+        .iter()
+        .zip(&grid.bins)
+        .zip(&grid.ranges)
+        .map(|((&m, &bins), &(lo, hi))| {
+            let x = ((bins as f64) * (m - lo) + EPSILON) / (hi - lo);
+            // Truncation toward zero then clipping, as numpy's astype and
+            // clip.
+            let i = if x >= 0.0 { x.trunc() } else { 0.0 };
+            (i.min((bins - 1) as f64)) as u64
+        })
+        .collect()
+}
+
+/// The cell of `measures` in `grid` (row-major, the last measure fastest:
+/// `numpy.ravel_multi_index`).
+pub fn index_of(grid: &Grid, measures: &[f64]) -> u64 {
+    grid_index(grid, measures)
+        .iter()
+        .zip(&grid.bins)
+        .fold(0, |acc, (&i, &b)| acc * b + i)
+}
+
 impl GridArchive {
     /// An empty archive over `grid` (checked by the scene).
     pub fn new(grid: Grid) -> GridArchive {
@@ -226,27 +252,13 @@ impl GridArchive {
 
     /// The cell of `measures` along each measure (pyribs's grid index).
     pub fn grid_index(&self, measures: &[f64]) -> Vec<u64> {
-        measures
-            .iter()
-            .zip(&self.grid.bins)
-            .zip(&self.grid.ranges)
-            .map(|((&m, &bins), &(lo, hi))| {
-                let x = ((bins as f64) * (m - lo) + EPSILON) / (hi - lo);
-                // Truncation toward zero then clipping, as numpy's astype
-                // and clip.
-                let i = if x >= 0.0 { x.trunc() } else { 0.0 };
-                (i.min((bins - 1) as f64)) as u64
-            })
-            .collect()
+        grid_index(&self.grid, measures)
     }
 
     /// The cell of `measures` (row-major, the last measure fastest:
     /// `numpy.ravel_multi_index`).
     pub fn index_of(&self, measures: &[f64]) -> u64 {
-        self.grid_index(measures)
-            .iter()
-            .zip(&self.grid.bins)
-            .fold(0, |acc, (&i, &b)| acc * b + i)
+        index_of(&self.grid, measures)
     }
 
     /// Cell `index` along each measure.
@@ -390,6 +402,23 @@ impl GridArchive {
             })
             .collect()
     }
+
+    /// `n` parents, each the best of the grid's `tournament` elites drawn
+    /// uniformly (the first of equals); with 1, [`GridArchive::sample`].
+    pub fn parents<'a>(&'a self, n: usize, rng: &mut Random) -> Vec<&'a Elite> {
+        let k = self.grid.tournament.max(1);
+        (0..n)
+            .filter_map(|_| {
+                self.sample(k, rng).into_iter().reduce(|a, b| {
+                    if b.objective > a.objective {
+                        b
+                    } else {
+                        a
+                    }
+                })
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -410,6 +439,7 @@ mod tests {
             emitters: None,
             sigma: None,
             line_sigma: None,
+            tournament: 1,
         }
     }
 
@@ -421,6 +451,48 @@ mod tests {
             time: 1.0,
             distance: 0.0,
             ended: "timeout".into(),
+        }
+    }
+
+    /// Parents by tournament: of 1, the uniform draws of `sample` (the
+    /// same random numbers); of k, each parent the best of k uniform
+    /// draws, so the best of n elites is picked with probability
+    /// 1 − (1 − 1/n)^k.
+    #[test]
+    fn tournaments_pick_the_better_elites() {
+        let mut a = GridArchive::new(grid(vec![10], vec![(0.0, 10.0)], 1.0, f64::NEG_INFINITY));
+        let genomes: Vec<Vec<f64>> = (0..10).map(|i| vec![i as f64]).collect();
+        let measures: Vec<Vec<f64>> = (0..10).map(|i| vec![i as f64 + 0.5]).collect();
+        let batch: Vec<Candidate> = (0..10)
+            .map(|i| cand(&genomes[i], i as f64, &measures[i]))
+            .collect();
+        a.add(&batch);
+        let draws = 20_000;
+        let (mut r1, mut r2) = (Random::for_entry(3, 1), Random::for_entry(3, 1));
+        let uniform: Vec<f64> = a
+            .sample(draws, &mut r1)
+            .iter()
+            .map(|e| e.objective)
+            .collect();
+        let one: Vec<f64> = a
+            .parents(draws, &mut r2)
+            .iter()
+            .map(|e| e.objective)
+            .collect();
+        assert_eq!(uniform, one);
+        for k in [2, 4] {
+            a.grid.tournament = k;
+            let mut r = Random::for_entry(3, 2);
+            let best = a
+                .parents(draws, &mut r)
+                .iter()
+                .filter(|e| e.objective == 9.0)
+                .count() as f64
+                / draws as f64;
+            let p = 1.0 - 0.9f64.powi(k as i32);
+            // Binomial: 5 standard deviations.
+            let sd = (p * (1.0 - p) / draws as f64).sqrt();
+            assert!((best - p).abs() < 5.0 * sd, "k = {k}: {best} against {p}");
         }
     }
 

@@ -24,6 +24,7 @@ pub mod optimiser;
 pub mod problem;
 pub mod run;
 pub mod schedule;
+pub mod screen;
 
 pub use optimiser::{cma_es, ga, hill_climber};
 

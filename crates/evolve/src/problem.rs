@@ -6,6 +6,7 @@
 
 use crate::optimiser::body_ga::Variation;
 use crate::optimiser::{Bounds, Random};
+use crate::screen::Screen;
 use animats_scene::def::MutationName;
 use animats_scene::evaluate::{EvolveSpec, SceneProblem};
 use animats_scene::morphology::{BodyStats, MorphologyProblem};
@@ -29,6 +30,12 @@ pub trait Problem: Send + Sync {
     /// Evaluates one genome. Deterministic: the same genome gives the same
     /// bits on any thread.
     fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String>;
+    /// [`Problem::evaluate`], a robust scene's half-step run made only
+    /// where `screen` says ([`Screen`]); by default in full.
+    fn evaluate_screened(&self, genome: &[f64], screen: &Screen) -> Result<Outcome, String> {
+        let _ = screen;
+        self.evaluate(genome)
+    }
     /// The scene's `[evolve]` table, resolved (none for a problem that is
     /// not a scene).
     fn spec(&self) -> Option<&EvolveSpec> {
@@ -76,6 +83,9 @@ impl Problem for SceneEvolution {
     fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
         self.0.evaluate(genome)
     }
+    fn evaluate_screened(&self, genome: &[f64], screen: &Screen) -> Result<Outcome, String> {
+        self.0.evaluate_screened(genome, &|o| screen.fine(o))
+    }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())
     }
@@ -107,6 +117,9 @@ impl Problem for BodyEvolution {
     }
     fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
         self.0.evaluate(genome)
+    }
+    fn evaluate_screened(&self, genome: &[f64], screen: &Screen) -> Result<Outcome, String> {
+        self.0.evaluate_screened(genome, &|o| screen.fine(o))
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())

@@ -12,6 +12,7 @@
 
 use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 use crate::problem::{BodyEvolution, Outcome, Problem, SceneEvolution};
+use crate::screen::Screen;
 use animats_scene::def::LogName;
 use animats_scene::evaluate::{SceneProblem, MAX_LANES};
 use animats_scene::morphology::MorphologyProblem;
@@ -593,13 +594,18 @@ impl State {
         let target = self.config.generations;
         let problem = self.bodies()?;
         let variation = problem.as_ref().and_then(|p| p.variation());
-        let lanes = self
+        let (lanes, screens) = self
             .lanes
             .iter_mut()
             .filter(|l| l.generation < target)
-            .map(|l| Ok((l.lane, l.optimiser.ask_with(variation)?)))
-            .collect::<Result<_, String>>()?;
-        Ok(Generation { lanes })
+            .map(|l| {
+                let population = l.optimiser.ask_with(variation)?;
+                Ok(((l.lane, population), l.optimiser.screen()))
+            })
+            .collect::<Result<Vec<_>, String>>()?
+            .into_iter()
+            .unzip();
+        Ok(Generation { lanes, screens })
     }
 
     /// The problem, built, when its bodies evolve (asking and telling need
@@ -1002,6 +1008,7 @@ fn advance_lane(
         let (k, g) = (lane.lane, lane.generation);
         let began = std::time::Instant::now();
         let population = lane.optimiser.ask_with(problem.variation())?;
+        let screen = lane.optimiser.screen();
         if let Some(t) = tracer {
             t.done(k, g, Piece::Ask, began);
         }
@@ -1010,7 +1017,7 @@ fn advance_lane(
             .enumerate()
             .map(|(i, genome)| {
                 let began = std::time::Instant::now();
-                let o = problem.evaluate(genome);
+                let o = problem.evaluate_screened(genome, &screen);
                 if let Some(t) = tracer {
                     t.done(k, g, Piece::Evaluate(i), began);
                 }
@@ -1104,6 +1111,11 @@ fn record(
 pub struct Generation {
     /// (lane, its population), in lane order.
     pub lanes: Vec<(usize, Vec<Vec<f64>>)>,
+    /// Each lane's [`Screen`]: which of its genomes need a robust scene's
+    /// half-step run. Evaluate genome `i` with
+    /// [`Problem::evaluate_screened`] and [`Generation::screen`]`(i)` to
+    /// write the log that [`State::advance`] writes.
+    pub screens: Vec<Screen>,
 }
 
 impl Generation {
@@ -1115,6 +1127,19 @@ impl Generation {
     /// True when every lane is done: nothing to evaluate.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The screen of genome `i` (in the order of
+    /// [`Generation::genomes`]): its lane's.
+    pub fn screen(&self, mut i: usize) -> &Screen {
+        for ((_, p), s) in self.lanes.iter().zip(&self.screens) {
+            if i < p.len() {
+                return s;
+            }
+            i -= p.len();
+        }
+        static ALL: Screen = Screen::All;
+        &ALL
     }
 
     /// Every genome, lane by lane.

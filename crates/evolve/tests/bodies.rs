@@ -6,7 +6,8 @@
 //! checkpoint is written, read back and continued.
 
 use animats_evolve::optimiser::AnyOptimiser;
-use animats_evolve::{checkpoint, Choices, Config, ProblemSpec, State};
+use animats_evolve::screen::Screen;
+use animats_evolve::{checkpoint, Choices, Config, Outcome, Problem, ProblemSpec, State};
 use animats_scene::evaluate::SceneProblem;
 use animats_scene::morphology::MorphologyProblem;
 
@@ -177,10 +178,167 @@ fn a_body_run_is_the_same_on_any_thread_count_and_after_a_checkpoint() {
     let problem = s.config.problem.build().unwrap();
     while !s.done() {
         let g = s.ask().unwrap();
-        let outcomes: Vec<_> = g.genomes().map(|x| problem.evaluate(x).unwrap()).collect();
+        let outcomes: Vec<_> = g
+            .genomes()
+            .enumerate()
+            .map(|(i, x)| problem.evaluate_screened(x, g.screen(i)).unwrap())
+            .collect();
         s.tell(g, &outcomes).unwrap();
     }
     assert_eq!(s.log_csv(), one.log_csv());
+}
+
+/// A problem that scores every candidate in full (ignores screens).
+struct Full(Box<dyn Problem>);
+
+impl Problem for Full {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+    fn start(&self) -> Vec<f64> {
+        self.0.start()
+    }
+    fn bounds(&self) -> Option<animats_evolve::optimiser::Bounds> {
+        self.0.bounds()
+    }
+    fn evaluate(&self, genome: &[f64]) -> Result<Outcome, String> {
+        self.0.evaluate(genome)
+    }
+    fn spec(&self) -> Option<&animats_scene::evaluate::EvolveSpec> {
+        self.0.spec()
+    }
+    fn variation(&self) -> Option<&dyn animats_evolve::optimiser::body_ga::Variation> {
+        self.0.variation()
+    }
+    fn stats(&self, genome: &[f64]) -> Option<animats_scene::morphology::BodyStats> {
+        self.0.stats(genome)
+    }
+    fn grid(&self) -> Option<&animats_scene::archive::Grid> {
+        self.0.grid()
+    }
+    fn scene_toml(&self, genome: &[f64], comment: &str) -> Result<String, String> {
+        self.0.scene_toml(genome, comment)
+    }
+}
+
+/// Robust evaluation (the default for bodies: at the step and at half of
+/// it, the worse counting) skips the half-step run of a child that cannot
+/// survive, since the robust score is never above the score at the step:
+/// the body GA keeps the same survivors, the same best and `best.toml` as
+/// with every child scored in full, and only log rows whose best child did
+/// not survive may differ, by showing its score at the step (never below
+/// its robust score).
+#[test]
+fn screened_robust_evaluation_keeps_every_survivor_and_the_best() {
+    let run = |full: bool, generations: u64| {
+        let mut s = State::new(config(GRAPH, generations)).unwrap();
+        let problem = s.config.problem.build().unwrap();
+        let problem: Box<dyn Problem> = if full {
+            Box::new(Full(problem))
+        } else {
+            problem
+        };
+        pool(2)
+            .install(|| s.advance_with(problem.as_ref(), generations))
+            .unwrap();
+        s
+    };
+    let screened = run(false, 10);
+    let full = run(true, 10);
+    assert_eq!(screened.lanes[0].optimiser, full.lanes[0].optimiser);
+    assert_eq!(screened.lanes[0].best, full.lanes[0].best);
+    assert_eq!(screened.best_toml().unwrap(), full.best_toml().unwrap());
+    let (a, b) = (screened.log_csv(), full.log_csv());
+    let mut differ = 0;
+    for (x, y) in a.lines().zip(b.lines()).skip(1) {
+        let (x, y): (Vec<&str>, Vec<&str>) = (x.split(',').collect(), y.split(',').collect());
+        // lane, generation, evaluations, best_fitness and the body columns
+        // are the same; the generation's best may show its score at the step.
+        for k in [0, 1, 2, 4, 8, 9, 10, 11, 12] {
+            assert_eq!(x[k], y[k], "column {k}: {x:?} against {y:?}");
+        }
+        let (fx, fy): (f64, f64) = (x[3].parse().unwrap(), y[3].parse().unwrap());
+        assert!(fx >= fy, "{fx} below the robust {fy}");
+        differ += (x[3] != y[3]) as usize;
+    }
+    println!("{differ} of 10 rows show a score at the step");
+    // The next generation's children: those at or below the worst
+    // survivor are scored once, the rest in full.
+    let mut s = run(false, 10);
+    s.config.generations = 11;
+    let problem = s.config.problem.build().unwrap();
+    let g = s.ask().unwrap();
+    let bar = match g.screen(0) {
+        Screen::Above { bar } => *bar,
+        other => panic!("a full population screens by its worst: {other:?}"),
+    };
+    let (mut cut, mut scored) = (0, 0);
+    for (i, x) in g.genomes().enumerate() {
+        let once = problem.evaluate_screened(x, g.screen(i)).unwrap();
+        let robust = problem.evaluate(x).unwrap();
+        if once.fitness > bar {
+            assert_eq!(once, robust, "child {i} above the bar is scored in full");
+            scored += 1;
+        } else {
+            assert!(robust.fitness <= once.fitness, "child {i}");
+            cut += 1;
+        }
+    }
+    println!("bar {bar}: {cut} children scored once, {scored} in full");
+    assert!(cut > 0, "no child was screened out");
+}
+
+/// MAP-Elites screens a child by its cell's threshold; with measures of the
+/// body as built (the same at either step) the archive is the same as with
+/// every child scored in full.
+#[test]
+fn screened_map_elites_over_build_measures_fills_the_same_archive() {
+    let text = format!(
+        "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"particles\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [1.5, 13.5]]\n"
+    );
+    let run = |full: bool| {
+        let spec = ProblemSpec {
+            file: "bodies.toml".into(),
+            text: text.clone(),
+        };
+        let choices = Choices {
+            generations: Some(8),
+            population: Some(8),
+            seed: Some(5),
+            optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+            ..Choices::default()
+        };
+        let mut s = State::new(Config::new(spec, &choices).unwrap()).unwrap();
+        let problem = s.config.problem.build().unwrap();
+        let problem: Box<dyn Problem> = if full {
+            Box::new(Full(problem))
+        } else {
+            problem
+        };
+        pool(2)
+            .install(|| s.advance_with(problem.as_ref(), 8))
+            .unwrap();
+        s
+    };
+    let (screened, full) = (run(false), run(true));
+    let (a, b) = (screened.archive().unwrap(), full.archive().unwrap());
+    assert!(a.len() > 2, "{} elites", a.len());
+    assert_eq!(a.elites(), b.elites());
+    assert_eq!(screened.best_toml().unwrap(), full.best_toml().unwrap());
+}
+
+#[test]
+fn a_screen_reads_back_from_json_with_infinite_bars() {
+    for s in [
+        Screen::All,
+        Screen::Above {
+            bar: f64::NEG_INFINITY,
+        },
+        Screen::Above { bar: 1.25 },
+    ] {
+        assert_eq!(Screen::from_json(&s.to_json()).unwrap(), s);
+    }
+    assert!(Screen::from_json("{\"kind\":\"sideways\"}").is_err());
 }
 
 #[test]

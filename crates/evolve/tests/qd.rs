@@ -50,6 +50,7 @@ fn grid(emitters: usize) -> Grid {
         emitters: Some(emitters),
         sigma: Some(0.5),
         line_sigma: None,
+        tournament: 1,
     }
 }
 

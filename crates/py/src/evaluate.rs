@@ -4,6 +4,7 @@
 
 use crate::scene::{no_evolve, Scene};
 use crate::{on, pool, runtime_error, scene_error, value_error};
+use animats_evolve::screen::Screen;
 use animats_evolve::{Outcome, Problem, ProblemSpec};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -113,6 +114,7 @@ pub(crate) fn outcomes(
     genomes: &Bound<'_, PyAny>,
     pool: &Option<rayon::ThreadPool>,
     clip: Option<bool>,
+    screens: Option<&[Screen]>,
 ) -> PyResult<Vec<Outcome>> {
     let mut rows = rows(problem, genomes)?;
     if let Some(clip) = clip {
@@ -121,14 +123,38 @@ pub(crate) fn outcomes(
     if rows.is_empty() {
         return Ok(Vec::new());
     }
+    if let Some(s) = screens {
+        if s.len() != rows.len() {
+            return Err(value_error(format!(
+                "{} screens for {} genomes",
+                s.len(),
+                rows.len()
+            )));
+        }
+    }
     py.detach(|| {
         on(pool, || {
             rows.par_iter()
-                .map(|g| problem.evaluate(g))
+                .enumerate()
+                .map(|(i, g)| match screens {
+                    Some(s) => problem.evaluate_screened(g, &s[i]),
+                    None => problem.evaluate(g),
+                })
                 .collect::<Result<Vec<_>, _>>()
         })
     })
     .map_err(runtime_error)
+}
+
+/// Screens sent as `Evolution.screens()` wrote them (JSON texts).
+pub(crate) fn read_screens(texts: Option<Vec<String>>) -> PyResult<Option<Vec<Screen>>> {
+    texts
+        .map(|t| {
+            t.iter()
+                .map(|x| Screen::from_json(x).map_err(value_error))
+                .collect()
+        })
+        .transpose()
 }
 
 /// `animats.evaluate_scenes`: each complete scene text (any bodies, as a
@@ -194,7 +220,7 @@ pub fn evaluate<'py>(
         ));
     }
     let pool = pool(threads)?;
-    let o = outcomes(py, problem.as_ref(), genomes, &pool, Some(clip))?;
+    let o = outcomes(py, problem.as_ref(), genomes, &pool, Some(clip), None)?;
     let fitness = PyArray1::from_vec(py, o.iter().map(|o| o.fitness).collect());
     if measures {
         let k = problem.grid().map_or(0, |g| g.names.len());
@@ -266,7 +292,14 @@ impl Evaluator {
         genomes: &Bound<'py, PyAny>,
         clip: bool,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool, Some(clip))?;
+        let o = outcomes(
+            py,
+            self.problem.as_ref(),
+            genomes,
+            &self.pool,
+            Some(clip),
+            None,
+        )?;
         Ok(PyArray1::from_vec(
             py,
             o.iter().map(|o| o.fitness).collect(),
@@ -275,14 +308,25 @@ impl Evaluator {
 
     /// Every outcome of each row: a dict of arrays `fitness`, `time`,
     /// `distance` and the list `ended` (what `Evolution.tell` takes).
-    #[pyo3(signature = (genomes, clip = false))]
+    /// `screens`: one per row, as `Evolution.screens()` gives them (which
+    /// rows a robust scene scores again at half the step); default: all.
+    #[pyo3(signature = (genomes, clip = false, screens = None))]
     fn outcomes<'py>(
         &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
         clip: bool,
+        screens: Option<Vec<String>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let o = outcomes(py, self.problem.as_ref(), genomes, &self.pool, Some(clip))?;
+        let screens = read_screens(screens)?;
+        let o = outcomes(
+            py,
+            self.problem.as_ref(),
+            genomes,
+            &self.pool,
+            Some(clip),
+            screens.as_deref(),
+        )?;
         outcome_dict(py, &o)
     }
 }

@@ -6,6 +6,7 @@ use crate::evaluate::{build, outcome_dict, outcomes, problem_spec};
 use crate::{on, pool, runtime_error, value_error};
 use animats_evolve::optimiser::{Bounds, Optimiser as _};
 use animats_evolve::run::Generation;
+use animats_evolve::screen::Screen;
 use animats_evolve::{
     AnyOptimiser, Choices, Config, OptimiserKind, Outcome, ProblemSpec, Setup, State,
 };
@@ -346,8 +347,33 @@ impl Evolution {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pool = pool(threads)?;
-        let o = outcomes(py, self.problem.as_ref(), genomes, &pool, None)?;
+        // The genomes last asked: each screened as its lane's optimiser
+        // says, as `run` evaluates them.
+        let screens: Option<Vec<Screen>> = self.pending.as_ref().and_then(|g| {
+            let n = genomes.len().ok()?;
+            (n == g.len()).then(|| (0..n).map(|i| g.screen(i).clone()).collect())
+        });
+        let o = outcomes(
+            py,
+            self.problem.as_ref(),
+            genomes,
+            &pool,
+            None,
+            screens.as_deref(),
+        )?;
         outcome_dict(py, &o)
+    }
+
+    /// One screen per genome of the last `ask()` (JSON texts): which a
+    /// robust scene scores again at half the step. Hand them to
+    /// `Evaluator.outcomes(genomes, screens=...)` wherever the genomes are
+    /// evaluated, to write the log `run()` writes.
+    fn screens(&self) -> PyResult<Vec<String>> {
+        let g = self
+            .pending
+            .as_ref()
+            .ok_or_else(|| value_error("ask for a generation first"))?;
+        Ok((0..g.len()).map(|i| g.screen(i).to_json()).collect())
     }
 
     /// Advances every lane by up to `generations` generations (default:

@@ -47,6 +47,26 @@ def test_an_evolution_of_bodies_writes_the_command_lines_files(cli, small, tmp_p
         assert isinstance(genomes, list) and len(genomes) == 6 and lanes == [0] * 6
         by_hand.tell(by_hand.evaluate(genomes))
     assert by_hand.log_csv() == run.log_csv()
+    # Evaluated elsewhere, as Ray's actors do: with the generation's screens
+    # (which children a robust scene scores again at half the step) the
+    # same log; scored in full, the same survivors and best.
+    elsewhere = animats.Evolution(str(small), population=6, generations=4, seed=3)
+    full = animats.Evolution(str(small), population=6, generations=4, seed=3)
+    evaluator = animats.Evaluator(str(small), threads=1)
+    while not elsewhere.done:
+        genomes, _ = elsewhere.ask()
+        screens = elsewhere.screens()
+        assert len(screens) == 6
+        assert {json.loads(s)["kind"] for s in screens} <= {"all", "above"}
+        elsewhere.tell(evaluator.outcomes(genomes, screens=screens))
+        genomes, _ = full.ask()
+        full.tell(evaluator.outcomes(genomes))
+    assert elsewhere.log_csv() == run.log_csv()
+    assert full.best_toml() == run.best_toml()
+    with pytest.raises(ValueError, match="2 screens for 6 genomes"):
+        evaluator.outcomes(genomes, screens=screens[:2])
+    with pytest.raises(ValueError, match="not a screen"):
+        evaluator.outcomes(genomes, screens=["{}"] * 6)
 
 
 def test_evaluate_scenes_scores_texts_as_evaluate_scores_files(cli, small, tmp_path):

@@ -69,6 +69,9 @@ pub struct ArchiveEntry {
     pub sigma: Option<f64>,
     /// The iso-line's standard deviation along the line; default 0.2.
     pub line_sigma: Option<f64>,
+    /// MAP-Elites's parents: each the best of this many elites drawn
+    /// uniformly; default 1 (uniform, pyribs's).
+    pub tournament: Option<u64>,
 }
 
 /// `[archive] emitter`.
@@ -213,12 +216,21 @@ pub struct Grid {
     pub sigma: Option<f64>,
     /// See [`ArchiveEntry::line_sigma`].
     pub line_sigma: Option<f64>,
+    /// See [`ArchiveEntry::tournament`] (1: uniform).
+    #[serde(default = "one")]
+    pub tournament: usize,
 }
 
-/// −∞ written as `null` (JSON has no infinities).
-mod minus_infinity_as_null {
+fn one() -> usize {
+    1
+}
+
+/// −∞ written as `null` (JSON has no infinities): `#[serde(with = ...)]`.
+pub mod minus_infinity_as_null {
+    //! −∞ as `null` for serde.
     use serde::{Deserialize, Deserializer, Serializer};
 
+    /// Writes `x`, −∞ (or any non-finite value) as `null`.
     pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
         if x.is_finite() {
             s.serialize_some(x)
@@ -227,6 +239,7 @@ mod minus_infinity_as_null {
         }
     }
 
+    /// Reads a number, `null` as −∞.
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
         Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NEG_INFINITY))
     }
@@ -346,6 +359,13 @@ impl ArchiveEntry {
                 }
             }
         }
+        let tournament = match self.tournament {
+            None => 1,
+            Some(t) if (1..=1000).contains(&t) => t as usize,
+            Some(t) => {
+                return Err(at.err("tournament", format!("must be between 1 and 1000, got {t}")))
+            }
+        };
         Ok(Grid {
             names,
             bins: self.bins.clone(),
@@ -358,6 +378,7 @@ impl ArchiveEntry {
             emitters: self.emitters,
             sigma: self.sigma,
             line_sigma: self.line_sigma,
+            tournament,
         })
     }
 

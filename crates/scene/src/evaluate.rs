@@ -566,6 +566,19 @@ fn worse(first: Evaluation, second: Evaluation) -> Evaluation {
 /// averaged, the ending the worst trial's), or with `aggregate = "worst"`
 /// the worst trial.
 pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
+    score_screened(make, &|_| true)
+}
+
+/// [`score`], except that a robust scene's run at half the step is made
+/// only where `fine` says the run at the scene's step could matter: where
+/// it says not, that run's evaluation is the score. Evolution asks it of
+/// a candidate whose score at the step cannot enter the population or
+/// its cell (the robust score is never above it). A scene with `trials`
+/// and `noise` is always scored in full.
+pub fn score_screened(
+    make: impl Fn() -> Result<Scene, String>,
+    fine: &dyn Fn(&Evaluation) -> bool,
+) -> Result<Evaluation, String> {
     let first = make()?;
     let spec = first
         .evolve
@@ -593,7 +606,7 @@ pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, Str
             }
             None => build()?,
         })?;
-        if !spec.robust {
+        if !spec.robust || (!perturbed && !fine(&full)) {
             return Ok(full);
         }
         let mut fine = build()?;
@@ -826,6 +839,16 @@ impl SceneProblem {
     /// ([`EvolveSpec::robust`]), over its trials.
     pub fn evaluate(&self, genome: &[f64]) -> Result<Evaluation, String> {
         score(|| self.scene(genome))
+    }
+
+    /// [`SceneProblem::evaluate`], a robust scene's half-step run made only
+    /// where `fine` says ([`score_screened`]).
+    pub fn evaluate_screened(
+        &self,
+        genome: &[f64],
+        fine: &dyn Fn(&Evaluation) -> bool,
+    ) -> Result<Evaluation, String> {
+        score_screened(|| self.scene(genome), fine)
     }
 
     /// The scene's text with `genome` written into the `[evolve]`

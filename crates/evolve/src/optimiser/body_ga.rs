@@ -16,6 +16,7 @@
 //!   equals), the best `P` survive.
 
 use super::{check_told, sane, BestSoFar, Random};
+use crate::screen::Screen;
 use animats_scene::morphology::vary::RETRIES;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -194,6 +195,16 @@ impl BodyGa {
             )
         } else {
             vary(variation, rng, |v, r| v.mutate(parent, r), parent)
+        }
+    }
+
+    /// Which children need a robust scene's half-step run: once the
+    /// population is full, those above its worst (a child at or below it
+    /// cannot survive: parents win ties).
+    pub fn screen(&self) -> Screen {
+        match self.parents.last() {
+            Some(&(_, bar)) if self.parents.len() == self.size => Screen::Above { bar },
+            _ => Screen::All,
         }
     }
 

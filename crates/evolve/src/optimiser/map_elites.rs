@@ -5,7 +5,8 @@
 //! each emitter is told its own slice.
 //!
 //! - `map-elites` (Mouret & Clune 2015): emitters that vary elites drawn
-//!   uniformly from the archive: `gaussian` (pyribs's `GaussianEmitter`:
+//!   uniformly from the archive (or each the best of `[archive]
+//!   tournament` drawn so): `gaussian` (pyribs's `GaussianEmitter`:
 //!   elite + σ·N(0, I)) or `iso-line` (`IsoLineEmitter`, Vassiliades &
 //!   Mouret 2018: elite + σ_iso·N(0, I) + σ_line·N(0, 1)·(other − elite)).
 //!   While the archive is empty they vary the starting genome. For a
@@ -303,7 +304,7 @@ impl Qd {
             vec![self.x0.clone(); n]
         } else {
             self.archive
-                .sample(n, rng)
+                .parents(n, rng)
                 .into_iter()
                 .map(|e| self.point(&e.genome))
                 .collect()
@@ -332,9 +333,9 @@ impl Qd {
                         None => body_ga::random_body(v, &mut rng),
                     };
                 }
-                let parent: &[f64] = &archive.sample(1, &mut rng)[0].genome;
+                let parent: &[f64] = &archive.parents(1, &mut rng)[0].genome;
                 if rng.uniform() < CROSSOVER {
-                    let other: &[f64] = &archive.sample(1, &mut rng)[0].genome;
+                    let other: &[f64] = &archive.parents(1, &mut rng)[0].genome;
                     body_ga::vary(
                         v,
                         &mut rng,

@@ -16,6 +16,7 @@ pub mod ga;
 pub mod hill_climber;
 pub mod map_elites;
 
+use crate::screen::Screen;
 use animats_engine::math;
 use body_ga::{BodyGa, Variation};
 use cma_es::CmaEs;
@@ -341,6 +342,18 @@ impl AnyOptimiser {
             AnyOptimiser::Ga(o) => Some(o),
             AnyOptimiser::CmaEs(o) => Some(o.as_ref()),
             AnyOptimiser::BodyGa(_) | AnyOptimiser::Qd(_) => None,
+        }
+    }
+
+    /// Which candidates of the generation just asked need a robust
+    /// scene's half-step run ([`Screen`]): above the worst survivor (body
+    /// GA), above their cell's threshold (MAP-Elites), all (any other: they
+    /// rank every candidate).
+    pub fn screen(&self) -> Screen {
+        match self {
+            AnyOptimiser::BodyGa(o) => o.screen(),
+            AnyOptimiser::Qd(o) if o.kind() == QdKind::MapElites => Screen::cells(&o.archive),
+            _ => Screen::All,
         }
     }
 

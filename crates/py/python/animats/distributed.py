@@ -44,12 +44,13 @@ class _Worker:
     def pid(self) -> int:
         return os.getpid()
 
-    def outcomes(self, genomes: np.ndarray) -> dict:
+    def outcomes(self, genomes: np.ndarray, screens: Optional[List[str]] = None) -> dict:
         start = time.perf_counter()
         if isinstance(genomes, list):
-            out = self.evaluator.outcomes([np.ascontiguousarray(g, dtype=np.float64) for g in genomes])
+            g = [np.ascontiguousarray(x, dtype=np.float64) for x in genomes]
         else:
-            out = self.evaluator.outcomes(np.ascontiguousarray(genomes, dtype=np.float64))
+            g = np.ascontiguousarray(genomes, dtype=np.float64)
+        out = self.evaluator.outcomes(g, screens=screens)
         out["seconds"] = time.perf_counter() - start
         return out
 
@@ -123,10 +124,14 @@ class Pool:
         self._next = 0
 
     def outcomes(
-        self, genomes: np.ndarray, on_dispatch: Optional[Callable[["Pool"], None]] = None
+        self,
+        genomes: np.ndarray,
+        on_dispatch: Optional[Callable[["Pool"], None]] = None,
+        screens: Optional[List[str]] = None,
     ) -> dict:
         """Outcomes of each row of ``genomes`` (``Evaluator.outcomes``'s
-        dict). The rows are cut into ``chunks`` shares per actor, handed out
+        dict); ``screens``, one per row, as ``Evolution.screens()`` gives
+        them. The rows are cut into ``chunks`` shares per actor, handed out
         as actors finish (evaluations differ in length: a fixed split would
         wait for the unluckiest actor), and merged in row order.
         ``on_dispatch`` is called once the first shares are sent (tests kill
@@ -152,7 +157,8 @@ class Pool:
         def send(actor: int) -> None:
             i = queue.pop(0)
             share = [g[k] for k in shares[i]] if isinstance(g, list) else g[shares[i]]
-            pending[self.actors[actor].outcomes.remote(share)] = (i, actor)
+            screen = None if screens is None else [screens[k] for k in shares[i]]
+            pending[self.actors[actor].outcomes.remote(share, screen)] = (i, actor)
 
         for a in range(len(self.actors)):
             if queue:
@@ -254,7 +260,7 @@ def evolve(
             g = run.generation + 1
             genomes, _ = run.ask()
             hook = None if on_generation is None else (lambda p, g=g: on_generation(g, p))
-            run.tell(pool.outcomes(genomes, on_dispatch=hook))
+            run.tell(pool.outcomes(genomes, on_dispatch=hook, screens=run.screens()))
             pool.stats.generations += 1
             if progress and time.monotonic() - last > 5:
                 last = time.monotonic()

@@ -184,9 +184,20 @@ impl MorphologyProblem {
     /// Evaluates the body of `genes` (a body the checks would refuse is
     /// still evaluated: the checks are the optimiser's business).
     pub fn evaluate(&self, genes: &[f64]) -> Result<Evaluation, String> {
+        self.evaluate_screened(genes, &|_| true)
+    }
+
+    /// [`MorphologyProblem::evaluate`], the half-step run of a robust
+    /// evaluation made only where `fine` says
+    /// ([`crate::evaluate::score_screened`]).
+    pub fn evaluate_screened(
+        &self,
+        genes: &[f64],
+        fine: &dyn Fn(&Evaluation) -> bool,
+    ) -> Result<Evaluation, String> {
         let text = self.develop(genes, "")?;
         let problem = SceneProblem::parse(&text, &self.file).map_err(|e| e.to_string())?;
-        problem.evaluate(problem.start())
+        problem.evaluate_screened(problem.start(), fine)
     }
 
     /// Every check of [`super::check`], the settle last.
