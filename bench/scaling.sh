@@ -23,7 +23,7 @@ rows=(
   "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
   "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
   "quadruped3|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1"
-  "bodies_walk|scenes/bodies_walk.toml --lanes 16 --generations 2 --seed 1"
+  "bodies_walk|scenes/bodies_walk.toml --optimiser body-ga --lanes 16 --generations 2 --seed 1"
 )
 header="| run |"; rule="|---|"
 for t in $THREADS; do header+=" $t |"; rule+="---|"; done

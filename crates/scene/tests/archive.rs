@@ -243,10 +243,10 @@ fn bad_archives_are_refused_naming_the_field() {
 fn bodies_of_a_map_are_checked_and_measured_as_bodies() {
     use animats_creatures::random::Random;
     use animats_scene::morphology::MorphologyProblem;
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/bodies_map.toml");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/bodies_walk.toml");
     let text = std::fs::read_to_string(path).unwrap();
     let bare = &text[..text.find("[archive]").unwrap()];
-    let map = MorphologyProblem::parse(&text, "bodies_map.toml").unwrap();
+    let map = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
     let plain = MorphologyProblem::parse(bare, "bodies_walk.toml").unwrap();
     assert!(map.grid().is_some() && plain.grid().is_none());
     let mut passed = 0;
