@@ -14,11 +14,13 @@
 //!   the same as with every child scored in full: the same survivors, the
 //!   same best and `best.toml`. Only the log's `fitness` of a generation
 //!   whose best child did not survive may show its score at the step.
-//! - MAP-Elites: a candidate enters only above its cell's threshold; the
-//!   cell is taken from the run at the step's measures (a body's measures
-//!   barely move with the step: a screen, not a proof, for measures the
-//!   run computes; exact for measures of the body as built).
-//! - Every other optimiser ranks every candidate: [`Screen::All`].
+//! - MAP-Elites over bodies: a candidate enters only above its cell's
+//!   threshold; the cell is taken from the run at the step's measures (a
+//!   body's measures barely move with the step: a screen, not a proof,
+//!   for measures the run computes; exact for measures of the body as
+//!   built).
+//! - Every other optimiser ranks every candidate, and MAP-Elites over a
+//!   fixed genome is pyribs's search: [`Screen::All`].
 //!
 //! The screen is part of a generation (see [`crate::run::Generation`]),
 //! so evaluations elsewhere (Python, Ray) apply the same one and write the

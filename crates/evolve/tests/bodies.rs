@@ -221,6 +221,23 @@ impl Problem for Full {
     }
 }
 
+/// A run of `config` to its end on 2 threads, every candidate scored in
+/// full if `full`, else as the optimiser's screens say.
+fn run_to_end(config: Config, full: bool) -> State {
+    let generations = config.generations;
+    let mut s = State::new(config).unwrap();
+    let problem = s.config.problem.build().unwrap();
+    let problem: Box<dyn Problem> = if full {
+        Box::new(Full(problem))
+    } else {
+        problem
+    };
+    pool(2)
+        .install(|| s.advance_with(problem.as_ref(), generations))
+        .unwrap();
+    s
+}
+
 /// Robust evaluation (the default for bodies: at the step and at half of
 /// it, the worse counting) skips the half-step run of a child that cannot
 /// survive, since the robust score is never above the score at the step:
@@ -230,19 +247,7 @@ impl Problem for Full {
 /// its robust score).
 #[test]
 fn screened_robust_evaluation_keeps_every_survivor_and_the_best() {
-    let run = |full: bool, generations: u64| {
-        let mut s = State::new(config(GRAPH, generations)).unwrap();
-        let problem = s.config.problem.build().unwrap();
-        let problem: Box<dyn Problem> = if full {
-            Box::new(Full(problem))
-        } else {
-            problem
-        };
-        pool(2)
-            .install(|| s.advance_with(problem.as_ref(), generations))
-            .unwrap();
-        s
-    };
+    let run = |full: bool, generations: u64| run_to_end(config(GRAPH, generations), full);
     let screened = run(false, 10);
     let full = run(true, 10);
     assert_eq!(screened.lanes[0].optimiser, full.lanes[0].optimiser);
@@ -308,17 +313,7 @@ fn screened_map_elites_over_build_measures_fills_the_same_archive() {
             optimiser: Some(animats_evolve::OptimiserKind::MapElites),
             ..Choices::default()
         };
-        let mut s = State::new(Config::new(spec, &choices).unwrap()).unwrap();
-        let problem = s.config.problem.build().unwrap();
-        let problem: Box<dyn Problem> = if full {
-            Box::new(Full(problem))
-        } else {
-            problem
-        };
-        pool(2)
-            .install(|| s.advance_with(problem.as_ref(), 8))
-            .unwrap();
-        s
+        run_to_end(Config::new(spec, &choices).unwrap(), full)
     };
     let (screened, full) = (run(false), run(true));
     let (a, b) = (screened.archive().unwrap(), full.archive().unwrap());

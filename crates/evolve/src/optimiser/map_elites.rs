@@ -200,6 +200,13 @@ impl Qd {
         self.kind
     }
 
+    /// True when its emitters vary bodies (a `[morphology]` scene's).
+    pub fn varies_bodies(&self) -> bool {
+        self.emitters
+            .iter()
+            .any(|e| matches!(e, Emitter::Body { .. }))
+    }
+
     /// A search-space point as a genome.
     fn genome(&self, x: &[f64]) -> Vec<f64> {
         match &self.bounds {

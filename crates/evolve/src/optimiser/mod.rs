@@ -347,12 +347,15 @@ impl AnyOptimiser {
 
     /// Which candidates of the generation just asked need a robust
     /// scene's half-step run ([`Screen`]): above the worst survivor (body
-    /// GA), above their cell's threshold (MAP-Elites), all (any other: they
-    /// rank every candidate).
+    /// GA), above their cell's threshold (MAP-Elites over bodies), all (any
+    /// other: they rank every candidate, or, MAP-Elites over a fixed
+    /// genome, are pyribs's search).
     pub fn screen(&self) -> Screen {
         match self {
             AnyOptimiser::BodyGa(o) => o.screen(),
-            AnyOptimiser::Qd(o) if o.kind() == QdKind::MapElites => Screen::cells(&o.archive),
+            AnyOptimiser::Qd(o) if o.kind() == QdKind::MapElites && o.varies_bodies() => {
+                Screen::cells(&o.archive)
+            }
             _ => Screen::All,
         }
     }
