@@ -89,6 +89,12 @@ pub trait Force: Send + CloneForce {
     fn name(&self) -> &str {
         "force"
     }
+
+    /// The force as [`std::any::Any`], for a built-in force a second
+    /// implementation reads (the GPU step's packer); `None` by default.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }
 
 /// The particles a force or event acts on: the thesis makes every association

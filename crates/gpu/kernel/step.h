@@ -14,8 +14,8 @@
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
- * constant forces, still fluids on every particle, the flat floor (its located collisions with
- * backtracking, and its contact force), and the explicit integrators
+ * constant forces, still fluids on every particle, soft (penalty) contact between spheres, the
+ * flat floor (its located collisions with backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
  */
@@ -91,6 +91,11 @@ typedef struct {
     int floor_contact; /* 1: and its contact force (reaction, friction) */
     double envelope, rest_speed, static_speed, contact_tolerance;
     double flight_shift; /* IntegratorKind::free_flight_shift */
+    const long long *first_pair; /* per creature: its soft contact's pairs */
+    const int *pair_a;
+    const int *pair_b;
+    const double *pair_stiffness;
+    const double *pair_damping;
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */
@@ -197,6 +202,38 @@ AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0,
     }
 }
 
+/* Soft (penalty) contact between the pairs q0 .. q0 + nq - 1 of spheres
+ * (forces/soft_contact.rs, `pair`): F = k overlap - c u_n along the line of
+ * centres, never pulling; the engine's sweep tests only pairs whose boxes
+ * overlap, with the same forces as testing all, as here. */
+AN_FN void an_soft_contact(const an_batch *b, long long p0, long long q0, long long nq,
+                           const double *x, const double *v, double *f) {
+    for (long long q = q0; q < q0 + nq; q++) {
+        long long a = b->pair_a[q], e = b->pair_b[q];
+        double d[3], u[3], n[3];
+        for (int k = 0; k < 3; k++) {
+            d[k] = x[3 * e + k] - x[3 * a + k];
+        }
+        double dist = sqrt(an_dot(d, d));
+        double overlap = b->radius[p0 + a] + b->radius[p0 + e] - dist;
+        if (overlap <= 0.0 || dist <= 0.0) {
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            n[k] = d[k] / dist;
+            u[k] = v[3 * e + k] - v[3 * a + k];
+        }
+        double separating = an_dot(u, n);
+        double push = b->pair_stiffness[q] * overlap - b->pair_damping[q] * separating;
+        push = push > 0.0 ? push : 0.0; /* f64::max(push, 0.0): NaN gives 0 */
+        for (int k = 0; k < 3; k++) {
+            double fk = n[k] * push;
+            f[3 * a + k] -= fk;
+            f[3 * e + k] += fk;
+        }
+    }
+}
+
 /* The flat floor's contact force on particle i (forces/floor_contact.rs,
  * `contact` and `friction`): a sphere resting on the plane and pressed
  * into it is held up, and rubs. h is the trial's step. */
@@ -248,8 +285,8 @@ AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, con
 
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints, constant forces, fluids, the floor's contact
- * force. h: the step
+ * joints, torque joints, constant forces, fluids, soft contact (a user
+ * force of the body stage), the floor's contact force. h: the step
  * of the trial. */
 AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, long long s0,
                      long long ns, const double *x, const double *v, double *f, double h) {
@@ -297,6 +334,8 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
     }
     long long q0 = b->first_fluid[c];
     an_fluids(b, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
+    long long c0 = b->first_pair[c];
+    an_soft_contact(b, p0, c0, b->first_pair[c + 1] - c0, x, v, f);
     if (b->floor && b->floor_contact) {
         for (long long i = 0; i < n; i++) {
             an_floor_contact(b, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);

@@ -2,7 +2,7 @@
 //! each creature's particles and springs a contiguous run found through
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
-use animats_engine::{DVec3, FloorCollision, IntegratorKind, World};
+use animats_engine::{DVec3, FloorCollision, IntegratorKind, SoftContact, World};
 use std::os::raw::{c_double, c_int, c_longlong};
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
@@ -59,6 +59,11 @@ pub(crate) struct Raw {
     static_speed: c_double,
     contact_tolerance: c_double,
     flight_shift: c_double,
+    first_pair: *const c_longlong,
+    pair_a: *const c_int,
+    pair_b: *const c_int,
+    pair_stiffness: *const c_double,
+    pair_damping: *const c_double,
 }
 
 extern "C" {
@@ -136,6 +141,11 @@ pub struct Batch {
     gravity: bool,
     integrator: IntegratorKind,
     dt: f64,
+    first_pair: Vec<i64>,
+    pair_a: Vec<i32>,
+    pair_b: Vec<i32>,
+    pair_stiffness: Vec<f64>,
+    pair_damping: Vec<f64>,
 }
 
 impl Batch {
@@ -143,8 +153,8 @@ impl Batch {
     /// world must share the first one's gravity, floor and integrator, and
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
-    /// torques, constant forces, still fluids about every particle, the flat floor under
-    /// every particle): anything else is refused with a message naming the
+    /// torques, constant forces, still fluids about every particle, soft
+    /// contact, the flat floor under every particle): anything else is refused with a message naming the
     /// world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
@@ -203,6 +213,11 @@ impl Batch {
             gravity,
             integrator,
             dt,
+            first_pair: vec![0],
+            pair_a: Vec::new(),
+            pair_b: Vec::new(),
+            pair_stiffness: Vec::new(),
+            pair_damping: Vec::new(),
         };
         for (k, w) in worlds.iter().enumerate() {
             supported(w).map_err(|what| format!("world {k}: {what}"))?;
@@ -273,6 +288,18 @@ impl Batch {
                     .push(-0.5 * fl.drag_coefficient * fl.density * std::f64::consts::PI);
                 b.fluid_density.push(fl.density);
             }
+            for sc in w
+                .forces()
+                .user()
+                .filter_map(|u| u.as_any()?.downcast_ref::<SoftContact>())
+            {
+                for &(a, e) in sc.pair_list() {
+                    b.pair_a.push(a as i32);
+                    b.pair_b.push(e as i32);
+                    b.pair_stiffness.push(sc.stiffness);
+                    b.pair_damping.push(sc.damping);
+                }
+            }
             b.radius.extend_from_slice(&props.radius);
             b.volume.extend_from_slice(&props.volume);
             b.restitution.extend_from_slice(&props.restitution);
@@ -284,6 +311,7 @@ impl Batch {
             b.first_motor.push(b.motor_end.len() as i64);
             b.first_fluid.push(b.fluid_drag.len() as i64);
             b.first_push.push(b.push_particle.len() as i64);
+            b.first_pair.push(b.pair_a.len() as i64);
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         Ok(b)
@@ -394,6 +422,11 @@ impl Batch {
             Array::FirstPush => I64(&self.first_push),
             Array::PushParticle => I32(&self.push_particle),
             Array::PushForce => F64(&self.push_force),
+            Array::FirstPair => I64(&self.first_pair),
+            Array::PairA => I32(&self.pair_a),
+            Array::PairB => I32(&self.pair_b),
+            Array::PairStiffness => F64(&self.pair_stiffness),
+            Array::PairDamping => F64(&self.pair_damping),
         }
     }
 
@@ -482,6 +515,11 @@ impl Batch {
             static_speed: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.0),
             contact_tolerance: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.1),
             flight_shift: self.integrator.free_flight_shift(),
+            first_pair: l(Array::FirstPair),
+            pair_a: i(Array::PairA),
+            pair_b: i(Array::PairB),
+            pair_stiffness: c(Array::PairStiffness),
+            pair_damping: c(Array::PairDamping),
         }
     }
 }
@@ -518,8 +556,13 @@ fn supported(w: &World) -> Result<(), String> {
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");
     }
-    if let Some(u) = f.user().next() {
-        return refuse(&format!("the user force `{}`", u.name()));
+    // Soft contact is the one user force the C steps (a body-stage force,
+    // after the fluids, as the engine orders it).
+    for u in f.user() {
+        let soft = u.as_any().is_some_and(|a| a.is::<SoftContact>());
+        if !soft || u.stage() != animats_engine::Stage::Body {
+            return refuse(&format!("the user force `{}`", u.name()));
+        }
     }
     Ok(())
 }
@@ -570,11 +613,16 @@ pub(crate) enum Array {
     FirstPush,
     PushParticle,
     PushForce,
+    FirstPair,
+    PairA,
+    PairB,
+    PairStiffness,
+    PairDamping,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 36] = [
+    pub(crate) const ALL: [Array; 41] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -611,6 +659,11 @@ impl Array {
         Array::FirstPush,
         Array::PushParticle,
         Array::PushForce,
+        Array::FirstPair,
+        Array::PairA,
+        Array::PairB,
+        Array::PairStiffness,
+        Array::PairDamping,
     ];
 }
 

@@ -4,7 +4,8 @@
 //! on batches of random bodies of mixed sizes (2 to 40 particles: both of
 //! the engine's paths, below and above its 16-particle "small world"
 //! loop) of springs, angle joints and torque joints, with and without
-//! gravity, in water and air or not.
+//! gravity, in water and air or not, on the floor, pushed, and touching
+//! each other through soft contact.
 
 use animats_engine::{DVec3, FloorDef, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
 use animats_gpu::Batch;
@@ -170,6 +171,64 @@ fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Bodies whose spheres collide with each other through soft (penalty)
+/// contact, every pair but those a spring joins, as an evolved body's
+/// `[contacts] model = "penalty"` builds it, dropped onto the floor: the
+/// C's contact forces are the engine's, pair by pair in its order.
+#[test]
+fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
+    let mut rng = Random::for_entry(17, 0);
+    for kind in INTEGRATORS {
+        let make = |rng: &mut Random, contact: bool| -> Vec<World> {
+            (0..16)
+                .map(|k| {
+                    // Up to 40 spheres: the engine sweeps from 32 on.
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
+                    let mut w = random_body(rng, n, true, k % 2 == 0, kind).unwrap();
+                    w.add_floor(FloorDef::default()).unwrap();
+                    if contact {
+                        let ids: Vec<_> = w.particle_ids().collect();
+                        let soft =
+                            animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs())
+                                .unwrap();
+                        w.add_force(Box::new(soft));
+                    }
+                    w
+                })
+                .collect()
+        };
+        let mut again = rng.clone();
+        let mut worlds = make(&mut rng, true);
+        let mut plain = make(&mut again, false);
+        // The contacts matter: without them the bodies end elsewhere.
+        let before: Vec<usize> = worlds.iter().map(World::len).collect();
+        assert_same(
+            &mut worlds,
+            5e-4,
+            400,
+            3,
+            &format!("touching bodies {before:?}, {kind:?}"),
+        );
+        for w in &mut plain {
+            for _ in 0..1200 {
+                if w.step(5e-4).is_err() {
+                    break;
+                }
+            }
+        }
+        let moved = worlds
+            .iter()
+            .zip(&plain)
+            .filter(|(a, b)| a.state().pos != b.state().pos)
+            .count();
+        eprintln!("{kind:?}: {moved} of 16 bodies end elsewhere without their contacts");
+        assert!(
+            moved >= 8,
+            "{kind:?}: the contacts changed only {moved} bodies"
+        );
+    }
+}
+
 #[test]
 fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let plain = || {
@@ -211,6 +270,23 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         .unwrap();
     let err = Batch::pack(&[&pulled], 1e-3).unwrap_err();
     assert_eq!(err, "world 0: n-body gravity is not in the GPU step yet");
+
+    /// A force of the user's own: the C cannot know it.
+    #[derive(Clone)]
+    struct Breeze;
+    impl animats_engine::Force for Breeze {
+        fn apply(&mut self, _: &animats_engine::ForceContext, _: &mut [DVec3]) {}
+        fn name(&self) -> &str {
+            "breeze"
+        }
+    }
+    let mut breezy = plain();
+    breezy.add_force(Box::new(Breeze));
+    let err = Batch::pack(&[&breezy], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: the user force `breeze` is not in the GPU step yet"
+    );
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);

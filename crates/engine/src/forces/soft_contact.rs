@@ -135,6 +135,12 @@ impl SoftContact {
         self.pairs.len()
     }
 
+    /// Those pairs as particle indices, in the order their forces are
+    /// added.
+    pub fn pair_list(&self) -> &[(u32, u32)] {
+        &self.pairs
+    }
+
     /// The same contact testing every pair every step, however many
     /// spheres (the sweep's reference: the forces are the same to the bit).
     pub fn every_pair(mut self) -> SoftContact {
@@ -258,5 +264,9 @@ impl Force for SoftContact {
 
     fn name(&self) -> &str {
         "soft contact"
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 }
