@@ -559,10 +559,17 @@ fn zoo(args: &Args) -> Result<(), Failure> {
                 None => spread(archive, count),
             };
             let problem = state.config.problem.build().map_err(Failure::Input)?;
-            let lanes = picked
+            let picked = picked
                 .into_iter()
-                .map(|e| vec![(e.genome.clone(), e.objective, e.index as usize)])
-                .collect();
+                .map(|e| (e.genome.clone(), e.objective, e.index as usize));
+            // One map: its elites side by side, best first. Several runs:
+            // each run's picks as one lineage, so every run's best comes
+            // before any run's second.
+            let lanes = if dirs.len() == 1 {
+                picked.map(|e| vec![e]).collect()
+            } else {
+                vec![picked.collect()]
+            };
             runs.push((dir, problem, lanes));
             cells = true;
             continue;

@@ -684,7 +684,7 @@ impl State {
             return Ok(None);
         };
         let problem = self.config.problem.build()?;
-        let what = if self.config.optimiser == OptimiserKind::BodyGa {
+        let what = if problem.variation().is_some() {
             "body and brain"
         } else {
             "controller"

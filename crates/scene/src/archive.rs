@@ -227,7 +227,6 @@ fn one() -> usize {
 
 /// −∞ written as `null` (JSON has no infinities): `#[serde(with = ...)]`.
 pub mod minus_infinity_as_null {
-    //! −∞ as `null` for serde.
     use serde::{Deserialize, Deserializer, Serializer};
 
     /// Writes `x`, −∞ (or any non-finite value) as `null`.
