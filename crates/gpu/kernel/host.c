@@ -8,6 +8,7 @@ double animats_atan(double x) { return an_atan(x); }
 double animats_atan2(double y, double x) { return an_atan2(y, x); }
 
 #include "trig.h"
+#include "eval.h"
 
 double animats_sin(double x) { return an_sin(x); }
 double animats_cos(double x) { return an_cos(x); }
@@ -17,5 +18,12 @@ double animats_cos(double x) { return an_cos(x); }
 void animats_step_range(const an_batch *b, long long first, long long last, long long steps) {
     for (long long c = first; c < last; c++) {
         an_step_creature(b, c, steps);
+    }
+}
+
+/* Creatures first .. last - 1 of a batch evaluated whole (eval.h). */
+void animats_evaluate_range(const an_batch *b, long long first, long long last) {
+    for (long long c = first; c < last; c++) {
+        an_evaluate_creature(b, c);
     }
 }

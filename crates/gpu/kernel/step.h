@@ -56,7 +56,7 @@ typedef struct {
     const int *spring_b;
     const double *stiffness;
     const double *damping;
-    const double *rest_length;
+    double *rest_length; /* muscles move it (eval.h) */
     double *scratch;
     const long long *first_joint;
     const int *joint_a;
@@ -96,6 +96,30 @@ typedef struct {
     const int *pair_b;
     const double *pair_stiffness;
     const double *pair_damping;
+    /* A scene's evaluation (eval.h): its spring muscles, its oscillators
+     * and its [evolve] rules. */
+    const long long *first_muscle; /* per creature: its spring muscles */
+    const int *muscle_spring;      /* the spring, within the creature */
+    const double *muscle_param;    /* 3 per muscle: min, max, rate (< 0: none) */
+    double *muscle_level;
+    const long long *first_osc;    /* per creature: its oscillators */
+    const double *osc_frequency;
+    const long long *first_output; /* per oscillator, over the batch: its outputs */
+    const int *output_muscle;      /* the muscle driven, within the creature */
+    const double *output_gene;     /* 4 per output: amplitude, phase, offset, shift (NaN: none) */
+    const long long *first_centre; /* per creature: the particles whose centre counts */
+    const int *centre_particle;
+    const long long *first_touch;  /* per creature: fail_on_touch */
+    const int *touch_particle;
+    const long long *first_stretch; /* per creature: fail_on_stretch */
+    const int *stretch_pair;        /* 2 per rule */
+    const double *stretch_length;
+    const int *fixed;              /* per particle: 1 where fixed (the guard skips it) */
+    const double *eval_param;      /* 8 per creature: axis x, y, z, time and distance
+                                      weights, touch tolerance, clock and its carry */
+    const long long *eval_count;   /* 2 per creature: steps to run, steps taken before */
+    double *result;                /* 3 per creature: fitness, distance, time */
+    long long *ended;              /* 2 per creature: why (AN_TIMEOUT ...) and which rule */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */
@@ -344,7 +368,7 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
 }
 
 /* One integrator step of size h from (x0, v0) into (x1, v1)
- * (integrators/*.rs); f, dx, dv: scratch. */
+ * (the files of integrators/); f, dx, dv: scratch. */
 AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long n, long long s0,
                         long long ns, double h, const double *x0, const double *v0, double *x1,
                         double *v1, double *f, double *dx, double *dv) {
@@ -481,13 +505,12 @@ AN_FN int an_finite(const double *x, long long m3) {
     return 1;
 }
 
-/* `steps` steps of creature c (world/step.rs: a trial of the whole step;
+/* One step of creature c (world/step.rs: a trial of the whole step;
  * after a missed collision, the step again in pieces, halved while one is
  * missed down to 1/1024 of the step, and grown back once they line up).
- * A non-finite state stops the creature at its last finite state, as the
- * engine's step refuses it; `failed[c]` records the step (1-based, counted
- * over every run of the batch). */
-AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
+ * Returns 1; or 0 where the state would stop being finite, leaving it at
+ * its last finite state, as the engine's step refuses it. */
+AN_FN int an_step_once(const an_batch *b, long long c) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
     long long m3 = 3 * n;
@@ -496,44 +519,54 @@ AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
     double *f = sc, *x1 = sc + m3, *v1 = sc + 2 * m3, *dx = sc + 3 * m3, *dv = sc + 4 * m3;
     double dt = b->dt;
     const long long total = 1LL << 10; /* MAX_BACKTRACK_DEPTH */
+    long long done = 0, piece = total;
+    while (done < total) {
+        double h = piece == total ? dt : dt * ((double)piece / (double)total);
+        an_integrate(b, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
+        int state = b->floor ? an_floor_check(b, p0, n, x1) : AN_NONE;
+        if (state == AN_MISSED) {
+            if (piece == total) {
+                piece = total / 2; /* the step again, in pieces */
+                continue;
+            }
+            if (piece > 1) {
+                piece /= 2;
+                continue;
+            }
+            state = AN_OCCURRING; /* cannot split further */
+        }
+        if (state != AN_NONE) {
+            an_floor_handle(b, p0, n, h, dt, v, x1, v1);
+        }
+        if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
+            return 0;
+        }
+        for (long long k = 0; k < m3; k++) {
+            x[k] = x1[k];
+            v[k] = v1[k];
+        }
+        if (piece == total) {
+            break;
+        }
+        done += piece;
+        if (piece < total && done % (2 * piece) == 0) {
+            piece *= 2;
+        }
+    }
+    return 1;
+}
+
+/* `steps` steps of creature c. A non-finite state stops the creature at
+ * its last finite state; `failed[c]` records the step (1-based, counted
+ * over every run of the batch). */
+AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
     if (b->failed[c] != 0) {
         return;
     }
     for (long long step = 0; step < steps; step++) {
-        long long done = 0, piece = total;
-        while (done < total) {
-            double h = piece == total ? dt : dt * ((double)piece / (double)total);
-            an_integrate(b, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
-            int state = b->floor ? an_floor_check(b, p0, n, x1) : AN_NONE;
-            if (state == AN_MISSED) {
-                if (piece == total) {
-                    piece = total / 2; /* the step again, in pieces */
-                    continue;
-                }
-                if (piece > 1) {
-                    piece /= 2;
-                    continue;
-                }
-                state = AN_OCCURRING; /* cannot split further */
-            }
-            if (state != AN_NONE) {
-                an_floor_handle(b, p0, n, h, dt, v, x1, v1);
-            }
-            if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
-                b->failed[c] = b->steps_before + step + 1;
-                return;
-            }
-            for (long long k = 0; k < m3; k++) {
-                x[k] = x1[k];
-                v[k] = v1[k];
-            }
-            if (piece == total) {
-                break;
-            }
-            done += piece;
-            if (piece < total && done % (2 * piece) == 0) {
-                piece *= 2;
-            }
+        if (!an_step_once(b, c)) {
+            b->failed[c] = b->steps_before + step + 1;
+            return;
         }
     }
 }

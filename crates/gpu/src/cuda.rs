@@ -27,6 +27,7 @@ fn source() -> String {
         include_str!("../kernel/libm.h"),
         include_str!("../kernel/trig.h"),
         include_str!("../kernel/step.h"),
+        include_str!("../kernel/eval.h"),
         include_str!("../kernel/kernel.cu"),
     ]
     .iter()
@@ -39,6 +40,7 @@ fn source() -> String {
 pub struct Device {
     stream: Arc<CudaStream>,
     function: CudaFunction,
+    evaluate: CudaFunction,
     name: String,
     arch: (i32, i32),
 }
@@ -79,9 +81,13 @@ impl Device {
         let function = module
             .load_function("animats_step_kernel")
             .map_err(|e| format!("the step's entry: {e}"))?;
+        let evaluate = module
+            .load_function("animats_evaluate_kernel")
+            .map_err(|e| format!("the evaluation's entry: {e}"))?;
         Ok(Device {
             stream: ctx.default_stream(),
             function,
+            evaluate,
             name,
             arch,
         })
@@ -96,73 +102,121 @@ impl Device {
     /// thread each) and copies the positions and velocities back.
     pub fn run(&self, batch: &mut Batch, steps: u64) -> Result<(), String> {
         let s = &self.stream;
-        fn err(what: &'static str) -> impl Fn(cudarc::driver::DriverError) -> String {
-            move |e| format!("{what}: {e}")
-        }
-        // Every array on the device (an empty one as one element: no
-        // zero-size allocation).
-        let mut on_device = Vec::with_capacity(Array::ALL.len());
-        for a in Array::ALL {
-            let up = match batch.array(a) {
-                Slice::F64(v) => OnDevice::F64(
-                    s.clone_htod(if v.is_empty() { &[0.0][..] } else { v })
-                        .map_err(err("copying to the GPU"))?,
-                ),
-                Slice::I32(v) => OnDevice::I32(
-                    s.clone_htod(if v.is_empty() { &[0][..] } else { v })
-                        .map_err(err("copying to the GPU"))?,
-                ),
-                Slice::I64(v) => OnDevice::I64(
-                    s.clone_htod(if v.is_empty() { &[0][..] } else { v })
-                        .map_err(err("copying to the GPU"))?,
-                ),
-            };
-            on_device.push(up);
-        }
-        let addresses: Vec<u64> = on_device
-            .iter()
-            .map(|d| match d {
-                OnDevice::F64(x) => x.device_ptr(s).0,
-                OnDevice::I32(x) => x.device_ptr(s).0,
-                OnDevice::I64(x) => x.device_ptr(s).0,
-            })
-            .collect();
-        let raw = DeviceBatch(batch.raw_with(|a| addresses[a as usize]));
+        let (on_device, raw) = upload(s, batch)?;
         let creatures = batch.creatures() as i64;
         let steps = steps.min(i64::MAX as u64) as i64;
-        let threads = 128u32;
-        let blocks = (creatures as u64).div_ceil(threads as u64).max(1);
-        let config = LaunchConfig {
-            grid_dim: (
-                u32::try_from(blocks).map_err(|_| "too many creatures for one launch")?,
-                1,
-                1,
-            ),
-            block_dim: (threads, 1, 1),
-            shared_mem_bytes: 0,
-        };
         let mut launch = s.launch_builder(&self.function);
         launch.arg(&raw).arg(&creatures).arg(&steps);
         // SAFETY: the kernel reads and writes within the arrays just
         // uploaded, at the offsets `Batch::pack` checked; the arguments
         // match its signature (an_batch by value, two long longs).
-        unsafe { launch.launch(config) }.map_err(err("launching the step"))?;
-        let back = |a: Array| match &on_device[a as usize] {
-            OnDevice::F64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU")),
-            _ => Err("positions and velocities are doubles".to_string()),
-        };
-        let (pos, vel) = (back(Array::Pos)?, back(Array::Vel)?);
-        let failed: Vec<i64> = match &on_device[Array::Failed as usize] {
-            OnDevice::I64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU"))?,
-            _ => return Err("failures are 64-bit integers".into()),
-        };
+        unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the step"))?;
+        let pos = download_f64(s, &on_device, Array::Pos)?;
+        let vel = download_f64(s, &on_device, Array::Vel)?;
+        let failed = download_i64(s, &on_device, Array::Failed)?;
         batch.set_state(&pos, &vel, &failed);
         batch.ran(steps as u64);
         Ok(())
     }
+
+    /// Runs every scene's evaluation of a batch of scenes
+    /// ([`Batch::pack_scenes`]) on the GPU, one thread per scene: the
+    /// evaluations [`Batch::evaluate_cpu`] gives, to the bit. The batch's
+    /// states become the scenes' last ones.
+    pub fn evaluate(
+        &self,
+        batch: &mut Batch,
+    ) -> Result<Vec<animats_scene::evaluate::Evaluation>, String> {
+        batch.take_ready()?;
+        let s = &self.stream;
+        let (on_device, raw) = upload(s, batch)?;
+        let creatures = batch.creatures() as i64;
+        let mut launch = s.launch_builder(&self.evaluate);
+        launch.arg(&raw).arg(&creatures);
+        // SAFETY: as in `run`; the kernel takes an_batch by value and one
+        // long long.
+        unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the evaluation"))?;
+        let pos = download_f64(s, &on_device, Array::Pos)?;
+        let vel = download_f64(s, &on_device, Array::Vel)?;
+        let failed = download_i64(s, &on_device, Array::Failed)?;
+        batch.set_state(&pos, &vel, &failed);
+        let result = download_f64(s, &on_device, Array::Result)?;
+        let ended = download_i64(s, &on_device, Array::Ended)?;
+        batch.set_results(&result, &ended);
+        Ok(batch.evaluations())
+    }
 }
 
-/// One of a batch's arrays on the device.
+/// A driver error as a message saying what was being done.
+fn err(what: &'static str) -> impl Fn(cudarc::driver::DriverError) -> String {
+    move |e| format!("{what}: {e}")
+}
+
+/// Every array of `batch` copied to the device (an empty one as one
+/// element: no zero-size allocation), and the kernel's struct pointing at
+/// the copies.
+fn upload(s: &Arc<CudaStream>, batch: &Batch) -> Result<(Vec<OnDevice>, DeviceBatch), String> {
+    let mut on_device = Vec::with_capacity(Array::ALL.len());
+    for a in Array::ALL {
+        let up = match batch.array(a) {
+            Slice::F64(v) => OnDevice::F64(
+                s.clone_htod(if v.is_empty() { &[0.0][..] } else { v })
+                    .map_err(err("copying to the GPU"))?,
+            ),
+            Slice::I32(v) => OnDevice::I32(
+                s.clone_htod(if v.is_empty() { &[0][..] } else { v })
+                    .map_err(err("copying to the GPU"))?,
+            ),
+            Slice::I64(v) => OnDevice::I64(
+                s.clone_htod(if v.is_empty() { &[0][..] } else { v })
+                    .map_err(err("copying to the GPU"))?,
+            ),
+        };
+        on_device.push(up);
+    }
+    let addresses: Vec<u64> = on_device
+        .iter()
+        .map(|d| match d {
+            OnDevice::F64(x) => x.device_ptr(s).0,
+            OnDevice::I32(x) => x.device_ptr(s).0,
+            OnDevice::I64(x) => x.device_ptr(s).0,
+        })
+        .collect();
+    let raw = DeviceBatch(batch.raw_with(|a| addresses[a as usize]));
+    Ok((on_device, raw))
+}
+
+/// One thread per creature, in blocks of 128.
+fn config(creatures: i64) -> Result<LaunchConfig, String> {
+    let threads = 128u32;
+    let blocks = (creatures.max(0) as u64).div_ceil(threads as u64).max(1);
+    Ok(LaunchConfig {
+        grid_dim: (
+            u32::try_from(blocks).map_err(|_| "too many creatures for one launch")?,
+            1,
+            1,
+        ),
+        block_dim: (threads, 1, 1),
+        shared_mem_bytes: 0,
+    })
+}
+
+/// Array `a` (of doubles) copied back from the device.
+fn download_f64(s: &Arc<CudaStream>, on: &[OnDevice], a: Array) -> Result<Vec<f64>, String> {
+    match &on[a as usize] {
+        OnDevice::F64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU")),
+        _ => Err(format!("{a:?} is not an array of doubles")),
+    }
+}
+
+/// Array `a` (of 64-bit integers) copied back from the device.
+fn download_i64(s: &Arc<CudaStream>, on: &[OnDevice], a: Array) -> Result<Vec<i64>, String> {
+    match &on[a as usize] {
+        OnDevice::I64(x) => s.clone_dtoh(x).map_err(err("copying from the GPU")),
+        _ => Err(format!("{a:?} is not an array of 64-bit integers")),
+    }
+}
+
 enum OnDevice {
     F64(CudaSlice<f64>),
     I32(CudaSlice<i32>),
@@ -229,6 +283,8 @@ mod tests {
             "an_atan2",
             "an_sin",
             "an_step_creature",
+            "an_evaluate_creature",
+            "animats_evaluate_kernel",
             "animats_step_kernel",
         ] {
             assert!(s.contains(needle), "{needle}");

@@ -31,6 +31,7 @@ pub mod bodies;
 pub mod cuda;
 mod pack;
 pub mod ported;
+mod scenes;
 
 pub use cuda::Device;
 pub use pack::Batch;

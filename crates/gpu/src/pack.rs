@@ -19,7 +19,7 @@ pub(crate) struct Raw {
     spring_b: *const c_int,
     stiffness: *const c_double,
     damping: *const c_double,
-    rest_length: *const c_double,
+    rest_length: *mut c_double,
     scratch: *mut c_double,
     first_joint: *const c_longlong,
     joint_a: *const c_int,
@@ -64,6 +64,27 @@ pub(crate) struct Raw {
     pair_b: *const c_int,
     pair_stiffness: *const c_double,
     pair_damping: *const c_double,
+    first_muscle: *const c_longlong,
+    muscle_spring: *const c_int,
+    muscle_param: *const c_double,
+    muscle_level: *mut c_double,
+    first_osc: *const c_longlong,
+    osc_frequency: *const c_double,
+    first_output: *const c_longlong,
+    output_muscle: *const c_int,
+    output_gene: *const c_double,
+    first_centre: *const c_longlong,
+    centre_particle: *const c_int,
+    first_touch: *const c_longlong,
+    touch_particle: *const c_int,
+    first_stretch: *const c_longlong,
+    stretch_pair: *const c_int,
+    stretch_length: *const c_double,
+    fixed: *const c_int,
+    eval_param: *const c_double,
+    eval_count: *const c_longlong,
+    result: *mut c_double,
+    ended: *mut c_longlong,
 }
 
 extern "C" {
@@ -76,10 +97,10 @@ extern "C" {
 }
 
 /// Creatures a thread of [`Batch::run_cpu`] takes at a time.
-const CHUNK: usize = 64;
+pub(crate) const CHUNK: usize = 64;
 
 /// The C's struct shared by the threads of [`Batch::run_cpu`].
-struct Shared(Raw);
+pub(crate) struct Shared(pub(crate) Raw);
 
 // SAFETY: the threads read the shared arrays and write only the positions,
 // velocities and scratch of their own creatures: disjoint ranges.
@@ -87,7 +108,7 @@ unsafe impl Sync for Shared {}
 
 impl Shared {
     /// (A method, so that closures capture the whole, which is `Sync`.)
-    fn get(&self) -> *const Raw {
+    pub(crate) fn get(&self) -> *const Raw {
         &self.0
     }
 }
@@ -146,6 +167,8 @@ pub struct Batch {
     pair_b: Vec<i32>,
     pair_stiffness: Vec<f64>,
     pair_damping: Vec<f64>,
+    /// A scene's evaluation: its muscles, oscillators and rules.
+    pub(crate) ev: crate::scenes::Rules,
 }
 
 impl Batch {
@@ -218,6 +241,7 @@ impl Batch {
             pair_b: Vec::new(),
             pair_stiffness: Vec::new(),
             pair_damping: Vec::new(),
+            ev: crate::scenes::Rules::default(),
         };
         for (k, w) in worlds.iter().enumerate() {
             supported(w).map_err(|what| format!("world {k}: {what}"))?;
@@ -312,8 +336,10 @@ impl Batch {
             b.first_fluid.push(b.fluid_drag.len() as i64);
             b.first_push.push(b.push_particle.len() as i64);
             b.first_pair.push(b.pair_a.len() as i64);
+            b.ev.fixed.extend(props.fixed.iter().map(|&f| i32::from(f)));
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
+        b.ev.no_rules(worlds.len());
         Ok(b)
     }
 
@@ -362,7 +388,7 @@ impl Batch {
         self.steps_run = self.steps_run.saturating_add(steps as u64);
     }
 
-    fn raw(&mut self) -> Raw {
+    pub(crate) fn raw(&mut self) -> Raw {
         let addresses: Vec<u64> = Array::ALL.iter().map(|&a| self.host_address(a)).collect();
         self.raw_with(|a| addresses[a as usize])
     }
@@ -374,6 +400,10 @@ impl Batch {
             Array::Vel => self.vel.as_mut_ptr() as u64,
             Array::Scratch => self.scratch.as_mut_ptr() as u64,
             Array::Failed => self.failed.as_mut_ptr() as u64,
+            Array::RestLength => self.rest_length.as_mut_ptr() as u64,
+            Array::MuscleLevel => self.ev.muscle_level.as_mut_ptr() as u64,
+            Array::Result => self.ev.result.as_mut_ptr() as u64,
+            Array::Ended => self.ev.ended.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -427,6 +457,27 @@ impl Batch {
             Array::PairB => I32(&self.pair_b),
             Array::PairStiffness => F64(&self.pair_stiffness),
             Array::PairDamping => F64(&self.pair_damping),
+            Array::FirstMuscle => I64(&self.ev.first_muscle),
+            Array::MuscleSpring => I32(&self.ev.muscle_spring),
+            Array::MuscleParam => F64(&self.ev.muscle_param),
+            Array::MuscleLevel => F64(&self.ev.muscle_level),
+            Array::FirstOsc => I64(&self.ev.first_osc),
+            Array::OscFrequency => F64(&self.ev.osc_frequency),
+            Array::FirstOutput => I64(&self.ev.first_output),
+            Array::OutputMuscle => I32(&self.ev.output_muscle),
+            Array::OutputGene => F64(&self.ev.output_gene),
+            Array::FirstCentre => I64(&self.ev.first_centre),
+            Array::CentreParticle => I32(&self.ev.centre_particle),
+            Array::FirstTouch => I64(&self.ev.first_touch),
+            Array::TouchParticle => I32(&self.ev.touch_particle),
+            Array::FirstStretch => I64(&self.ev.first_stretch),
+            Array::StretchPair => I32(&self.ev.stretch_pair),
+            Array::StretchLength => F64(&self.ev.stretch_length),
+            Array::Fixed => I32(&self.ev.fixed),
+            Array::EvalParam => F64(&self.ev.eval_param),
+            Array::EvalCount => I64(&self.ev.eval_count),
+            Array::Result => F64(&self.ev.result),
+            Array::Ended => I64(&self.ev.ended),
         }
     }
 
@@ -470,7 +521,7 @@ impl Batch {
             spring_b: i(Array::SpringB),
             stiffness: c(Array::Stiffness),
             damping: c(Array::Damping),
-            rest_length: c(Array::RestLength),
+            rest_length: m(Array::RestLength),
             scratch: m(Array::Scratch),
             first_joint: l(Array::FirstJoint),
             joint_a: i(Array::JointA),
@@ -520,6 +571,27 @@ impl Batch {
             pair_b: i(Array::PairB),
             pair_stiffness: c(Array::PairStiffness),
             pair_damping: c(Array::PairDamping),
+            first_muscle: l(Array::FirstMuscle),
+            muscle_spring: i(Array::MuscleSpring),
+            muscle_param: c(Array::MuscleParam),
+            muscle_level: m(Array::MuscleLevel),
+            first_osc: l(Array::FirstOsc),
+            osc_frequency: c(Array::OscFrequency),
+            first_output: l(Array::FirstOutput),
+            output_muscle: i(Array::OutputMuscle),
+            output_gene: c(Array::OutputGene),
+            first_centre: l(Array::FirstCentre),
+            centre_particle: i(Array::CentreParticle),
+            first_touch: l(Array::FirstTouch),
+            touch_particle: i(Array::TouchParticle),
+            first_stretch: l(Array::FirstStretch),
+            stretch_pair: i(Array::StretchPair),
+            stretch_length: c(Array::StretchLength),
+            fixed: i(Array::Fixed),
+            eval_param: c(Array::EvalParam),
+            eval_count: l(Array::EvalCount),
+            result: m(Array::Result),
+            ended: at(Array::Ended) as *mut c_longlong,
         }
     }
 }
@@ -618,11 +690,32 @@ pub(crate) enum Array {
     PairB,
     PairStiffness,
     PairDamping,
+    FirstMuscle,
+    MuscleSpring,
+    MuscleParam,
+    MuscleLevel,
+    FirstOsc,
+    OscFrequency,
+    FirstOutput,
+    OutputMuscle,
+    OutputGene,
+    FirstCentre,
+    CentreParticle,
+    FirstTouch,
+    TouchParticle,
+    FirstStretch,
+    StretchPair,
+    StretchLength,
+    Fixed,
+    EvalParam,
+    EvalCount,
+    Result,
+    Ended,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 41] = [
+    pub(crate) const ALL: [Array; 62] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -664,6 +757,27 @@ impl Array {
         Array::PairB,
         Array::PairStiffness,
         Array::PairDamping,
+        Array::FirstMuscle,
+        Array::MuscleSpring,
+        Array::MuscleParam,
+        Array::MuscleLevel,
+        Array::FirstOsc,
+        Array::OscFrequency,
+        Array::FirstOutput,
+        Array::OutputMuscle,
+        Array::OutputGene,
+        Array::FirstCentre,
+        Array::CentreParticle,
+        Array::FirstTouch,
+        Array::TouchParticle,
+        Array::FirstStretch,
+        Array::StretchPair,
+        Array::StretchLength,
+        Array::Fixed,
+        Array::EvalParam,
+        Array::EvalCount,
+        Array::Result,
+        Array::Ended,
     ];
 }
 

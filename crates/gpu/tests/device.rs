@@ -56,3 +56,45 @@ fn the_gpu_steps_every_creature_as_the_cpu_does_or_says_what_is_missing() {
         }
     }
 }
+
+/// Whole evaluations (the soft walker under 200 random oscillator genomes,
+/// 2 s each): the GPU's against the C's on the CPU, bit for bit.
+#[test]
+fn the_gpu_evaluates_every_scene_as_the_cpu_does_or_says_what_is_missing() {
+    let device = match Device::open() {
+        Ok(d) => d,
+        Err(why) => {
+            eprintln!("skipped, no GPU to test: {why}");
+            return;
+        }
+    };
+    let text =
+        include_str!("../../../scenes/walker.toml").replace("duration = 10.0", "duration = 2.0");
+    let problem = animats_scene::evaluate::SceneProblem::parse(&text, "walker.toml").unwrap();
+    let mut rng = Random::for_entry(3, 0);
+    let scenes: Vec<animats_scene::Scene> = (0..200)
+        .map(|_| {
+            let g: Vec<f64> = problem
+                .bounds()
+                .iter()
+                .map(|&(lo, hi)| rng.between(lo, hi))
+                .collect();
+            problem.scene(&g).unwrap()
+        })
+        .collect();
+    let refs: Vec<&animats_scene::Scene> = scenes.iter().collect();
+    let mut cpu = Batch::pack_scenes(&refs).unwrap();
+    let mut gpu = cpu.clone();
+    let want = cpu.evaluate_cpu().unwrap();
+    let got = device.evaluate(&mut gpu).unwrap();
+    for (c, (a, b)) in want.iter().zip(&got).enumerate() {
+        let bits = |e: &animats_scene::evaluate::Evaluation| {
+            [e.fitness, e.distance, e.time].map(f64::to_bits)
+        };
+        assert!(
+            bits(a) == bits(b) && a.ended == b.ended,
+            "{}: walker {c}: CPU {a:?}, GPU {b:?}",
+            device.name()
+        );
+    }
+}

@@ -1,0 +1,155 @@
+//! Whole evaluations, GPU against CPU (issue 42's checks 1 and 2): a
+//! population of the soft walker (`scenes/walker.toml`, its own genome and
+//! random oscillator genomes within its bounds) or of random evolved
+//! bodies (`scenes/bodies_walk.toml`'s random starts, scored without the
+//! archive's measures), evaluated by the engine on every core (what
+//! `animats evolve` does, strict), by the C on every core, and by the
+//! GPU; every fitness, distance, time and end reason compared as bits;
+//! evaluations and creature-steps per second of each.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies] [COUNT] [SECONDS]
+//!
+//! Exit 2 where no GPU can be used (after the CPU's comparison; the
+//! message says why), 1 if any bit differs.
+
+use animats_creatures::random::Random;
+use animats_gpu::{Batch, Device};
+use animats_scene::evaluate::{evaluate, Evaluation, SceneProblem};
+use animats_scene::morphology::MorphologyProblem;
+use animats_scene::Scene;
+use rayon::prelude::*;
+use std::time::Instant;
+
+const WALKER: &str = include_str!("../../../scenes/walker.toml");
+const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
+
+fn fail(e: impl std::fmt::Display) -> ! {
+    eprintln!("gpu_evaluate: {e}");
+    std::process::exit(2)
+}
+
+/// Scene `k` of the population.
+fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
+    let duration = |t: &str| t.replace("duration = 10.0", &format!("duration = {seconds}"));
+    let mut rng = Random::for_entry(42, k);
+    if kind == "walker" {
+        let problem = SceneProblem::parse(&duration(WALKER), "scenes/walker.toml")
+            .map_err(|e| e.to_string())?;
+        if k == 0 {
+            return problem.fresh();
+        }
+        let g: Vec<f64> = problem
+            .bounds()
+            .iter()
+            .map(|&(lo, hi)| rng.between(lo, hi))
+            .collect();
+        problem.scene(&g)
+    } else {
+        let problem = MorphologyProblem::parse(&duration(BODIES_WALK), "scenes/bodies_walk.toml")
+            .map_err(|e| e.to_string())?;
+        let genes = problem.random(&mut rng);
+        let text = problem.develop(&genes, "")?;
+        let mut s = animats_scene::parse(&text, "body.toml").map_err(|e| e.to_string())?;
+        s.archive = None;
+        Ok(s)
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let kind = args.get(1).map_or("walker", String::as_str);
+    let count: u64 = args
+        .get(2)
+        .map_or(Ok(65_536), |a| a.parse())
+        .unwrap_or_else(|_| fail("COUNT: a whole number"));
+    let seconds: f64 = args
+        .get(3)
+        .map_or(Ok(10.0), |a| a.parse())
+        .unwrap_or_else(|_| fail("SECONDS: a number"));
+    if !matches!(kind, "walker" | "bodies") || !(1..=10_000_000).contains(&count) {
+        fail("usage: gpu_evaluate [walker|bodies] [COUNT 1 to 10,000,000] [SECONDS]");
+    }
+    if !(seconds > 0.0 && seconds <= 1000.0) {
+        fail("SECONDS: more than 0, at most 1000");
+    }
+    let build = || -> Vec<Scene> {
+        (0..count)
+            .into_par_iter()
+            .map(|k| scene(kind, seconds, k).unwrap_or_else(|e| fail(e)))
+            .collect()
+    };
+    let t = Instant::now();
+    let scenes = build();
+    let built = t.elapsed().as_secs_f64();
+    let refs: Vec<&Scene> = scenes.iter().collect();
+    let packed = Batch::pack_scenes(&refs).unwrap_or_else(|e| fail(e));
+    let particles: usize = scenes.iter().map(|s| s.world.len()).sum();
+    let dt = scenes[0].dt;
+    println!(
+        "{count} {kind} evaluations of {seconds} s ({particles} particles, steps of {dt} s), {} CPU threads; scenes built in {built:.2} s",
+        rayon::current_num_threads()
+    );
+
+    let t = Instant::now();
+    let engine: Vec<Evaluation> = scenes
+        .into_par_iter()
+        .map(|s| evaluate(s).unwrap_or_else(|e| fail(e)))
+        .collect();
+    let on_engine = t.elapsed().as_secs_f64();
+    let steps: f64 = engine.iter().map(|e| (e.time / dt).round()).sum();
+    let report = |what: &str, secs: f64| {
+        println!(
+            "{what:<28} {secs:8.3} s  {:10.1} evaluations/s  {:.3e} creature-steps/s",
+            count as f64 / secs,
+            steps / secs
+        )
+    };
+    report("engine, every core:", on_engine);
+
+    let mut cpu = packed.clone();
+    let t = Instant::now();
+    let c_cpu = cpu.evaluate_cpu().unwrap_or_else(|e| fail(e));
+    report("C, every core:", t.elapsed().as_secs_f64());
+    let bits = |e: &Evaluation| {
+        (
+            [e.fitness, e.distance, e.time].map(f64::to_bits),
+            e.ended.clone(),
+        )
+    };
+    let differ = |got: &[Evaluation]| {
+        got.iter()
+            .zip(&engine)
+            .filter(|(a, b)| bits(a) != bits(b))
+            .count()
+    };
+    let bad = differ(&c_cpu);
+    println!("C on the CPU against the engine: {bad} of {count} evaluations differ");
+    let best = engine
+        .iter()
+        .map(|e| e.fitness)
+        .fold(f64::NEG_INFINITY, f64::max);
+    println!("best fitness {best}; the first: {:?}", engine[0]);
+
+    let device = match Device::open() {
+        Ok(d) => d,
+        Err(e) => {
+            eprintln!("gpu_evaluate: {e}");
+            std::process::exit(if bad == 0 { 2 } else { 1 });
+        }
+    };
+    // Once to warm (the module is loaded; the first launch pays for it).
+    let one = scene(kind, seconds, 0).unwrap_or_else(|e| fail(e));
+    let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
+    device.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
+    let mut gpu = packed.clone();
+    let t = Instant::now();
+    let on_gpu = device.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));
+    let secs = t.elapsed().as_secs_f64();
+    report(&format!("GPU ({}), copies included:", device.name()), secs);
+    println!("GPU: {:.1}x the engine on every core", on_engine / secs);
+    let bad_gpu = differ(&on_gpu);
+    println!("GPU against the engine: {bad_gpu} of {count} evaluations differ");
+    if bad > 0 || bad_gpu > 0 {
+        std::process::exit(1);
+    }
+}

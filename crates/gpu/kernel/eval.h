@@ -1,0 +1,206 @@
+/*
+ * A scene's whole evaluation in C, after the step (step.h): what
+ * crates/scene/src/evaluate.rs `evaluate_with` does for a scene whose
+ * brains are oscillators driving spring muscles, operation by operation.
+ * Each step: the nervous system acts (creatures/src/nervous_system.rs
+ * `act`: every oscillator's outputs at the world's time, each slewed by its
+ * muscle's rate and clamped to [0, 1], the spring's rest length set), the
+ * world steps, its clock advances (Kahan), the divergence guard checks
+ * every 64th step (engine/src/guard.rs: a driven world's speed limit),
+ * then the centre of the particles that count is taken and the end rules
+ * (fail_on_touch, then fail_on_stretch) are tried. The fitness is the
+ * [evolve] table's time and distance terms. What this file does not cover
+ * is refused when a scene is packed (crates/gpu/src/scenes.rs).
+ */
+#ifndef ANIMATS_EVAL_H
+#define ANIMATS_EVAL_H
+
+#include "step.h"
+#include "trig.h"
+
+/* Why an evaluation ended, as scene::evaluate::Ended. */
+enum { AN_TIMEOUT = 0, AN_TOUCH = 1, AN_STRETCH = 2, AN_BLOWUP = 3 };
+
+/* sensor::unit: x clamped to [0, 1], NaN to 0. */
+AN_FN double an_unit(double x) {
+    if (x >= 1.0) {
+        return 1.0;
+    }
+    if (x > 0.0) {
+        return x;
+    }
+    return 0.0;
+}
+
+/* nervous_system.rs `slew` of muscle q (index over the batch) of a
+ * creature whose springs begin at s0, towards level l over dt. */
+AN_FN void an_slew(const an_batch *b, long long q, long long s0, double l, double dt) {
+    if (l != l) {
+        return;
+    }
+    double level = an_unit(l);
+    double rate = b->muscle_param[3 * q + 2];
+    if (rate >= 0.0) {
+        double now = b->muscle_level[q];
+        double lo = -rate * dt, hi = rate * dt, d = level - now;
+        if (d < lo) {
+            d = lo;
+        }
+        if (d > hi) {
+            d = hi;
+        }
+        level = now + d;
+    }
+    level = an_unit(level); /* Actuator::set_level */
+    b->muscle_level[q] = level;
+    double lo = b->muscle_param[3 * q], hi = b->muscle_param[3 * q + 1];
+    b->rest_length[s0 + b->muscle_spring[q]] = lo + level * (hi - lo);
+}
+
+/* Every oscillator of creature c acts at time t (brains/oscillator.rs:
+ * level = offset + amplitude sin(2 pi f t + phase)). */
+AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
+    long long s0 = b->first_spring[c], u0 = b->first_muscle[c];
+    for (long long o = b->first_osc[c]; o < b->first_osc[c + 1]; o++) {
+        double w = (6.283185307179586 * b->osc_frequency[o]) * t;
+        for (long long k = b->first_output[o]; k < b->first_output[o + 1]; k++) {
+            const double *g = b->output_gene + 4 * k;
+            double l = g[2] + g[0] * an_sin(w + g[1]);
+            if (g[3] == g[3]) {
+                l = l + g[3];
+            }
+            an_slew(b, u0 + b->output_muscle[k], s0, l, dt);
+        }
+    }
+}
+
+/* scene::evaluate::centre_at: the centre of mass of the particles that
+ * count (of one: its position; of massless ones: their mean). */
+AN_FN void an_centre(const an_batch *b, long long c, double *out) {
+    long long p0 = b->first_particle[c];
+    long long k0 = b->first_centre[c], nk = b->first_centre[c + 1] - k0;
+    const double *x = b->pos + 3 * p0;
+    if (nk == 1) {
+        long long p = b->centre_particle[k0];
+        for (int d = 0; d < 3; d++) {
+            out[d] = x[3 * p + d];
+        }
+        return;
+    }
+    double sum[3] = {0.0, 0.0, 0.0}, m = 0.0;
+    for (long long k = k0; k < k0 + nk; k++) {
+        long long p = b->centre_particle[k];
+        double mp = b->mass[p0 + p];
+        for (int d = 0; d < 3; d++) {
+            sum[d] = sum[d] + x[3 * p + d] * mp;
+        }
+        m = m + mp;
+    }
+    double by = m > 0.0 ? m : (double)(nk > 1 ? nk : 1);
+    for (int d = 0; d < 3; d++) {
+        out[d] = sum[d] / by;
+    }
+}
+
+/* EvolveSpec::ending: the first fail_on_touch particle within the
+ * tolerance of the (flat) floor, else the first fail_on_stretch pair
+ * stretched; AN_TIMEOUT where none holds. `which` gets the rule. */
+AN_FN int an_ending(const an_batch *b, long long c, long long *which) {
+    long long p0 = b->first_particle[c];
+    const double *x = b->pos + 3 * p0;
+    double tolerance = b->eval_param[8 * c + 5];
+    for (long long k = b->first_touch[c]; k < b->first_touch[c + 1]; k++) {
+        long long p = b->touch_particle[k];
+        if (x[3 * p + 1] - b->radius[p0 + p] <= tolerance) {
+            *which = k - b->first_touch[c];
+            return AN_TOUCH;
+        }
+    }
+    for (long long k = b->first_stretch[c]; k < b->first_stretch[c + 1]; k++) {
+        long long pa = b->stretch_pair[2 * k], pb = b->stretch_pair[2 * k + 1];
+        double d[3];
+        for (int e = 0; e < 3; e++) {
+            d[e] = x[3 * pa + e] - x[3 * pb + e];
+        }
+        if (sqrt(an_dot(d, d)) >= b->stretch_length[k]) {
+            *which = k - b->first_stretch[c];
+            return AN_STRETCH;
+        }
+    }
+    return AN_TIMEOUT;
+}
+
+/* DivergenceGuard::check of a driven world: 0 where a particle that is
+ * not fixed moves faster than 1000 m/s. */
+AN_FN int an_guard(const an_batch *b, long long c) {
+    long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
+    const double *v = b->vel + 3 * p0;
+    for (long long i = 0; i < n; i++) {
+        if (!b->fixed[p0 + i] && an_dot(v + 3 * i, v + 3 * i) > 1000.0 * 1000.0) {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* The evaluation of creature c (scene::evaluate::evaluate_with). */
+AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
+    const double *param = b->eval_param + 8 * c;
+    double dt = b->dt, t = param[6], carry = param[7];
+    long long steps = b->eval_count[2 * c], taken = b->eval_count[2 * c + 1];
+    long long done = 0, which = 0;
+    double start[3], last[3], now[3];
+    an_centre(b, c, start);
+    for (int d = 0; d < 3; d++) {
+        last[d] = start[d];
+    }
+    int why = an_ending(b, c, &which);
+    if (why == AN_TIMEOUT) {
+        while (done < steps) {
+            an_act(b, c, t, dt); /* Scene::step: the nervous system first */
+            if (!an_step_once(b, c)) {
+                why = AN_BLOWUP;
+                break;
+            }
+            /* World::advance_clock */
+            double y = dt - carry;
+            double t1 = t + y;
+            carry = (t1 - t) - y;
+            t = t1;
+            taken++;
+            if (taken % 64 == 0 && !an_guard(b, c)) {
+                why = AN_BLOWUP;
+                break;
+            }
+            done++;
+            an_centre(b, c, now);
+            if (!(now[0] - now[0] == 0.0 && now[1] - now[1] == 0.0 && now[2] - now[2] == 0.0)) {
+                why = AN_BLOWUP;
+                break;
+            }
+            for (int d = 0; d < 3; d++) {
+                last[d] = now[d];
+            }
+            why = an_ending(b, c, &which);
+            if (why != AN_TIMEOUT) {
+                break;
+            }
+        }
+    }
+    double time = (double)done * dt;
+    double moved[3];
+    for (int d = 0; d < 3; d++) {
+        moved[d] = last[d] - start[d];
+    }
+    double distance = an_dot(moved, param);
+    if (why == AN_BLOWUP) {
+        distance = distance < 0.0 ? distance : 0.0;
+    }
+    b->result[3 * c] = param[3] * time + param[4] * distance;
+    b->result[3 * c + 1] = distance;
+    b->result[3 * c + 2] = time;
+    b->ended[2 * c] = why;
+    b->ended[2 * c + 1] = which;
+}
+
+#endif

@@ -1,0 +1,298 @@
+//! Scenes evaluated whole by the C (`kernel/eval.h`): a batch of scenes
+//! ([`Batch::pack_scenes`]) holds, beside each world, its spring muscles,
+//! its oscillators and its `[evolve]` rules, and [`Batch::evaluate_cpu`]
+//! (or [`crate::Device::evaluate`]) runs each scene's evaluation as
+//! `animats_scene::evaluate::evaluate` does, returning the same
+//! [`Evaluation`] to the bit.
+//!
+//! Covered: spring muscles (a spring's rest length between `min` and
+//! `max`, with or without a `rate`), oscillator brains, the centre of the
+//! particles that count, `fail_on_touch` and `fail_on_stretch`, the
+//! divergence guard of a driven scene, and the fitness's time and distance
+//! terms. Anything else a scene holds is refused when it is packed, with a
+//! message naming the scene and the entry.
+
+use crate::pack::{Batch, Shared, CHUNK};
+use animats_creatures::actuators::AnyActuator;
+use animats_engine::World;
+use animats_scene::evaluate::{Ended, Evaluation};
+use animats_scene::Scene;
+use std::os::raw::c_longlong;
+
+extern "C" {
+    fn animats_evaluate_range(batch: *const crate::pack::Raw, first: c_longlong, last: c_longlong);
+}
+
+/// The arrays of a scene's evaluation (the tail of the C's `an_batch`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Rules {
+    pub(crate) first_muscle: Vec<i64>,
+    pub(crate) muscle_spring: Vec<i32>,
+    pub(crate) muscle_param: Vec<f64>,
+    pub(crate) muscle_level: Vec<f64>,
+    pub(crate) first_osc: Vec<i64>,
+    pub(crate) osc_frequency: Vec<f64>,
+    pub(crate) first_output: Vec<i64>,
+    pub(crate) output_muscle: Vec<i32>,
+    pub(crate) output_gene: Vec<f64>,
+    pub(crate) first_centre: Vec<i64>,
+    pub(crate) centre_particle: Vec<i32>,
+    pub(crate) first_touch: Vec<i64>,
+    pub(crate) touch_particle: Vec<i32>,
+    pub(crate) first_stretch: Vec<i64>,
+    pub(crate) stretch_pair: Vec<i32>,
+    pub(crate) stretch_length: Vec<f64>,
+    pub(crate) fixed: Vec<i32>,
+    pub(crate) eval_param: Vec<f64>,
+    pub(crate) eval_count: Vec<i64>,
+    pub(crate) result: Vec<f64>,
+    pub(crate) ended: Vec<i64>,
+    /// Per creature: its `fail_on_touch` particles' names and its
+    /// `fail_on_stretch` rules' names, for [`Ended`].
+    names: Vec<(Vec<String>, Vec<String>)>,
+    /// Packed from scenes, not yet evaluated.
+    ready: bool,
+}
+
+impl Rules {
+    /// Well-formed empty rules for `creatures` worlds (a batch of worlds,
+    /// which is stepped, not evaluated); keeps `fixed`.
+    pub(crate) fn no_rules(&mut self, creatures: usize) {
+        let fixed = std::mem::take(&mut self.fixed);
+        *self = Rules {
+            fixed,
+            ..Rules::default()
+        };
+        for offsets in [
+            &mut self.first_muscle,
+            &mut self.first_osc,
+            &mut self.first_centre,
+            &mut self.first_touch,
+            &mut self.first_stretch,
+        ] {
+            *offsets = vec![0; creatures + 1];
+        }
+        self.first_output = vec![0];
+        self.eval_param = vec![0.0; 8 * creatures];
+        self.eval_count = vec![0; 2 * creatures];
+        self.result = vec![0.0; 3 * creatures];
+        self.ended = vec![0; 2 * creatures];
+    }
+
+    /// Appends `scene`'s muscles, oscillators and rules (its creature's
+    /// offsets pushed after them); `Err` names what the C does not cover.
+    fn add(&mut self, scene: &Scene) -> Result<(), String> {
+        let spec = scene
+            .evolve
+            .as_ref()
+            .ok_or("it has no [evolve] table: nothing to evaluate")?;
+        if let Some(a) = scene.actors.first() {
+            let who = a
+                .status()
+                .map_or("a creature that acts by itself".into(), |s| {
+                    format!("the creature `{}`", s.name)
+                });
+            return Err(format!(
+                "{who} (roobot, quadruped, jellyfish or bubble column) is not in the GPU evaluation yet"
+            ));
+        }
+        if scene.archive.is_some() {
+            return Err("[archive] measures are not in the GPU evaluation yet".into());
+        }
+        if spec.energy_weight != 0.0 || !spec.terms.is_empty() || spec.target.is_some() {
+            return Err(
+                "[evolve] energy_weight, target and terms are not in the GPU evaluation yet".into(),
+            );
+        }
+        let nervous = &scene.nervous;
+        let world = &scene.world;
+        if nervous.is_empty() && world.is_passive() {
+            return Err("the divergence guard's energy check of a scene nothing drives is not in the GPU evaluation yet".into());
+        }
+        for ((name, a), (gate, rate)) in nervous
+            .actuators
+            .iter()
+            .zip(nervous.gates.iter().zip(&nervous.rates))
+        {
+            let AnyActuator::Spring(a) = a else {
+                return Err(format!(
+                    "the actuator `{name}` (not a spring's rest length) is not in the GPU evaluation yet"
+                ));
+            };
+            if gate.is_some() {
+                return Err(format!(
+                    "the actuator `{name}`'s gate is not in the GPU evaluation yet"
+                ));
+            }
+            let (min, max) = a.range();
+            self.muscle_spring.push(a.target().0.index() as i32);
+            self.muscle_param.extend([min, max, rate.unwrap_or(-1.0)]);
+            self.muscle_level.push(a.level());
+        }
+        for c in &nervous.controllers {
+            let kind = c.brain.kind();
+            let g = c.brain.genome();
+            let n = c.outputs.len();
+            if kind != "oscillator" || g.len() != 1 + 3 * n {
+                return Err(format!(
+                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators are",
+                    c.name
+                ));
+            }
+            self.osc_frequency.push(g[0]);
+            for (j, &o) in c.outputs.iter().enumerate() {
+                self.output_muscle.push(o as i32);
+                let shift = nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
+                self.output_gene
+                    .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift]);
+            }
+            self.first_output.push(self.output_muscle.len() as i64);
+        }
+        self.centre_particle
+            .extend(spec.particles.iter().map(|p| p.index() as i32));
+        let mut touch = Vec::new();
+        for (p, name) in &spec.fail_on_touch {
+            self.touch_particle.push(p.index() as i32);
+            touch.push(name.clone());
+        }
+        let mut stretch = Vec::new();
+        for s in &spec.fail_on_stretch {
+            self.stretch_pair
+                .extend([s.a.index() as i32, s.b.index() as i32]);
+            self.stretch_length.push(s.length);
+            stretch.push(s.name.clone());
+        }
+        self.names.push((touch, stretch));
+        let clock = world.snapshot();
+        self.eval_param.extend(spec.axis.to_array());
+        self.eval_param.extend([
+            spec.time_weight,
+            spec.distance_weight,
+            spec.touch_tolerance,
+            clock.time,
+            clock.time_carry,
+        ]);
+        let steps = (spec.duration / scene.dt).round() as u64;
+        self.eval_count.extend([
+            steps.min(i64::MAX as u64) as i64,
+            world.stats().steps as i64,
+        ]);
+        self.first_muscle.push(self.muscle_spring.len() as i64);
+        self.first_osc.push(self.osc_frequency.len() as i64);
+        self.first_centre.push(self.centre_particle.len() as i64);
+        self.first_touch.push(self.touch_particle.len() as i64);
+        self.first_stretch.push(self.stretch_length.len() as i64);
+        Ok(())
+    }
+}
+
+impl Batch {
+    /// The scenes' worlds packed as [`Batch::pack`] packs them, with their
+    /// evaluations: spring muscles, oscillators, the centre and the end
+    /// rules of `[evolve]`. Every scene must share the first one's step,
+    /// gravity, floor and integrator; whatever the C does not evaluate is
+    /// refused with a message naming the scene and the entry.
+    pub fn pack_scenes(scenes: &[&Scene]) -> Result<Batch, String> {
+        let Some(first) = scenes.first() else {
+            return Err("no scenes to pack".into());
+        };
+        let dt = first.dt;
+        if let Some(k) = scenes.iter().position(|s| s.dt.to_bits() != dt.to_bits()) {
+            return Err(format!(
+                "scene {k}: a batch shares one step; scene 0 has dt = {dt}, this one {}",
+                scenes[k].dt
+            ));
+        }
+        let worlds: Vec<&World> = scenes.iter().map(|s| &s.world).collect();
+        let mut b = Batch::pack(&worlds, dt)?;
+        let fixed = std::mem::take(&mut b.ev.fixed);
+        let mut r = Rules {
+            fixed,
+            first_muscle: vec![0],
+            first_osc: vec![0],
+            first_output: vec![0],
+            first_centre: vec![0],
+            first_touch: vec![0],
+            first_stretch: vec![0],
+            ..Rules::default()
+        };
+        for (k, s) in scenes.iter().enumerate() {
+            r.add(s).map_err(|e| format!("scene {k}: {e}"))?;
+        }
+        r.result = vec![0.0; 3 * scenes.len()];
+        r.ended = vec![0; 2 * scenes.len()];
+        r.ready = true;
+        b.ev = r;
+        Ok(b)
+    }
+
+    /// Runs every scene's evaluation with the C compiled for this CPU, on
+    /// the threads of the current rayon pool (the same bits on any number),
+    /// from the state it was packed in: once (`Err` after the first).
+    pub fn evaluate_cpu(&mut self) -> Result<Vec<Evaluation>, String> {
+        use rayon::prelude::*;
+        self.take_ready()?;
+        let shared = Shared(self.raw());
+        let n = self.creatures();
+        (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|k| {
+            let (first, last) = (k * CHUNK, ((k + 1) * CHUNK).min(n));
+            // SAFETY: `shared` points into this batch's vectors, which
+            // live until the loop ends; the C reads and writes within the
+            // bounds the offsets give (as packed), and creatures
+            // first..last, with their springs, muscles and results, are
+            // this task's alone.
+            unsafe {
+                animats_evaluate_range(shared.get(), first as c_longlong, last as c_longlong)
+            };
+        });
+        Ok(self.evaluations())
+    }
+
+    /// Checks that the batch holds scenes not yet evaluated, and marks it
+    /// evaluated.
+    pub(crate) fn take_ready(&mut self) -> Result<(), String> {
+        if !self.ev.ready {
+            return Err(
+                "this batch holds no evaluations to run: pack scenes (Batch::pack_scenes), once per evaluation"
+                    .into(),
+            );
+        }
+        self.ev.ready = false;
+        Ok(())
+    }
+
+    /// Results and endings written back (from a GPU).
+    pub(crate) fn set_results(&mut self, result: &[f64], ended: &[i64]) {
+        let (r, e) = (self.ev.result.len(), self.ev.ended.len());
+        self.ev.result.copy_from_slice(&result[..r]);
+        self.ev.ended.copy_from_slice(&ended[..e]);
+    }
+
+    /// The evaluations the C wrote.
+    pub(crate) fn evaluations(&self) -> Vec<Evaluation> {
+        (0..self.creatures())
+            .map(|c| {
+                let r = &self.ev.result[3 * c..3 * c + 3];
+                let (why, which) = (self.ev.ended[2 * c], self.ev.ended[2 * c + 1] as usize);
+                let (touch, stretch) = &self.ev.names[c];
+                let name = |names: &[String]| names.get(which).cloned().unwrap_or_default();
+                let ended = match why {
+                    1 => Ended::Touch(name(touch)),
+                    2 => Ended::Stretch(name(stretch)),
+                    3 => Ended::BlowUp,
+                    _ => Ended::Timeout,
+                };
+                Evaluation {
+                    fitness: r[0],
+                    distance: r[1],
+                    time: r[2],
+                    ended,
+                    measures: Vec::new(),
+                    energy: None,
+                    target_distance: None,
+                    terms: Vec::new(),
+                }
+            })
+            .collect()
+    }
+}
