@@ -5,14 +5,17 @@
 # as bits; then whole evaluations: 65,536 soft walkers (random oscillator
 # genomes) and 65,536 random evolved bodies (self-contact, spring muscles),
 # each evaluated for 10 s by the engine on every core, by the C and by the
-# GPU, every fitness compared as bits; the throughput of each.
+# GPU, every fitness compared as bits; the throughput of each; last the
+# soft walker evolved on the GPU, 16,384 candidates a generation, against
+# the README's CPU run (scenes/walker.toml's header), wall time and
+# distance of each.
 #
 # Builds nothing: it takes the examples built here, carried in an ignored
 # folder:
-#   cargo build --release -p animats-gpu --example gpu_check --example gpu_evaluate
-#   mkdir -p target/carry && cp target/release/examples/gpu_{check,evaluate} target/carry/
+#   cargo build --release -p animats -p animats-gpu --example gpu_check --example gpu_evaluate
+#   mkdir -p target/carry && cp target/release/examples/gpu_{check,evaluate} target/release/animats target/carry/
 #   bench/gpu.sh
-# About three minutes on an H100 machine with 16 cores. Exit 1 if any bit
+# About four minutes on an H100 machine with 16 cores. Exit 1 if any bit
 # differs, 2 if no GPU can be used (the message says why).
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -24,6 +27,9 @@ bin() {
 }
 B=$(bin gpu_check) || exit 2
 E=$(bin gpu_evaluate) || exit 2
+A=target/carry/animats
+[ -x "$A" ] || A=target/release/animats
+[ -x "$A" ] || { echo "no animats binary: build it (see the top of this file)" >&2; exit 2; }
 # NVRTC (and its builtins) where the lent machines keep CUDA 13's.
 export LD_LIBRARY_PATH="/usr/local/cuda/targets/x86_64-linux/lib:/usr/local/cuda/lib64:${LD_LIBRARY_PATH:-}"
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%dT%H:%MZ)"
@@ -43,4 +49,27 @@ for run in "walker 65536 10" "bodies 65536 10"; do
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
+# The walker evolved: on the GPU with 16,384 candidates a generation, and
+# on the CPU as the README runs it; the first generation whose best walks
+# 4.31 m (the CPU run's shipped result), and each run's wall time.
+T=$(mktemp -d)
+reached() {
+  awk -F, 'NR > 1 && $7 + 0 > best { best = $7 + 0 }
+           NR > 1 && !hit && $7 + 0 >= 4.31 { hit = $2 }
+           END { printf "best distance %.3f m; 4.31 m first at generation %s\n", best, hit ? hit : "never" }' "$1/log.csv"
+}
+for device in cuda cpu; do
+  if [ $device = cuda ]; then extra="--population 16384 --generations 40"; else extra="--generations 1500"; fi
+  echo "== evolve scenes/walker.toml --optimiser cma-es --device $device $extra"
+  t0=$(date +%s.%N)
+  # shellcheck disable=SC2086
+  "$A" evolve scenes/walker.toml --optimiser cma-es --device $device $extra --out "$T/$device" >"$T/$device.txt" 2>&1
+  rc=$?
+  t1=$(date +%s.%N)
+  tail -3 "$T/$device.txt"
+  echo "wall $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }') s, exit $rc"
+  [ $rc -eq 0 ] && reached "$T/$device"
+  [ $rc -gt $status ] && status=$rc
+done
+rm -rf "$T"
 exit $status

@@ -6,7 +6,7 @@
 //! them.
 
 use crate::Failure;
-use animats_scene::evaluate::{evaluate, score, SceneProblem};
+use animats_scene::evaluate::{evaluate, score, score_all, SceneProblem};
 use std::path::PathBuf;
 
 /// Arguments of `animats evaluate`.
@@ -26,6 +26,10 @@ pub struct Args {
     /// `measures` for a scene with an `[archive]`).
     #[arg(long)]
     json: bool,
+    /// Where the scene is evaluated: cpu (the engine) or cuda (an NVIDIA
+    /// GPU: the same bits; docs/GPU.md says what it covers).
+    #[arg(long, value_enum, default_value_t)]
+    device: crate::device::DeviceName,
 }
 
 /// Runs the command.
@@ -37,7 +41,17 @@ pub fn run(args: Args) -> Result<(), Failure> {
         let thesis =
             SceneProblem::parse(animats_scene::HOP_EVOLVER, animats_scene::HOP_EVOLVER_FILE)
                 .map_err(|e| Failure::Other(e.to_string()))?;
-        thesis.scene(&params.0).map_err(Failure::Other)?
+        let scene = thesis.scene(&params.0).map_err(Failure::Other)?;
+        if let Some(b) = batches(&args, animats_scene::HOP_EVOLVER_FILE, || {
+            thesis.scene(&params.0)
+        })? {
+            let mut e = (b.0)(vec![scene]).map_err(Failure::Other)?;
+            return report(
+                e.pop().ok_or(Failure::Other("no evaluation".into()))?,
+                args.json,
+            );
+        }
+        scene
     } else {
         if args.lane.is_some() || args.params != "evolved" {
             return Err(input(
@@ -57,11 +71,26 @@ pub fn run(args: Args) -> Result<(), Failure> {
             // Robust, trials: as evolution scores it.
             Some(_) => {
                 let build = || animats_scene::parse(&text, &file).map_err(|e| e.to_string());
-                return report(score(build).map_err(Failure::Other)?, args.json);
+                let e = match batches(&args, &file, build)? {
+                    None => score(build),
+                    Some(b) => score_all(&[&build], &|_| true, &*b.0)
+                        .and_then(|mut all| all.pop().ok_or_else(|| "no evaluation".to_string())),
+                };
+                return report(e.map_err(Failure::Other)?, args.json);
             }
         }
     };
     report(evaluate(scene).map_err(Failure::Other)?, args.json)
+}
+
+/// `--device`'s batches for `file`'s scene (none on the CPU); exit 2 where
+/// the GPU cannot evaluate it or cannot be used.
+fn batches(
+    args: &Args,
+    file: &str,
+    probe: impl FnOnce() -> Result<animats_scene::Scene, String>,
+) -> Result<Option<animats_scene::evaluate::Batches>, Failure> {
+    crate::device::batches(args.device, file, probe).map_err(Failure::Input)
 }
 
 /// Prints an evaluation: a JSON object, or a line a field.

@@ -74,6 +74,11 @@ pub struct Args {
     /// end of each batch of generations. The results are unchanged.
     #[arg(long)]
     schedule: bool,
+    /// Where the candidates are evaluated: cpu (the engine on every core)
+    /// or cuda (a generation at a time on an NVIDIA GPU, one thread a
+    /// candidate: the same log and best; docs/GPU.md says what it covers).
+    #[arg(long, value_enum, default_value_t)]
+    device: crate::device::DeviceName,
     #[command(flatten)]
     serving: crate::view::Serving,
 }
@@ -392,8 +397,13 @@ fn evolve(
     board: Option<&BestBrain>,
     tracer: Option<&animats_evolve::schedule::Tracer>,
 ) -> Result<bool, Failure> {
+    // `--device cuda`: the scene checked and the GPU opened before any
+    // generation.
+    let spec = &state.config.problem;
+    let batches = crate::device::batches(args.device, &spec.file, || crate::device::probe(spec))
+        .map_err(input)?;
     // Built once for the whole run (a scene is parsed and checked here).
-    let problem = state.config.problem.build().map_err(input)?;
+    let problem = state.config.problem.build_on(batches).map_err(input)?;
     let mut progress = Progress::new(state);
     // Each stretch of work runs until the next checkpoint is due (at least
     // a generation of every lane), or Ctrl-C.

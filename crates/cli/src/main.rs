@@ -16,6 +16,7 @@ macro_rules! say {
 }
 
 mod bench;
+mod device;
 mod evaluate;
 mod evolve;
 mod hop;

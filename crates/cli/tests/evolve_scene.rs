@@ -131,3 +131,59 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
         "{err}"
     );
 }
+
+/// `--device cuda`: a scene the GPU does not evaluate is refused by file
+/// and entry, before anything runs; without a usable GPU (CI has none)
+/// the message says what is missing; with one, `evaluate` gives the CPU's
+/// bits. Exit 2 for every refusal.
+#[test]
+fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
+    let o = animats(&[
+        "evaluate",
+        "scenes/quadruped3_gait.toml",
+        "--device",
+        "cuda",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = text(&o).1;
+    assert!(
+        err.contains("scenes/quadruped3_gait.toml: --device cuda:")
+            && err.contains("the creature `dog`")
+            && err.contains("not in the GPU evaluation yet"),
+        "{err}"
+    );
+    let dir = scratch("device-bodies");
+    let out = dir.join("x");
+    let o = animats(&[
+        "evolve",
+        "scenes/bodies_walk.toml",
+        "--device",
+        "cuda",
+        "--generations",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("[archive] measures"), "{}", text(&o).1);
+    assert!(!out.join("log.csv").exists());
+    let cpu = animats(&["evaluate", "scenes/walker.toml", "--json"]);
+    let gpu = animats(&[
+        "evaluate",
+        "scenes/walker.toml",
+        "--json",
+        "--device",
+        "cuda",
+    ]);
+    if gpu.status.success() {
+        assert_eq!(text(&gpu).0, text(&cpu).0);
+    } else {
+        assert_eq!(gpu.status.code(), Some(2));
+        let err = text(&gpu).1;
+        assert!(
+            err.contains("--device cuda:")
+                && (err.contains("driver") || err.contains("device") || err.contains("NVRTC")),
+            "{err}"
+        );
+    }
+}

@@ -36,6 +36,17 @@ pub trait Problem: Send + Sync {
         let _ = screen;
         self.evaluate(genome)
     }
+    /// Every genome of a generation evaluated at once, where the problem
+    /// runs its evaluations in batches (on a GPU: `animats_scene::evaluate::Batches`),
+    /// each as [`Problem::evaluate_screened`] would; `None` where it
+    /// evaluates them one by one.
+    fn evaluate_population(
+        &self,
+        _genomes: &[Vec<f64>],
+        _screen: &Screen,
+    ) -> Option<Result<Vec<Outcome>, String>> {
+        None
+    }
     /// The scene's `[evolve]` table, resolved (none for a problem that is
     /// not a scene).
     fn spec(&self) -> Option<&EvolveSpec> {
@@ -86,6 +97,14 @@ impl Problem for SceneEvolution {
     fn evaluate_screened(&self, genome: &[f64], screen: &Screen) -> Result<Outcome, String> {
         self.0.evaluate_screened(genome, &|o| screen.fine(o))
     }
+    fn evaluate_population(
+        &self,
+        genomes: &[Vec<f64>],
+        screen: &Screen,
+    ) -> Option<Result<Vec<Outcome>, String>> {
+        let b = self.0.batches()?;
+        Some(self.0.evaluate_all(genomes, &|o| screen.fine(o), &*b.0))
+    }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())
     }
@@ -120,6 +139,14 @@ impl Problem for BodyEvolution {
     }
     fn evaluate_screened(&self, genome: &[f64], screen: &Screen) -> Result<Outcome, String> {
         self.0.evaluate_screened(genome, &|o| screen.fine(o))
+    }
+    fn evaluate_population(
+        &self,
+        genomes: &[Vec<f64>],
+        screen: &Screen,
+    ) -> Option<Result<Vec<Outcome>, String>> {
+        let b = self.0.batches()?;
+        Some(self.0.evaluate_all(genomes, &|o| screen.fine(o), &*b.0))
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())

@@ -60,11 +60,20 @@ impl ProblemSpec {
     /// Builds the problem: a `[morphology]` scene's bodies, else its
     /// `[evolve]` controller.
     pub fn build(&self) -> Result<Box<dyn Problem>, String> {
+        self.build_on(None)
+    }
+
+    /// [`ProblemSpec::build`], its evaluations run in `batches` (a GPU's)
+    /// where given.
+    pub fn build_on(
+        &self,
+        batches: Option<animats_scene::evaluate::Batches>,
+    ) -> Result<Box<dyn Problem>, String> {
         if self.has_morphology()? {
             let m = MorphologyProblem::parse(&self.text, &self.file).map_err(|e| e.to_string())?;
-            Ok(Box::new(BodyEvolution(m)))
+            Ok(Box::new(BodyEvolution(m.on(batches))))
         } else {
-            Ok(Box::new(SceneEvolution(self.parse()?)))
+            Ok(Box::new(SceneEvolution(self.parse()?.on(batches))))
         }
     }
 }
@@ -1012,18 +1021,21 @@ fn advance_lane(
         if let Some(t) = tracer {
             t.done(k, g, Piece::Ask, began);
         }
-        let outcomes: Vec<Outcome> = population
-            .par_iter()
-            .enumerate()
-            .map(|(i, genome)| {
-                let began = std::time::Instant::now();
-                let o = problem.evaluate_screened(genome, &screen);
-                if let Some(t) = tracer {
-                    t.done(k, g, Piece::Evaluate(i), began);
-                }
-                o
-            })
-            .collect::<Result<_, _>>()?;
+        let outcomes: Vec<Outcome> = match problem.evaluate_population(&population, &screen) {
+            Some(batch) => batch?,
+            None => population
+                .par_iter()
+                .enumerate()
+                .map(|(i, genome)| {
+                    let began = std::time::Instant::now();
+                    let o = problem.evaluate_screened(genome, &screen);
+                    if let Some(t) = tracer {
+                        t.done(k, g, Piece::Evaluate(i), began);
+                    }
+                    o
+                })
+                .collect::<Result<_, _>>()?,
+        };
         let began = std::time::Instant::now();
         rows.push(record(lane, Some(problem), population, &outcomes)?);
         if let Some(t) = tracer {

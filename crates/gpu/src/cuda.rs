@@ -147,6 +147,23 @@ impl Device {
     }
 }
 
+impl Device {
+    /// The device as a problem's evaluation runner
+    /// ([`animats_scene::evaluate::Batches`]): each batch of scenes packed
+    /// ([`Batch::pack_scenes`]) and evaluated here, one batch at a time.
+    pub fn into_batches(self) -> animats_scene::evaluate::Batches {
+        let device = std::sync::Mutex::new(self);
+        animats_scene::evaluate::Batches(Arc::new(move |scenes| {
+            let refs: Vec<&animats_scene::Scene> = scenes.iter().collect();
+            let mut batch = Batch::pack_scenes(&refs)?;
+            let device = device
+                .lock()
+                .map_err(|_| "an earlier evaluation on the GPU panicked".to_string())?;
+            device.evaluate(&mut batch)
+        }))
+    }
+}
+
 /// A driver error as a message saying what was being done.
 fn err(what: &'static str) -> impl Fn(cudarc::driver::DriverError) -> String {
     move |e| format!("{what}: {e}")

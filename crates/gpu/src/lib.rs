@@ -35,3 +35,4 @@ mod scenes;
 
 pub use cuda::Device;
 pub use pack::Batch;
+pub use scenes::{c_batches, c_runs};

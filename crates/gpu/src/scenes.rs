@@ -15,7 +15,7 @@
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
 use animats_engine::World;
-use animats_scene::evaluate::{Ended, Evaluation};
+use animats_scene::evaluate::{Batches, Ended, Evaluation};
 use animats_scene::Scene;
 use std::os::raw::c_longlong;
 
@@ -295,4 +295,19 @@ impl Batch {
             })
             .collect()
     }
+}
+
+/// The C compiled for this CPU as a runner of scenes' evaluations
+/// ([`animats_scene::evaluate::Runner`]): each batch packed and evaluated
+/// on the current rayon pool. What the GPU's runner does, on the CPU: the
+/// tests evolve with it to show that a generation evaluated in batches by
+/// the C gives the engine's log.
+pub fn c_runs(scenes: Vec<Scene>) -> Result<Vec<Evaluation>, String> {
+    let refs: Vec<&Scene> = scenes.iter().collect();
+    Batch::pack_scenes(&refs)?.evaluate_cpu()
+}
+
+/// [`c_runs`] as a problem's [`Batches`].
+pub fn c_batches() -> Batches {
+    Batches(std::sync::Arc::new(c_runs))
 }

@@ -565,7 +565,7 @@ fn worse(first: Evaluation, second: Evaluation) -> Evaluation {
 /// would at the finer step); the mean of the trials counts (every figure
 /// averaged, the ending the worst trial's), or with `aggregate = "worst"`
 /// the worst trial.
-pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, String> {
+pub fn score(make: impl Fn() -> Result<Scene, String> + Sync) -> Result<Evaluation, String> {
     score_screened(make, &|_| true)
 }
 
@@ -576,54 +576,133 @@ pub fn score(make: impl Fn() -> Result<Scene, String>) -> Result<Evaluation, Str
 /// its cell (the robust score is never above it). A scene with `trials`
 /// and `noise` is always scored in full.
 pub fn score_screened(
-    make: impl Fn() -> Result<Scene, String>,
+    make: impl Fn() -> Result<Scene, String> + Sync,
     fine: &dyn Fn(&Evaluation) -> bool,
 ) -> Result<Evaluation, String> {
-    let first = make()?;
-    let spec = first
-        .evolve
-        .clone()
-        .ok_or("the scene has no [evolve] table: nothing to evaluate")?;
-    // Without noise every trial is the same run: one is enough.
-    let perturbed = spec.noise > 0.0;
-    let trials = if perturbed { spec.trials } else { 1 };
-    // Trial k from `scene` (the first build, reused) or a fresh one,
-    // perturbed; robust: again at half the step, the worse counting.
-    let one = |k: u32, scene: Option<Scene>| -> Result<Evaluation, String> {
-        let build = || -> Result<Scene, String> {
-            let mut s = make()?;
-            if perturbed {
-                perturb(&mut s, k)?;
-            }
-            Ok(s)
-        };
-        let full = evaluate(match scene {
-            Some(mut s) => {
+    let make: &Make<'_> = &make;
+    let mut all = score_all(&[make], fine, &engine_runs)?;
+    all.pop().ok_or_else(|| "no evaluation".to_string())
+}
+
+/// Runs many scenes' evaluations and returns them in order: the engine's
+/// [`evaluate`] one by one ([`engine_runs`]), or a batch on another device
+/// (the GPU's, `animats-gpu`), which must give the same bits.
+pub type Runner = dyn Fn(Vec<Scene>) -> Result<Vec<Evaluation>, String> + Send + Sync;
+
+/// Builds one genome's scene, from any thread.
+pub type Make<'a> = dyn Fn() -> Result<Scene, String> + Sync + 'a;
+
+/// The engine's [`Runner`]: [`evaluate`] on each scene, in order, on the
+/// calling thread.
+pub fn engine_runs(scenes: Vec<Scene>) -> Result<Vec<Evaluation>, String> {
+    scenes.into_iter().map(evaluate).collect()
+}
+
+/// [`score_screened`] for many genomes at once, each `makes[g]` building
+/// genome `g`'s scene: every run at the scenes' step handed to `run` in one
+/// batch, then every run at half the step that a robust scene needs in a
+/// second one (a batch shares one step). The same scores as
+/// [`score_screened`] on each genome, where `run` gives the engine's bits.
+pub fn score_all(
+    makes: &[&Make<'_>],
+    fine: &dyn Fn(&Evaluation) -> bool,
+    run: &dyn Fn(Vec<Scene>) -> Result<Vec<Evaluation>, String>,
+) -> Result<Vec<Evaluation>, String> {
+    use rayon::prelude::*;
+    // Every trial of every genome, at the scenes' step, built on the
+    // current rayon pool; the first build of each genome is its first
+    // trial.
+    let built = makes
+        .par_iter()
+        .map(|make| -> Result<(EvolveSpec, Vec<Scene>), String> {
+            let first = make()?;
+            let spec = first
+                .evolve
+                .clone()
+                .ok_or("the scene has no [evolve] table: nothing to evaluate")?;
+            // Without noise every trial is the same run: one is enough.
+            let perturbed = spec.noise > 0.0;
+            let trials = if perturbed { spec.trials } else { 1 };
+            let mut first = Some(first);
+            let mut scenes = Vec::with_capacity(trials as usize);
+            for k in 0..trials {
+                let mut s = match first.take() {
+                    Some(s) => s,
+                    None => make()?,
+                };
                 if perturbed {
                     perturb(&mut s, k)?;
                 }
-                s
+                scenes.push(s);
             }
-            None => build()?,
-        })?;
-        if !spec.robust || (!perturbed && !fine(&full)) {
-            return Ok(full);
-        }
-        let mut fine = build()?;
-        fine.dt *= 0.5;
-        Ok(worse(full, evaluate(fine)?))
-    };
-    let mut first = Some(first);
-    let trials = (0..trials)
-        .map(|k| one(k, first.take()))
+            Ok((spec, scenes))
+        })
         .collect::<Result<Vec<_>, String>>()?;
-    if !perturbed {
-        return trials
-            .into_iter()
-            .next()
-            .ok_or_else(|| "no trial".to_string());
+    let (mut specs, mut coarse, mut trial) = (Vec::new(), Vec::new(), Vec::new());
+    for (g, (spec, scenes)) in built.into_iter().enumerate() {
+        for (k, s) in scenes.into_iter().enumerate() {
+            coarse.push(s);
+            trial.push((g, k as u32));
+        }
+        specs.push(spec);
     }
-    Ok(aggregate(trials, spec.aggregate))
+    let mut runs = run_checked(run, coarse)?;
+    // Robust: again at half the step where it could matter, the worse
+    // counting.
+    let at: Vec<usize> = (0..trial.len())
+        .filter(|&i| {
+            let spec = &specs[trial[i].0];
+            spec.robust && (spec.noise > 0.0 || fine(&runs[i]))
+        })
+        .collect();
+    let finer = at
+        .par_iter()
+        .map(|&i| {
+            let (g, k) = trial[i];
+            let mut s = makes[g]()?;
+            if specs[g].noise > 0.0 {
+                perturb(&mut s, k)?;
+            }
+            s.dt *= 0.5;
+            Ok(s)
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    for (i, e) in at.into_iter().zip(run_checked(run, finer)?) {
+        let full = std::mem::replace(&mut runs[i], e.clone());
+        runs[i] = worse(full, e);
+    }
+    // Each genome's trials, aggregated.
+    let mut runs = runs.into_iter();
+    let mut out = Vec::with_capacity(makes.len());
+    for spec in &specs {
+        if spec.noise > 0.0 {
+            let trials: Vec<Evaluation> = runs.by_ref().take(spec.trials as usize).collect();
+            if trials.is_empty() {
+                return Err("no trial".into());
+            }
+            out.push(aggregate(trials, spec.aggregate));
+        } else {
+            out.push(runs.next().ok_or("no trial")?);
+        }
+    }
+    Ok(out)
+}
+
+/// `run` on `scenes`, which must give one evaluation each (none asked of
+/// an empty batch).
+fn run_checked(
+    run: &dyn Fn(Vec<Scene>) -> Result<Vec<Evaluation>, String>,
+    scenes: Vec<Scene>,
+) -> Result<Vec<Evaluation>, String> {
+    if scenes.is_empty() {
+        return Ok(Vec::new());
+    }
+    let n = scenes.len();
+    let got = run(scenes)?;
+    if got.len() != n {
+        return Err(format!("{} evaluations for {n} scenes", got.len()));
+    }
+    Ok(got)
 }
 
 /// The trials' evaluations as `aggregate` says.
@@ -728,6 +807,20 @@ pub struct SceneProblem {
     /// Per evolved controller, in genome order: its genome's keys.
     keys: Vec<Vec<GenomeKey>>,
     grid: Option<crate::archive::Grid>,
+    /// Where its evaluations run in batches, if not on the engine here.
+    batches: Option<Batches>,
+}
+
+/// A [`Runner`] that a problem hands its evaluations to in batches (one
+/// per generation and step): the GPU's, in place of the engine's one by
+/// one.
+#[derive(Clone)]
+pub struct Batches(pub std::sync::Arc<Runner>);
+
+impl fmt::Debug for Batches {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("Batches(..)")
+    }
 }
 
 impl SceneProblem {
@@ -764,7 +857,32 @@ impl SceneProblem {
             spec: spec.clone(),
             grid: scene.archive.as_ref().map(|a| a.grid.clone()),
             def,
+            batches: None,
         })
+    }
+
+    /// The problem with its evaluations run in `batches`.
+    pub fn on(mut self, batches: Option<Batches>) -> SceneProblem {
+        self.batches = batches;
+        self
+    }
+
+    /// Where its evaluations run in batches, if not on the engine here.
+    pub fn batches(&self) -> Option<&Batches> {
+        self.batches.as_ref()
+    }
+
+    /// [`SceneProblem::evaluate_screened`] on every genome of `genomes`, in
+    /// batches run by `run` ([`score_all`]).
+    pub fn evaluate_all(
+        &self,
+        genomes: &[Vec<f64>],
+        fine: &dyn Fn(&Evaluation) -> bool,
+        run: &Runner,
+    ) -> Result<Vec<Evaluation>, String> {
+        let makes: Vec<_> = genomes.iter().map(|g| move || self.scene(g)).collect();
+        let makes: Vec<&Make<'_>> = makes.iter().map(|m| m as &Make<'_>).collect();
+        score_all(&makes, fine, run)
     }
 
     /// The scene's `[evolve]` table, resolved.

@@ -38,6 +38,8 @@ pub struct MorphologyProblem {
     start: Option<Vec<f64>>,
     spec: EvolveSpec,
     grid: Option<crate::archive::Grid>,
+    /// Where its evaluations run in batches, if not on the engine here.
+    batches: Option<crate::evaluate::Batches>,
 }
 
 impl MorphologyProblem {
@@ -119,6 +121,7 @@ impl MorphologyProblem {
             start,
             spec: placeholder_spec(),
             grid,
+            batches: None,
         };
         if let Some(g) = &problem.start {
             problem.check(g).map_err(|r| {
@@ -138,6 +141,17 @@ impl MorphologyProblem {
         let scene = SceneProblem::parse(&text, file)?;
         problem.spec = scene.spec().clone();
         Ok(problem)
+    }
+
+    /// The problem with its evaluations run in `batches`.
+    pub fn on(mut self, batches: Option<crate::evaluate::Batches>) -> MorphologyProblem {
+        self.batches = batches;
+        self
+    }
+
+    /// Where its evaluations run in batches, if not on the engine here.
+    pub fn batches(&self) -> Option<&crate::evaluate::Batches> {
+        self.batches.as_ref()
     }
 
     /// The scene file's name.
@@ -198,6 +212,33 @@ impl MorphologyProblem {
         let text = self.develop(genes, "")?;
         let problem = SceneProblem::parse(&text, &self.file).map_err(|e| e.to_string())?;
         problem.evaluate_screened(problem.start(), fine)
+    }
+
+    /// [`MorphologyProblem::evaluate_screened`] on every genome of
+    /// `genomes`, in batches run by `run` ([`crate::evaluate::score_all`]).
+    pub fn evaluate_all(
+        &self,
+        genomes: &[Vec<f64>],
+        fine: &dyn Fn(&Evaluation) -> bool,
+        run: &crate::evaluate::Runner,
+    ) -> Result<Vec<Evaluation>, String> {
+        use rayon::prelude::*;
+        let problems = genomes
+            .par_iter()
+            .map(|g| {
+                let text = self.develop(g, "")?;
+                SceneProblem::parse(&text, &self.file).map_err(|e| e.to_string())
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        let makes: Vec<_> = problems
+            .iter()
+            .map(|p| move || p.scene(p.start()))
+            .collect();
+        let makes: Vec<&crate::evaluate::Make<'_>> = makes
+            .iter()
+            .map(|m| m as &crate::evaluate::Make<'_>)
+            .collect();
+        crate::evaluate::score_all(&makes, fine, run)
     }
 
     /// Every check of [`super::check`], the settle last.

@@ -1,0 +1,63 @@
+//! `--device cpu|cuda`: where `evaluate` and `evolve` run a scene's
+//! evaluations. `cpu` (the default) is the engine on every core; `cuda`
+//! hands them to an NVIDIA GPU a batch at a time (a generation's runs at
+//! the scene's step, then those at half of it), one GPU thread per run,
+//! with the same bits (docs/GPU.md).
+
+use animats_creatures::random::Random;
+use animats_evolve::run::ProblemSpec;
+use animats_scene::evaluate::Batches;
+use animats_scene::morphology::MorphologyProblem;
+use animats_scene::Scene;
+
+/// `--device`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum DeviceName {
+    /// The engine, on every core.
+    #[default]
+    Cpu,
+    /// An NVIDIA GPU (its driver and NVRTC are loaded at run time).
+    Cuda,
+}
+
+/// Where the evaluations of `file`'s scene run: `None` on the CPU; on
+/// `cuda`, the GPU, once `probe()` (a scene as the run builds them) is
+/// found to be one the GPU evaluates and a GPU is found. `Err` names the
+/// file and the entry the GPU does not cover, or what is missing (driver,
+/// device, NVRTC).
+pub fn batches(
+    device: DeviceName,
+    file: &str,
+    probe: impl FnOnce() -> Result<Scene, String>,
+) -> Result<Option<Batches>, String> {
+    match device {
+        DeviceName::Cpu => Ok(None),
+        DeviceName::Cuda => {
+            let scene = probe()?;
+            animats_gpu::Batch::pack_scenes(&[&scene]).map_err(|e| {
+                format!(
+                    "{file}: --device cuda: {}",
+                    e.strip_prefix("scene 0: ").unwrap_or(&e)
+                )
+            })?;
+            let device = animats_gpu::Device::open().map_err(|e| format!("--device cuda: {e}"))?;
+            Ok(Some(device.into_batches()))
+        }
+    }
+}
+
+/// A scene of the problem as evolution builds them: the scene's own
+/// brain, or a `[morphology]` scene's start body (a random one if it
+/// starts from random bodies).
+pub fn probe(spec: &ProblemSpec) -> Result<Scene, String> {
+    if !spec.has_morphology()? {
+        return spec.parse()?.fresh();
+    }
+    let m = MorphologyProblem::parse(&spec.text, &spec.file).map_err(|e| e.to_string())?;
+    let genes = match m.start() {
+        Some(g) => g.to_vec(),
+        None => m.random(&mut Random::for_entry(0, 0)),
+    };
+    let text = m.develop(&genes, "")?;
+    animats_scene::parse(&text, &spec.file).map_err(|e| e.to_string())
+}

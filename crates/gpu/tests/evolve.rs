@@ -1,0 +1,88 @@
+//! Evolution with every generation evaluated in batches by the C (what
+//! `--device cuda` does on a GPU, here on the CPU) writes the engine's
+//! log, optimiser state and best to the bit: CMA-ES on the soft walker
+//! with robust evaluation (a batch at the step, then one at half of it for
+//! the candidates that need it) and with perturbed trials, and the body GA
+//! on random bodies.
+
+use animats_evolve::run::{Choices, Config, ProblemSpec, State};
+use animats_evolve::OptimiserKind;
+use animats_scene::evaluate::Batches;
+
+const WALKER: &str = include_str!("../../../scenes/walker.toml");
+const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
+
+/// `generations` of `text` with `choices`, on the engine or in the C's
+/// batches: (log.csv, best.toml, the optimisers' states).
+fn run(text: &str, choices: &Choices, batches: Option<Batches>) -> (String, String, String) {
+    let spec = ProblemSpec {
+        file: "scene.toml".into(),
+        text: text.into(),
+    };
+    let config = Config::new(spec.clone(), choices).unwrap();
+    let generations = config.generations;
+    let mut s = State::new(config).unwrap();
+    let problem = spec.build_on(batches).unwrap();
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| s.advance_with(problem.as_ref(), generations))
+        .unwrap();
+    let lanes = format!("{:?}", s.lanes);
+    (
+        s.log_csv(),
+        s.best_toml().unwrap().unwrap_or_default(),
+        lanes,
+    )
+}
+
+fn assert_same(text: &str, choices: Choices, what: &str) {
+    let engine = run(text, &choices, None);
+    let c = run(text, &choices, Some(animats_gpu::c_batches()));
+    assert_eq!(engine.0, c.0, "{what}: log.csv");
+    assert_eq!(engine.1, c.1, "{what}: best.toml");
+    assert_eq!(engine.2, c.2, "{what}: the lanes");
+    assert!(engine.0.lines().count() > 3, "{what}: {}", engine.0);
+}
+
+fn walker(extra: &str) -> String {
+    WALKER
+        .replace("duration = 10.0", "duration = 1.0")
+        .replace("[evolve]\n", &format!("[evolve]\n{extra}\n"))
+}
+
+#[test]
+fn cma_es_on_the_walker_in_batches_writes_the_engine_s_log() {
+    let choices = Choices {
+        generations: Some(4),
+        population: Some(8),
+        seed: Some(3),
+        lanes: Some(2),
+        optimiser: Some(OptimiserKind::CmaEs),
+        ..Choices::default()
+    };
+    assert_same(&walker("robust = true"), choices.clone(), "robust walker");
+    assert_same(
+        &walker("trials = 3\nnoise = 0.1\nrobust = true"),
+        choices,
+        "perturbed trials",
+    );
+}
+
+#[test]
+fn the_body_ga_in_batches_writes_the_engine_s_log() {
+    // The land task's bodies without the archive (the C does not measure
+    // yet), by the body GA, 1 s each.
+    let start = BODIES_WALK.find("[archive]").unwrap();
+    let text = BODIES_WALK[..start]
+        .replace("duration = 10.0", "duration = 1.0")
+        .replace("optimiser = \"map-elites\"", "optimiser = \"body-ga\"");
+    let choices = Choices {
+        generations: Some(3),
+        population: Some(8),
+        seed: Some(2),
+        ..Choices::default()
+    };
+    assert_same(&text, choices, "body GA");
+}
