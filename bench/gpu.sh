@@ -8,7 +8,9 @@
 # GPU, every fitness compared as bits; the throughput of each; last the
 # soft walker evolved on the GPU, 16,384 candidates a generation, against
 # the README's CPU run (scenes/walker.toml's header), wall time and
-# distance of each.
+# distance of each; and short evolutions of the walker and of bodies
+# (MAP-Elites, the archive's measures) on the GPU and on the CPU with the
+# same seed: log.csv and best.toml compared byte for byte.
 #
 # Builds nothing: it takes the examples built here, carried in an ignored
 # folder:
@@ -70,6 +72,21 @@ for device in cuda cpu; do
   echo "wall $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }') s, exit $rc"
   [ $rc -eq 0 ] && reached "$T/$device"
   [ $rc -gt $status ] && status=$rc
+done
+# Same seed, same log and best on the GPU as on the CPU (strict mode).
+for run in "scenes/walker.toml --optimiser cma-es --generations 20" "scenes/bodies_walk.toml --generations 4 --population 256"; do
+  echo "== evolve $run --seed 2: GPU against CPU"
+  for device in cuda cpu; do
+    # shellcheck disable=SC2086
+    "$A" evolve $run --seed 2 --device $device --out "$T/same-$device" >/dev/null 2>&1 || { echo "evolve on $device failed"; status=1; }
+  done
+  if cmp -s "$T/same-cuda/log.csv" "$T/same-cpu/log.csv" && cmp -s "$T/same-cuda/best.toml" "$T/same-cpu/best.toml"; then
+    echo "log.csv and best.toml identical ($(wc -l < "$T/same-cpu/log.csv") lines)"
+  else
+    echo "log.csv or best.toml DIFFER"
+    status=1
+  fi
+  rm -rf "$T/same-cuda" "$T/same-cpu"
 done
 rm -rf "$T"
 exit $status

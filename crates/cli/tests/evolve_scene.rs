@@ -156,7 +156,7 @@ fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
     let out = dir.join("x");
     let o = animats(&[
         "evolve",
-        "scenes/bodies_walk.toml",
+        "scenes/quadruped3_gait.toml",
         "--device",
         "cuda",
         "--generations",
@@ -165,7 +165,7 @@ fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o).1.contains("[archive] measures"), "{}", text(&o).1);
+    assert!(text(&o).1.contains("the creature `dog`"), "{}", text(&o).1);
     assert!(!out.join("log.csv").exists());
     let cpu = animats(&["evaluate", "scenes/walker.toml", "--json"]);
     let gpu = animats(&[

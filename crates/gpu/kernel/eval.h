@@ -7,9 +7,10 @@
  * muscle's rate and clamped to [0, 1], the spring's rest length set), the
  * world steps, its clock advances (Kahan), the divergence guard checks
  * every 64th step (engine/src/guard.rs: a driven world's speed limit),
- * then the centre of the particles that count is taken and the end rules
+ * then the measures record the step (scene/src/archive.rs, Recorder), the
+ * centre of the particles that count is taken and the end rules
  * (fail_on_touch, then fail_on_stretch) are tried. The fitness is the
- * [evolve] table's time and distance terms. What this file does not cover
+ * [evolve] table's time and distance terms plus its measure terms. What this file does not cover
  * is refused when a scene is packed (crates/gpu/src/scenes.rs).
  */
 #ifndef ANIMATS_EVAL_H
@@ -74,22 +75,22 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
     }
 }
 
-/* scene::evaluate::centre_at: the centre of mass of the particles that
- * count (of one: its position; of massless ones: their mean). */
-AN_FN void an_centre(const an_batch *b, long long c, double *out) {
-    long long p0 = b->first_particle[c];
-    long long k0 = b->first_centre[c], nk = b->first_centre[c + 1] - k0;
+/* scene::evaluate::centre_at: the centre of mass of particles ids[0 ..
+ * nk - 1] of the creature whose particles begin at p0 (of one: its
+ * position; of massless ones: their mean). */
+AN_FN void an_centre_of(const an_batch *b, long long p0, const int *ids, long long nk,
+                        double *out) {
     const double *x = b->pos + 3 * p0;
     if (nk == 1) {
-        long long p = b->centre_particle[k0];
+        long long p = ids[0];
         for (int d = 0; d < 3; d++) {
             out[d] = x[3 * p + d];
         }
         return;
     }
     double sum[3] = {0.0, 0.0, 0.0}, m = 0.0;
-    for (long long k = k0; k < k0 + nk; k++) {
-        long long p = b->centre_particle[k];
+    for (long long k = 0; k < nk; k++) {
+        long long p = ids[k];
         double mp = b->mass[p0 + p];
         for (int d = 0; d < 3; d++) {
             sum[d] = sum[d] + x[3 * p + d] * mp;
@@ -99,6 +100,106 @@ AN_FN void an_centre(const an_batch *b, long long c, double *out) {
     double by = m > 0.0 ? m : (double)(nk > 1 ? nk : 1);
     for (int d = 0; d < 3; d++) {
         out[d] = sum[d] / by;
+    }
+}
+
+/* The centre of the particles of [evolve] that count. */
+AN_FN void an_centre(const an_batch *b, long long c, double *out) {
+    long long k0 = b->first_centre[c];
+    an_centre_of(b, b->first_particle[c], b->centre_particle + k0, b->first_centre[c + 1] - k0,
+                 out);
+}
+
+/* Measures (scene/src/archive.rs, `Measure`), as packed. */
+enum {
+    AN_M_CONTACT = 0,      /* contact_fraction: one particle's steps on the floor */
+    AN_M_FEET = 1,         /* feet: particles on the floor, a step */
+    AN_M_DISPLACEMENT = 2, /* the centre's final offset along an axis */
+    AN_M_MEAN_HEIGHT = 3,  /* the centre's height, a step */
+    AN_M_SPEED = 4,        /* the displacement over the time survived */
+    AN_M_FIXED = 5         /* particles, muscles, mass, size: fixed when built */
+};
+
+/* Measure q's particles and their number. */
+AN_FN const int *an_measure_ids(const an_batch *b, long long q, long long *nk) {
+    long long k0 = b->measure_first_id[q];
+    *nk = b->measure_first_id[q + 1] - k0;
+    return b->measure_id + k0;
+}
+
+/* Whether particle p (within the creature whose particles begin at p0)
+ * touches the flat floor within `tolerance` (World::clearance). */
+AN_FN int an_on_floor(const an_batch *b, long long p0, long long p, double tolerance) {
+    return b->pos[3 * (p0 + p) + 1] - b->radius[p0 + p] <= tolerance;
+}
+
+/* Recorder::new: the centres that displacements and speeds start from. */
+AN_FN void an_measures_begin(const an_batch *b, long long c) {
+    long long p0 = b->first_particle[c];
+    for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
+        long long nk;
+        const int *ids = an_measure_ids(b, q, &nk);
+        b->measure_sum[q] = 0.0;
+        int kind = b->measure_kind[q];
+        if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
+            an_centre_of(b, p0, ids, nk, b->measure_start + 3 * q);
+        }
+    }
+}
+
+/* Recorder::step: after each step. */
+AN_FN void an_measures_step(const an_batch *b, long long c) {
+    long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
+    double tolerance = b->eval_param[8 * c + 5];
+    for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
+        long long nk;
+        const int *ids = an_measure_ids(b, q, &nk);
+        int kind = b->measure_kind[q];
+        if (kind == AN_M_CONTACT) {
+            if (an_on_floor(b, p0, ids[0], tolerance)) {
+                b->measure_sum[q] = b->measure_sum[q] + 1.0;
+            }
+        } else if (kind == AN_M_FEET) {
+            long long count = 0;
+            for (long long i = 0; i < n; i++) {
+                if (b->inv_mass[p0 + i] > 0.0 && an_on_floor(b, p0, i, tolerance)) {
+                    count++;
+                }
+            }
+            b->measure_sum[q] = b->measure_sum[q] + (double)count;
+        } else if (kind == AN_M_MEAN_HEIGHT) {
+            double at[3];
+            an_centre_of(b, p0, ids, nk, at);
+            b->measure_sum[q] = b->measure_sum[q] + at[1];
+        }
+    }
+}
+
+/* Recorder::finish: each measure's value, after `steps` steps and `time`
+ * survived, into measure_sum. */
+AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, double time) {
+    long long p0 = b->first_particle[c];
+    for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
+        long long nk;
+        const int *ids = an_measure_ids(b, q, &nk);
+        int kind = b->measure_kind[q];
+        double value;
+        if (kind == AN_M_CONTACT || kind == AN_M_FEET || kind == AN_M_MEAN_HEIGHT) {
+            value = steps == 0 ? 0.0 : b->measure_sum[q] / (double)steps;
+        } else if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
+            double at[3], moved[3];
+            an_centre_of(b, p0, ids, nk, at);
+            for (int d = 0; d < 3; d++) {
+                moved[d] = at[d] - b->measure_start[3 * q + d];
+            }
+            value = an_dot(moved, b->measure_axis + 3 * q);
+            if (kind == AN_M_SPEED) {
+                value = time > 0.0 ? value / time : 0.0;
+            }
+        } else {
+            value = b->measure_fixed[q];
+        }
+        b->measure_sum[q] = value;
     }
 }
 
@@ -147,13 +248,14 @@ AN_FN int an_guard(const an_batch *b, long long c) {
 AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     const double *param = b->eval_param + 8 * c;
     double dt = b->dt, t = param[6], carry = param[7];
-    long long steps = b->eval_count[2 * c], taken = b->eval_count[2 * c + 1];
+    long long steps = b->eval_count[3 * c], taken = b->eval_count[3 * c + 1];
     long long done = 0, which = 0;
     double start[3], last[3], now[3];
     an_centre(b, c, start);
     for (int d = 0; d < 3; d++) {
         last[d] = start[d];
     }
+    an_measures_begin(b, c);
     int why = an_ending(b, c, &which);
     if (why == AN_TIMEOUT) {
         while (done < steps) {
@@ -173,6 +275,7 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
                 break;
             }
             done++;
+            an_measures_step(b, c);
             an_centre(b, c, now);
             if (!(now[0] - now[0] == 0.0 && now[1] - now[1] == 0.0 && now[2] - now[2] == 0.0)) {
                 why = AN_BLOWUP;
@@ -196,7 +299,14 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     if (why == AN_BLOWUP) {
         distance = distance < 0.0 ? distance : 0.0;
     }
-    b->result[3 * c] = param[3] * time + param[4] * distance;
+    an_measures_finish(b, c, done, time);
+    double fitness = param[3] * time + param[4] * distance;
+    /* The terms, after the archive's measures: each times its weight. */
+    for (long long q = b->first_measure[c] + b->eval_count[3 * c + 2]; q < b->first_measure[c + 1];
+         q++) {
+        fitness = fitness + b->measure_weight[q] * b->measure_sum[q];
+    }
+    b->result[3 * c] = fitness;
     b->result[3 * c + 1] = distance;
     b->result[3 * c + 2] = time;
     b->ended[2 * c] = why;

@@ -117,9 +117,19 @@ typedef struct {
     const int *fixed;              /* per particle: 1 where fixed (the guard skips it) */
     const double *eval_param;      /* 8 per creature: axis x, y, z, time and distance
                                       weights, touch tolerance, clock and its carry */
-    const long long *eval_count;   /* 2 per creature: steps to run, steps taken before */
+    const long long *eval_count;   /* 3 per creature: steps to run, steps taken before,
+                                      measures of the archive (the rest are terms) */
     double *result;                /* 3 per creature: fitness, distance, time */
     long long *ended;              /* 2 per creature: why (AN_TIMEOUT ...) and which rule */
+    const long long *first_measure; /* per creature: its archive measures, then its terms */
+    const int *measure_kind;        /* AN_M_CONTACT ... */
+    const long long *measure_first_id; /* per measure, over the batch: its particles */
+    const int *measure_id;
+    const double *measure_axis;     /* 3 per measure */
+    const double *measure_fixed;    /* a measure fixed when built: its value */
+    const double *measure_weight;   /* a term's weight in the fitness */
+    double *measure_sum;            /* per measure: its running sum, then its value */
+    double *measure_start;          /* 3 per measure: the centre it starts from */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */

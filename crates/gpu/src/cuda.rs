@@ -142,7 +142,8 @@ impl Device {
         batch.set_state(&pos, &vel, &failed);
         let result = download_f64(s, &on_device, Array::Result)?;
         let ended = download_i64(s, &on_device, Array::Ended)?;
-        batch.set_results(&result, &ended);
+        let measures = download_f64(s, &on_device, Array::MeasureSum)?;
+        batch.set_results(&result, &ended, &measures);
         Ok(batch.evaluations())
     }
 }

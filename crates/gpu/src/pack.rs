@@ -85,6 +85,15 @@ pub(crate) struct Raw {
     eval_count: *const c_longlong,
     result: *mut c_double,
     ended: *mut c_longlong,
+    first_measure: *const c_longlong,
+    measure_kind: *const c_int,
+    measure_first_id: *const c_longlong,
+    measure_id: *const c_int,
+    measure_axis: *const c_double,
+    measure_fixed: *const c_double,
+    measure_weight: *const c_double,
+    measure_sum: *mut c_double,
+    measure_start: *mut c_double,
 }
 
 extern "C" {
@@ -404,6 +413,8 @@ impl Batch {
             Array::MuscleLevel => self.ev.muscle_level.as_mut_ptr() as u64,
             Array::Result => self.ev.result.as_mut_ptr() as u64,
             Array::Ended => self.ev.ended.as_mut_ptr() as u64,
+            Array::MeasureSum => self.ev.measure_sum.as_mut_ptr() as u64,
+            Array::MeasureStart => self.ev.measure_start.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -478,6 +489,15 @@ impl Batch {
             Array::EvalCount => I64(&self.ev.eval_count),
             Array::Result => F64(&self.ev.result),
             Array::Ended => I64(&self.ev.ended),
+            Array::FirstMeasure => I64(&self.ev.first_measure),
+            Array::MeasureKind => I32(&self.ev.measure_kind),
+            Array::MeasureFirstId => I64(&self.ev.measure_first_id),
+            Array::MeasureId => I32(&self.ev.measure_id),
+            Array::MeasureAxis => F64(&self.ev.measure_axis),
+            Array::MeasureFixed => F64(&self.ev.measure_fixed),
+            Array::MeasureWeight => F64(&self.ev.measure_weight),
+            Array::MeasureSum => F64(&self.ev.measure_sum),
+            Array::MeasureStart => F64(&self.ev.measure_start),
         }
     }
 
@@ -592,6 +612,15 @@ impl Batch {
             eval_count: l(Array::EvalCount),
             result: m(Array::Result),
             ended: at(Array::Ended) as *mut c_longlong,
+            first_measure: l(Array::FirstMeasure),
+            measure_kind: i(Array::MeasureKind),
+            measure_first_id: l(Array::MeasureFirstId),
+            measure_id: i(Array::MeasureId),
+            measure_axis: c(Array::MeasureAxis),
+            measure_fixed: c(Array::MeasureFixed),
+            measure_weight: c(Array::MeasureWeight),
+            measure_sum: m(Array::MeasureSum),
+            measure_start: m(Array::MeasureStart),
         }
     }
 }
@@ -711,11 +740,20 @@ pub(crate) enum Array {
     EvalCount,
     Result,
     Ended,
+    FirstMeasure,
+    MeasureKind,
+    MeasureFirstId,
+    MeasureId,
+    MeasureAxis,
+    MeasureFixed,
+    MeasureWeight,
+    MeasureSum,
+    MeasureStart,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 62] = [
+    pub(crate) const ALL: [Array; 71] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -778,6 +816,15 @@ impl Array {
         Array::EvalCount,
         Array::Result,
         Array::Ended,
+        Array::FirstMeasure,
+        Array::MeasureKind,
+        Array::MeasureFirstId,
+        Array::MeasureId,
+        Array::MeasureAxis,
+        Array::MeasureFixed,
+        Array::MeasureWeight,
+        Array::MeasureSum,
+        Array::MeasureStart,
     ];
 }
 

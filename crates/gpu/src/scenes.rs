@@ -8,13 +8,15 @@
 //! Covered: spring muscles (a spring's rest length between `min` and
 //! `max`, with or without a `rate`), oscillator brains, the centre of the
 //! particles that count, `fail_on_touch` and `fail_on_stretch`, the
-//! divergence guard of a driven scene, and the fitness's time and distance
-//! terms. Anything else a scene holds is refused when it is packed, with a
+//! divergence guard of a driven scene, the `[archive]` measures and
+//! `[evolve] terms` but `energy`, and the fitness's time, distance and
+//! measure terms. Anything else a scene holds is refused when it is packed, with a
 //! message naming the scene and the entry.
 
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
-use animats_engine::World;
+use animats_engine::{DVec3, ParticleId, World};
+use animats_scene::archive::{Measure, Recorder};
 use animats_scene::evaluate::{Batches, Ended, Evaluation};
 use animats_scene::Scene;
 use std::os::raw::c_longlong;
@@ -47,6 +49,15 @@ pub(crate) struct Rules {
     pub(crate) eval_count: Vec<i64>,
     pub(crate) result: Vec<f64>,
     pub(crate) ended: Vec<i64>,
+    pub(crate) first_measure: Vec<i64>,
+    pub(crate) measure_kind: Vec<i32>,
+    pub(crate) measure_first_id: Vec<i64>,
+    pub(crate) measure_id: Vec<i32>,
+    pub(crate) measure_axis: Vec<f64>,
+    pub(crate) measure_fixed: Vec<f64>,
+    pub(crate) measure_weight: Vec<f64>,
+    pub(crate) measure_sum: Vec<f64>,
+    pub(crate) measure_start: Vec<f64>,
     /// Per creature: its `fail_on_touch` particles' names and its
     /// `fail_on_stretch` rules' names, for [`Ended`].
     names: Vec<(Vec<String>, Vec<String>)>,
@@ -69,12 +80,14 @@ impl Rules {
             &mut self.first_centre,
             &mut self.first_touch,
             &mut self.first_stretch,
+            &mut self.first_measure,
         ] {
             *offsets = vec![0; creatures + 1];
         }
         self.first_output = vec![0];
+        self.measure_first_id = vec![0];
         self.eval_param = vec![0.0; 8 * creatures];
-        self.eval_count = vec![0; 2 * creatures];
+        self.eval_count = vec![0; 3 * creatures];
         self.result = vec![0.0; 3 * creatures];
         self.ended = vec![0; 2 * creatures];
     }
@@ -96,12 +109,9 @@ impl Rules {
                 "{who} (roobot, quadruped, jellyfish or bubble column) is not in the GPU evaluation yet"
             ));
         }
-        if scene.archive.is_some() {
-            return Err("[archive] measures are not in the GPU evaluation yet".into());
-        }
-        if spec.energy_weight != 0.0 || !spec.terms.is_empty() || spec.target.is_some() {
+        if spec.energy_weight != 0.0 || spec.target.is_some() {
             return Err(
-                "[evolve] energy_weight, target and terms are not in the GPU evaluation yet".into(),
+                "[evolve] energy_weight and target are not in the GPU evaluation yet".into(),
             );
         }
         let nervous = &scene.nervous;
@@ -172,16 +182,66 @@ impl Rules {
             clock.time,
             clock.time_carry,
         ]);
+        // The archive's measures, then the terms of the fitness.
+        let archive: &[Measure] = scene.archive.as_ref().map_or(&[], |a| &a.measures);
+        let muscles = nervous.actuators.len();
+        for m in archive {
+            self.add_measure(m, 0.0, spec, world, muscles)?;
+        }
+        for (w, m) in &spec.terms {
+            self.add_measure(m, *w, spec, world, muscles)?;
+        }
         let steps = (spec.duration / scene.dt).round() as u64;
         self.eval_count.extend([
             steps.min(i64::MAX as u64) as i64,
             world.stats().steps as i64,
+            archive.len() as i64,
         ]);
         self.first_muscle.push(self.muscle_spring.len() as i64);
         self.first_osc.push(self.osc_frequency.len() as i64);
         self.first_centre.push(self.centre_particle.len() as i64);
         self.first_touch.push(self.touch_particle.len() as i64);
         self.first_stretch.push(self.stretch_length.len() as i64);
+        self.first_measure.push(self.measure_kind.len() as i64);
+        Ok(())
+    }
+
+    /// Appends measure `m` (of weight `w` in the fitness, for a term).
+    fn add_measure(
+        &mut self,
+        m: &Measure,
+        w: f64,
+        spec: &animats_scene::evaluate::EvolveSpec,
+        world: &World,
+        muscles: usize,
+    ) -> Result<(), String> {
+        let (kind, ids, axis): (i32, &[ParticleId], DVec3) =
+            match m {
+                Measure::ContactFraction(p) => (0, std::slice::from_ref(p), DVec3::ZERO),
+                Measure::Feet => (1, &[], DVec3::ZERO),
+                Measure::Displacement(ids, axis) => (2, ids, *axis),
+                Measure::MeanHeight(ids) => (3, ids, DVec3::ZERO),
+                Measure::Speed(ids, axis) => (4, ids, *axis),
+                Measure::Particles | Measure::Muscles | Measure::Mass | Measure::Size => {
+                    (5, &[], DVec3::ZERO)
+                }
+                Measure::Energy => return Err(
+                    "the measure `energy` (the actuators' work) is not in the GPU evaluation yet"
+                        .into(),
+                ),
+            };
+        // A measure fixed when built: the engine's own value.
+        let fixed = if kind == 5 {
+            Recorder::new(std::slice::from_ref(m), spec, world, muscles).finish(world, 0.0, 0.0)[0]
+        } else {
+            0.0
+        };
+        self.measure_kind.push(kind);
+        self.measure_id.extend(ids.iter().map(|p| p.index() as i32));
+        self.measure_first_id.push(self.measure_id.len() as i64);
+        self.measure_axis.extend(axis.to_array());
+        self.measure_fixed.push(fixed);
+        self.measure_weight.push(w);
         Ok(())
     }
 }
@@ -214,11 +274,15 @@ impl Batch {
             first_centre: vec![0],
             first_touch: vec![0],
             first_stretch: vec![0],
+            first_measure: vec![0],
+            measure_first_id: vec![0],
             ..Rules::default()
         };
         for (k, s) in scenes.iter().enumerate() {
             r.add(s).map_err(|e| format!("scene {k}: {e}"))?;
         }
+        r.measure_sum = vec![0.0; r.measure_kind.len()];
+        r.measure_start = vec![0.0; 3 * r.measure_kind.len()];
         r.result = vec![0.0; 3 * scenes.len()];
         r.ended = vec![0; 2 * scenes.len()];
         r.ready = true;
@@ -261,11 +325,16 @@ impl Batch {
         Ok(())
     }
 
-    /// Results and endings written back (from a GPU).
-    pub(crate) fn set_results(&mut self, result: &[f64], ended: &[i64]) {
-        let (r, e) = (self.ev.result.len(), self.ev.ended.len());
+    /// Results, endings and measures written back (from a GPU).
+    pub(crate) fn set_results(&mut self, result: &[f64], ended: &[i64], measures: &[f64]) {
+        let (r, e, m) = (
+            self.ev.result.len(),
+            self.ev.ended.len(),
+            self.ev.measure_sum.len(),
+        );
         self.ev.result.copy_from_slice(&result[..r]);
         self.ev.ended.copy_from_slice(&ended[..e]);
+        self.ev.measure_sum.copy_from_slice(&measures[..m]);
     }
 
     /// The evaluations the C wrote.
@@ -282,15 +351,20 @@ impl Batch {
                     3 => Ended::BlowUp,
                     _ => Ended::Timeout,
                 };
+                let (m0, m1) = (
+                    self.ev.first_measure[c] as usize,
+                    self.ev.first_measure[c + 1] as usize,
+                );
+                let split = m0 + self.ev.eval_count[3 * c + 2] as usize;
                 Evaluation {
                     fitness: r[0],
                     distance: r[1],
                     time: r[2],
                     ended,
-                    measures: Vec::new(),
+                    measures: self.ev.measure_sum[m0..split].to_vec(),
                     energy: None,
                     target_distance: None,
-                    terms: Vec::new(),
+                    terms: self.ev.measure_sum[split..m1].to_vec(),
                 }
             })
             .collect()

@@ -29,7 +29,16 @@ fn assert_same(scenes: Vec<Scene>, what: &str) -> Vec<Evaluation> {
             last = Some((s.world.state().pos.clone(), s.world.state().vel.clone()))
         })
         .unwrap();
-        let bits = |e: &Evaluation| [e.fitness, e.distance, e.time].map(f64::to_bits);
+        let bits = |e: &Evaluation| {
+            let mut b: Vec<u64> = [e.fitness, e.distance, e.time]
+                .iter()
+                .chain(&e.measures)
+                .chain(&e.terms)
+                .map(|x| x.to_bits())
+                .collect();
+            b.push(e.measures.len() as u64);
+            b
+        };
         assert!(
             bits(&got[c]) == bits(&e) && got[c].ended == e.ended,
             "{what}: scene {c}: C {:?}; engine {e:?}",
@@ -140,10 +149,45 @@ fn end_rules_and_blow_ups_end_as_the_engine_s() {
 }
 
 #[test]
+fn every_measure_but_energy_and_every_term_are_the_engine_s_to_the_bit() {
+    let archive = r#"
+[archive]
+measures = [
+  { kind = "contact_fraction", particle = "foot_fl" },
+  { kind = "feet" },
+  { kind = "displacement" },
+  { kind = "displacement", particles = ["foot_bl", "foot_br", "hip_b"], axis = [0.6, 0.0, 0.8] },
+  { kind = "mean_height", particles = ["hip_f"] },
+  { kind = "speed" },
+  { kind = "particles" },
+  { kind = "muscles" },
+  { kind = "mass" },
+  { kind = "size" },
+]
+bins = [2, 2, 2, 2, 2, 2, 2, 2, 2, 2]
+ranges = [[0.0, 1.0], [0.0, 6.0], [-1.0, 1.0], [-1.0, 1.0], [0.0, 0.3], [-1.0, 1.0], [0.0, 9.0], [0.0, 9.0], [0.0, 2.0], [0.0, 1.0]]
+"#;
+    let terms = "terms = [{ kind = \"mean_height\", particles = [\"hip_b\"], weight = 20.0 }, { kind = \"feet\", weight = -0.5 }, { kind = \"size\", weight = 3.0 }]";
+    let text = walker(2.0, "symplectic", "").replace("[evolve]\n", &format!("[evolve]\n{terms}\n"))
+        + archive;
+    let got = assert_same(genomes(&text, 12, 4), "walker with measures and terms");
+    assert!(got
+        .iter()
+        .all(|e| e.measures.len() == 10 && e.terms.len() == 3));
+    // The measures vary with the genome (not constants).
+    for m in [0, 1, 2, 4, 5] {
+        let mut v: Vec<u64> = got.iter().map(|e| e.measures[m].to_bits()).collect();
+        v.sort_unstable();
+        v.dedup();
+        assert!(v.len() > 3, "measure {m}: {got:?}");
+    }
+}
+
+#[test]
 fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     // The land task's random starts, 2 s each: spring muscles driven by
-    // oscillators, self-contact, the floor; scored without the archive's
-    // measures (the C does not take them yet).
+    // oscillators, self-contact, the floor, and the archive's measures
+    // (feet on the floor, size).
     let text = BODIES_WALK.replace("duration = 10.0", "duration = 2.0");
     let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
     let mut rng = Random::for_entry(11, 0);
@@ -151,9 +195,7 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     while scenes.len() < 16 {
         let genes = problem.random(&mut rng);
         let body = problem.develop(&genes, "").unwrap();
-        let mut scene = animats_scene::parse(&body, "body.toml").unwrap();
-        scene.archive = None;
-        scenes.push(scene);
+        scenes.push(animats_scene::parse(&body, "body.toml").unwrap());
     }
     let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
     let got = assert_same(scenes, &format!("random bodies {sizes:?}"));
@@ -164,22 +206,27 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
 
 #[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
-    // An archive's measures.
-    let text = BODIES_WALK.to_string();
+    // The energy measure, the energy weight.
+    let text = BODIES_WALK.replace("{ kind = \"size\" }", "{ kind = \"energy\" }");
     let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
     let genes = problem.random(&mut Random::for_entry(1, 0));
     let scene = animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap();
     let err = Batch::pack_scenes(&[&scene]).unwrap_err();
-    assert!(
-        err.contains("scene 0") && err.contains("[archive]"),
-        "{err}"
-    );
+    assert!(err.contains("scene 0") && err.contains("`energy`"), "{err}");
+    let tired =
+        walker(2.0, "symplectic", "").replace("[evolve]\n", "[evolve]\nenergy_weight = 0.1\n");
+    let scene = SceneProblem::parse(&tired, "w.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
+    let err = Batch::pack_scenes(&[&scene]).unwrap_err();
+    assert!(err.contains("energy_weight"), "{err}");
+    let text = BODIES_WALK.to_string();
     // A neural brain.
     let neural = text.replace("controller = \"oscillator\"", "controller = \"neural\"");
     let problem = MorphologyProblem::parse(&neural, "bodies_walk.toml").unwrap();
     let genes = problem.random(&mut Random::for_entry(1, 0));
-    let mut scene = animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap();
-    scene.archive = None;
+    let scene = animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap();
     let walker = SceneProblem::parse(WALKER, "walker.toml")
         .unwrap()
         .fresh()

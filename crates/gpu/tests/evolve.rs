@@ -2,8 +2,9 @@
 //! `--device cuda` does on a GPU, here on the CPU) writes the engine's
 //! log, optimiser state and best to the bit: CMA-ES on the soft walker
 //! with robust evaluation (a batch at the step, then one at half of it for
-//! the candidates that need it) and with perturbed trials, and the body GA
-//! on random bodies.
+//! the candidates that need it) and with perturbed trials, the body GA on
+//! random bodies, and MAP-Elites over bodies (its archive in the lanes'
+//! state).
 
 use animats_evolve::run::{Choices, Config, ProblemSpec, State};
 use animats_evolve::OptimiserKind;
@@ -68,6 +69,19 @@ fn cma_es_on_the_walker_in_batches_writes_the_engine_s_log() {
         choices,
         "perturbed trials",
     );
+}
+
+#[test]
+fn map_elites_over_bodies_in_batches_writes_the_engine_s_log_and_archive() {
+    // The shipped land task (feet on the floor against size), 1 s each.
+    let text = BODIES_WALK.replace("duration = 10.0", "duration = 1.0");
+    let choices = Choices {
+        generations: Some(3),
+        population: Some(8),
+        seed: Some(4),
+        ..Choices::default()
+    };
+    assert_same(&text, choices, "MAP-Elites over bodies");
 }
 
 #[test]
