@@ -6,6 +6,7 @@ use crate::scene::{no_evolve, Scene};
 use crate::{on, pool, runtime_error, scene_error, value_error};
 use animats_evolve::screen::Screen;
 use animats_evolve::{Outcome, Problem, ProblemSpec};
+use animats_scene::evaluate::{score_all, Batches, Make};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -132,6 +133,13 @@ pub(crate) fn outcomes(
             )));
         }
     }
+    if screens.is_none() {
+        // A problem on a GPU evaluates the genomes as one batch.
+        let all = Screen::All;
+        if let Some(batch) = py.detach(|| on(pool, || problem.evaluate_population(&rows, &all))) {
+            return batch.map_err(runtime_error);
+        }
+    }
     py.detach(|| {
         on(pool, || {
             rows.par_iter()
@@ -157,20 +165,61 @@ pub(crate) fn read_screens(texts: Option<Vec<String>>) -> PyResult<Option<Vec<Sc
         .transpose()
 }
 
+/// `device`: `None` for "cpu", the GPU's batches for "cuda" (opened once
+/// a process: the kernel is compiled then); a `RuntimeError` says what is
+/// missing (driver, device, NVRTC).
+pub(crate) fn device_batches(device: &str) -> PyResult<Option<Batches>> {
+    static GPU: std::sync::OnceLock<Result<Batches, String>> = std::sync::OnceLock::new();
+    match device {
+        "cpu" => Ok(None),
+        "cuda" => GPU
+            .get_or_init(|| animats_gpu::Device::open().map(animats_gpu::Device::into_batches))
+            .clone()
+            .map(Some)
+            .map_err(|e| runtime_error(format!("device=\"cuda\": {e}"))),
+        other => Err(value_error(format!(
+            "device={other:?}: \"cpu\" (the engine) or \"cuda\" (an NVIDIA GPU)"
+        ))),
+    }
+}
+
 /// `animats.evaluate_scenes`: each complete scene text (any bodies, as a
 /// researcher's own encoding writes them) evaluated by its `[evolve]`
-/// table, in parallel on `threads` threads with the GIL released: the
-/// same bits as `animats evaluate` on each. A text that is not a scene,
-/// or has no `[evolve]` table, raises `SceneError` naming its index.
+/// table, in parallel on `threads` threads with the GIL released (or, with
+/// `device="cuda"`, as batches on the GPU): the same bits as `animats
+/// evaluate` on each. A text that is not a scene, or has no `[evolve]`
+/// table, raises `SceneError` naming its index; one the GPU does not
+/// evaluate, a `RuntimeError` naming the entry.
 #[pyfunction]
-#[pyo3(signature = (texts, threads = None))]
+#[pyo3(signature = (texts, threads = None, device = "cpu"))]
 pub fn evaluate_scenes<'py>(
     py: Python<'py>,
     texts: Vec<String>,
     threads: Option<usize>,
+    device: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let pool = pool(threads)?;
     let files: Vec<String> = (0..texts.len()).map(|k| format!("<scene {k}>")).collect();
+    if let Some(b) = device_batches(device)? {
+        for (text, file) in texts.iter().zip(&files) {
+            let scene = animats_scene::parse(text, file).map_err(|e| scene_error(e.to_string()))?;
+            if scene.evolve.is_none() {
+                return Err(scene_error(format!(
+                    "{file}: the scene has no [evolve] table: nothing to evaluate"
+                )));
+            }
+        }
+        let makes: Vec<_> = texts
+            .iter()
+            .zip(&files)
+            .map(|(text, file)| move || animats_scene::parse(text, file).map_err(|e| e.to_string()))
+            .collect();
+        let makes: Vec<&Make<'_>> = makes.iter().map(|m| m as &Make<'_>).collect();
+        let o = py
+            .detach(|| on(&pool, || score_all(&makes, &|_| true, &*b.0)))
+            .map_err(runtime_error)?;
+        return outcome_dict(py, &o);
+    }
     let results: Vec<Result<Outcome, String>> = py.detach(|| {
         on(&pool, || {
             texts
@@ -204,7 +253,7 @@ fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
 /// With `measures`, a tuple: the fitness and the `(P, k)` array of the
 /// scene's `[archive]` measures.
 #[pyfunction]
-#[pyo3(signature = (scene, genomes, threads = None, measures = false, clip = false))]
+#[pyo3(signature = (scene, genomes, threads = None, measures = false, clip = false, device = "cpu"))]
 pub fn evaluate<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyAny>,
@@ -212,8 +261,12 @@ pub fn evaluate<'py>(
     threads: Option<usize>,
     measures: bool,
     clip: bool,
+    device: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let problem = build(&problem_spec(scene)?)?;
+    let batches = device_batches(device)?;
+    let problem = problem_spec(scene)?
+        .build_on(batches)
+        .map_err(scene_error)?;
     if measures && problem.grid().is_none() {
         return Err(value_error(
             "measures=True: the scene has no [archive] table naming its measures",

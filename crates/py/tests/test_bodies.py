@@ -89,6 +89,25 @@ def test_evaluate_scenes_scores_texts_as_evaluate_scores_files(cli, small, tmp_p
     assert animats.evaluate_scenes([])["fitness"].shape == (0,)
 
 
+def test_device_cuda_gives_the_cpu_s_bits_or_says_what_is_missing():
+    walker = (animats_root() / "scenes" / "walker.toml").read_text()
+    scene = animats.load(animats_root() / "scenes" / "walker.toml")
+    with pytest.raises(ValueError, match='device="tpu"'):
+        animats.evaluate_scenes([walker], device="tpu")
+    try:
+        gpu = animats.evaluate_scenes([walker], device="cuda")
+    except RuntimeError as e:  # no GPU here (CI has none): what is missing
+        assert "device=\"cuda\"" in str(e)
+        assert any(w in str(e) for w in ("driver", "device", "NVRTC")), e
+        with pytest.raises(RuntimeError, match="driver|device|NVRTC"):
+            animats.evaluate(scene, scene.start(), device="cuda")
+        return
+    cpu = animats.evaluate_scenes([walker])
+    assert gpu["fitness"].tolist() == cpu["fitness"].tolist()
+    g = scene.start()[None, :]
+    assert animats.evaluate(scene, g, device="cuda").tolist() == animats.evaluate(scene, g).tolist()
+
+
 def animats_root():
     import pathlib
 

@@ -76,7 +76,12 @@ SceneLike = Union[Scene, str, "os.PathLike[str]"]
 
 
 def evaluate(
-    scene: SceneLike, genomes, threads: Optional[int] = None, measures: bool = False, clip: bool = False
+    scene: SceneLike,
+    genomes,
+    threads: Optional[int] = None,
+    measures: bool = False,
+    clip: bool = False,
+    device: str = "cpu",
 ):
     """Fitness of each row of ``genomes`` under ``scene``'s ``[evolve]``
     evaluation (``"roobot"``: the thesis's hopping gait).
@@ -91,21 +96,30 @@ def evaluate(
     outside the scene's bounds (``scene.bounds()``) raises ``ValueError``
     naming it, unless ``clip=True`` clips genes into their bounds (the
     roobot's genes, mutated by a fraction of their value, have none).
+    ``device="cuda"`` evaluates them as one batch on an NVIDIA GPU, with
+    the same bits (``docs/GPU.md``); a ``RuntimeError`` says what is
+    missing where no GPU can be used, or which entry of the scene the GPU
+    does not evaluate.
     """
     if isinstance(genomes, list):
         # Bodies ([morphology] scenes): genomes differ in length.
         return _animats.evaluate(
-            scene, [np.ascontiguousarray(g, dtype=np.float64) for g in genomes], threads, measures, clip
+            scene,
+            [np.ascontiguousarray(g, dtype=np.float64) for g in genomes],
+            threads,
+            measures,
+            clip,
+            device,
         )
     g = np.ascontiguousarray(genomes, dtype=np.float64)
     if g.ndim == 1:
         g = g[None, :]
     if g.ndim != 2:
         raise ValueError(f"genomes must be a (P, D) array, got shape {g.shape}")
-    return _animats.evaluate(scene, g, threads, measures, clip)
+    return _animats.evaluate(scene, g, threads, measures, clip, device)
 
 
-def evaluate_scenes(texts, threads: Optional[int] = None) -> dict:
+def evaluate_scenes(texts, threads: Optional[int] = None, device: str = "cpu") -> dict:
     """Each complete scene text in ``texts`` scored by its own ``[evolve]``
     table, in parallel on ``threads`` threads (default: every core) with the
     GIL released: a dict of arrays ``fitness``, ``distance``, ``time`` and
@@ -115,7 +129,9 @@ def evaluate_scenes(texts, threads: Optional[int] = None) -> dict:
     (CPPNs, grammars, learned decoders): write the body your genome
     describes as ``[[particle]]``, ``[[spring]]``, ``[[actuator]]`` and a
     ``[[controller]]``, and let animats simulate it. A text that is not a
-    valid scene raises ``SceneError`` naming it ``<scene K>``."""
+    valid scene raises ``SceneError`` naming it ``<scene K>``.
+    ``device="cuda"``: evaluated as batches on an NVIDIA GPU, with the same
+    bits (``docs/GPU.md``)."""
     if isinstance(texts, str):
         raise TypeError("texts must be a list of scene texts, not one string")
-    return _animats.evaluate_scenes(list(texts), threads)
+    return _animats.evaluate_scenes(list(texts), threads, device)
