@@ -86,8 +86,15 @@ impl Force for NBodyGravity {
         let eps2 = self.softening * self.softening;
         let (pos, mass) = (ctx.pos, &ctx.particles.mass);
         let s = &mut self.scratch;
-        s.load(&self.indices, pos, mass);
-        s.sum(eps2);
+        // A set that fills no more than one block of lanes is summed
+        // straight from the particles (the same bits, none of the
+        // kernel's copying and padding).
+        if self.indices.len() <= pairs::LANES {
+            s.sum_small(&self.indices, pos, mass, eps2);
+        } else {
+            s.load(&self.indices, pos, mass);
+            s.sum(eps2);
+        }
         for (k, &i) in self.indices.iter().enumerate() {
             let i = i as usize;
             let a = DVec3::new(s.ax[k], s.ay[k], s.az[k]);

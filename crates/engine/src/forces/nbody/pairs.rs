@@ -154,6 +154,70 @@ impl Pairs {
     }
 }
 
+impl Pairs {
+    /// [`Pairs::sum`] for a set of at most [`LANES`] bodies, read straight
+    /// from the particles' arrays: no copy into padded lanes, no vectors,
+    /// the pairs that pull visited once each. The same operations in the
+    /// same order as the kernel, so the same bits: the pairs it leaves out
+    /// are those the kernel weighs 0 (a body on itself or one before it,
+    /// padding, two at one place unsoftened), whose terms (±0) leave an
+    /// accumulator as it was, since one never holds −0 (it starts at +0,
+    /// and a sum that cancels to zero is +0).
+    pub fn sum_small(&mut self, indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) {
+        let n = indices.len();
+        if self.ax.len() != n || self.rx.len() != n {
+            for v in [
+                &mut self.ax,
+                &mut self.ay,
+                &mut self.az,
+                &mut self.rx,
+                &mut self.ry,
+                &mut self.rz,
+            ] {
+                v.clear();
+                v.resize(n, 0.0);
+            }
+        } else {
+            for v in [&mut self.rx, &mut self.ry, &mut self.rz] {
+                v.fill(0.0);
+            }
+        }
+        for (k, &i) in indices.iter().enumerate() {
+            let (pi, mi) = (pos[i as usize], mass[i as usize]);
+            let mut s = [[0.0f64; LANES]; 3];
+            for (q, &j) in indices.iter().enumerate().skip(k + 1) {
+                let pj = pos[j as usize];
+                let (dx, dy, dz) = (pj.x - pi.x, pj.y - pi.y, pj.z - pi.z);
+                let r2 = dx * dx + dy * dy + dz * dz + eps2;
+                // (Not `r2 <= 0.0`: a NaN pulls nowhere too, as in the kernel.)
+                if r2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                    continue;
+                }
+                let inv = 1.0 / (r2 * r2.sqrt());
+                let (wj, wi) = (mass[j as usize] * inv, mi * inv);
+                let l = q % LANES;
+                s[0][l] += dx * wj;
+                s[1][l] += dy * wj;
+                s[2][l] += dz * wj;
+                self.rx[q] -= dx * wi;
+                self.ry[q] -= dy * wi;
+                self.rz[q] -= dz * wi;
+            }
+            self.ax[k] = tree(&s[0]);
+            self.ay[k] = tree(&s[1]);
+            self.az[k] = tree(&s[2]);
+            // The reactions of the rows before it (none for the first).
+            if k > 0 {
+                self.ax[k] += self.rx[k];
+                self.ay[k] += self.ry[k];
+                self.az[k] += self.rz[k];
+            }
+        }
+        // The kernel's buffers are sized again by its next `load`.
+        self.bounds.clear();
+    }
+}
+
 /// Whether `n` bodies are summed in parallel (more than one task's rows).
 pub(super) fn splits(n: usize) -> bool {
     n >= 2 * ROWS_PER_TASK
@@ -482,6 +546,33 @@ mod tests {
                     (got - sum).abs().cmple(tol).all(),
                     "{n} bodies, body {i}: {got} against {sum} (tolerance {tol})"
                 );
+            }
+        }
+    }
+
+    /// A set of up to LANES bodies summed straight from the particles gives
+    /// the kernel's bits, with and without softening, with two bodies at
+    /// one place, in any order of indices.
+    #[test]
+    fn small_sets_summed_straight_from_the_particles_give_the_kernel_s_bits() {
+        let all = bodies(203);
+        let pos: Vec<DVec3> = (0..203)
+            .map(|i| DVec3::new(all.x[i], all.y[i], all.z[i]))
+            .collect();
+        let mass = all.m[..203].to_vec();
+        for n in 2..=LANES {
+            for eps2 in [0.0, 1e-4] {
+                // Out of order; 100 and 7 share a place.
+                let idx = [100u32, 7, 50, 3, 150, 20, 199, 60][..n].to_vec();
+                let mut kernel = Pairs::default();
+                kernel.load(&idx, &pos, &mass);
+                kernel.sum_on(eps2, Width::Base);
+                let mut small = Pairs::default();
+                small.sum_small(&idx, &pos, &mass, eps2);
+                assert_eq!(bits(&small), bits(&kernel), "{n} bodies, eps² {eps2}");
+                if n > 2 {
+                    assert!(bits(&small).iter().any(|&b| f64::from_bits(b).abs() > 0.0));
+                }
             }
         }
     }
