@@ -8,6 +8,7 @@ fn main() {
     println!("cargo:rerun-if-changed=kernel/libm.h");
     println!("cargo:rerun-if-changed=kernel/trig.h");
     println!("cargo:rerun-if-changed=kernel/eval.h");
+    println!("cargo:rerun-if-changed=kernel/exp.h");
     cc::Build::new()
         .file("kernel/host.c")
         .flag_if_supported("-ffp-contract=off")

@@ -8,10 +8,14 @@ double animats_atan(double x) { return an_atan(x); }
 double animats_atan2(double y, double x) { return an_atan2(y, x); }
 
 #include "trig.h"
+#include "exp.h"
 #include "eval.h"
 
 double animats_sin(double x) { return an_sin(x); }
 double animats_cos(double x) { return an_cos(x); }
+double animats_exp(double x) { return an_exp(x); }
+double animats_expm1(double x) { return an_expm1(x); }
+double animats_tanh(double x) { return an_tanh(x); }
 
 /* Creatures first .. last - 1 of a batch: the CPU's threads each take a
  * range (every creature writes only its own particles and scratch). */

@@ -26,6 +26,7 @@ fn source() -> String {
     [
         include_str!("../kernel/libm.h"),
         include_str!("../kernel/trig.h"),
+        include_str!("../kernel/exp.h"),
         include_str!("../kernel/step.h"),
         include_str!("../kernel/eval.h"),
         include_str!("../kernel/kernel.cu"),

@@ -114,3 +114,46 @@ fn sin_and_cos_are_the_libm_crate_s_to_the_bit() {
         assert!(same(c, rust), "cos({x:e}): C {c:e}, libm {rust:e}");
     }
 }
+
+#[test]
+fn exp_expm1_and_tanh_are_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(4);
+    let mut args: Vec<f64> = SPECIAL.to_vec();
+    // Every branch: tiny, the primary range, near multiples of ln 2 (the
+    // reduction's boundaries), up to overflow and underflow and past them,
+    // the neural brains' usual range, any bits.
+    args.extend((-1100..1100).flat_map(|k| {
+        let x = k as f64 * std::f64::consts::LN_2;
+        [
+            x,
+            f64::from_bits(x.to_bits() + 1),
+            f64::from_bits(x.to_bits().wrapping_sub(1)),
+        ]
+    }));
+    // The thresholds of overflow and underflow (as the crate writes them).
+    #[allow(clippy::excessive_precision)]
+    args.extend([
+        709.782712893383973096,
+        709.79,
+        -708.39641853226410622,
+        -745.13321910194110842,
+        -745.2,
+        20.0,
+        22.0,
+        0.5493,
+        0.2554,
+    ]);
+    args.extend((0..300_000).map(|_| r.spread(-60, 0)));
+    args.extend((0..300_000).map(|_| r.spread(0, 10)));
+    args.extend((0..200_000).map(|_| (r.next() as f64 / u64::MAX as f64 - 0.5) * 1600.0));
+    args.extend((0..200_000).map(|_| f64::from_bits(r.next())));
+    assert!(args.len() > 1_000_000);
+    for x in args {
+        let (c, rust) = (ported::exp(x), math::exp(x));
+        assert!(same(c, rust), "exp({x:e}): C {c:e}, libm {rust:e}");
+        let (c, rust) = (ported::expm1(x), libm::expm1(x));
+        assert!(same(c, rust), "expm1({x:e}): C {c:e}, libm {rust:e}");
+        let (c, rust) = (ported::tanh(x), math::tanh(x));
+        assert!(same(c, rust), "tanh({x:e}): C {c:e}, libm {rust:e}");
+    }
+}
