@@ -3,7 +3,8 @@
 # torque joints dropped onto the floor, stepped by the engine on every
 # core, by the C on every core and by the GPU, every coordinate compared
 # as bits; then whole evaluations: 65,536 soft walkers (random oscillator
-# genomes) and 65,536 random evolved bodies (self-contact, spring muscles),
+# genomes), 65,536 random evolved bodies (self-contact, spring muscles)
+# and 16,384 with neural brains reading touch sensors,
 # each evaluated for 10 s by the engine on every core, by the C and by the
 # GPU, every fitness compared as bits; the throughput of each; last the
 # soft walker evolved on the GPU, 16,384 candidates a generation, against
@@ -44,7 +45,7 @@ for run in "65536 1000 20" "65536 1000 0" "262144 200 20"; do
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
-for run in "walker 65536 10" "bodies 65536 10"; do
+for run in "walker 65536 10" "bodies 65536 10" "neural 16384 10"; do
   echo "== gpu_evaluate $run"
   # shellcheck disable=SC2086
   "$E" $run

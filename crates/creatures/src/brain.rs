@@ -30,6 +30,13 @@ pub trait Brain: Send {
         None
     }
 
+    /// The brain as itself, for code that reads a built-in kind's
+    /// parameters (the GPU's packer reads a neural network's layers); a
+    /// user's brain need not say.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
+
     /// The evolvable parameters (empty if none).
     fn genome(&self) -> Vec<f64> {
         Vec::new()

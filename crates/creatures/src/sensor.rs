@@ -8,6 +8,13 @@ use animats_engine::World;
 pub trait Sensor {
     /// The current level, clamped to [0, 1].
     fn level(&self, world: &World) -> f64;
+
+    /// The sensor as itself, for code that reads a built-in kind's
+    /// parameters (the GPU's packer reads a scene's `[[sensor]]`); a
+    /// user's sensor need not say.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }
 
 /// Clamps `x` to [0, 1] (NaN becomes 0, so a sensor never reports NaN).

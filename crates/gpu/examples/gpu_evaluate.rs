@@ -7,7 +7,9 @@
 //! GPU; every fitness, distance, time and end reason compared as bits;
 //! evaluations and creature-steps per second of each.
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies] [COUNT] [SECONDS]
+//! `neural`: the same bodies with neural brains reading touch sensors.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural] [COUNT] [SECONDS]
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -45,7 +47,11 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
             .collect();
         problem.scene(&g)
     } else {
-        let problem = MorphologyProblem::parse(&duration(BODIES_WALK), "scenes/bodies_walk.toml")
+        let mut text = duration(BODIES_WALK);
+        if kind == "neural" {
+            text = text.replace("controller = \"oscillator\"", "controller = \"neural\"");
+        }
+        let problem = MorphologyProblem::parse(&text, "scenes/bodies_walk.toml")
             .map_err(|e| e.to_string())?;
         let genes = problem.random(&mut rng);
         let text = problem.develop(&genes, "")?;
@@ -64,8 +70,8 @@ fn main() {
         .get(3)
         .map_or(Ok(10.0), |a| a.parse())
         .unwrap_or_else(|_| fail("SECONDS: a number"));
-    if !matches!(kind, "walker" | "bodies") || !(1..=10_000_000).contains(&count) {
-        fail("usage: gpu_evaluate [walker|bodies] [COUNT 1 to 10,000,000] [SECONDS]");
+    if !matches!(kind, "walker" | "bodies" | "neural") || !(1..=10_000_000).contains(&count) {
+        fail("usage: gpu_evaluate [walker|bodies|neural] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");

@@ -1,10 +1,11 @@
 /*
  * A scene's whole evaluation in C, after the step (step.h): what
  * crates/scene/src/evaluate.rs `evaluate_with` does for a scene whose
- * brains are oscillators driving spring muscles, operation by operation.
- * Each step: the nervous system acts (creatures/src/nervous_system.rs
- * `act`: every oscillator's outputs at the world's time, each slewed by its
- * muscle's rate and clamped to [0, 1], the spring's rest length set), the
+ * brains are oscillators or neural networks driving spring muscles,
+ * operation by operation. Each step: the nervous system acts
+ * (creatures/src/nervous_system.rs `act`: every sensor read, then every
+ * controller's outputs at the world's time, each slewed by its muscle's
+ * rate and clamped to [0, 1], the spring's rest length set), the
  * world steps, its clock advances (Kahan), the divergence guard checks
  * every 64th step (engine/src/guard.rs: a driven world's speed limit),
  * then the measures record the step (scene/src/archive.rs, Recorder), the
@@ -18,6 +19,7 @@
 
 #include "step.h"
 #include "trig.h"
+#include "exp.h"
 
 /* Why an evaluation ended, as scene::evaluate::Ended. */
 enum { AN_TIMEOUT = 0, AN_TOUCH = 1, AN_STRETCH = 2, AN_BLOWUP = 3 };
@@ -58,19 +60,130 @@ AN_FN void an_slew(const an_batch *b, long long q, long long s0, double l, doubl
     b->rest_length[s0 + b->muscle_spring[q]] = lo + level * (hi - lo);
 }
 
-/* Every oscillator of creature c acts at time t (brains/oscillator.rs:
- * level = offset + amplitude sin(2 pi f t + phase)). */
-AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
+/* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`). */
+enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_ANGLE = 4, AN_S_TILT = 5 };
+
+/* ScaledSensor::level of sensor q of the creature whose particles begin at
+ * p0: the probe's reading mapped from [min, max] onto [0, 1]. */
+AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
+    const int *ids = b->sensor_particle + 3 * q;
+    const double *param = b->sensor_param + 5 * q;
+    const double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0;
+    const double *pa = x + 3 * ids[0], *pb = x + 3 * ids[1], *pc = x + 3 * ids[2];
+    double reading, d[3], e[3], n[3];
+    switch (b->sensor_kind[q]) {
+    case AN_S_HEIGHT:
+        reading = pa[1];
+        break;
+    case AN_S_SPEED:
+        reading = an_dot(v + 3 * ids[0], param);
+        break;
+    case AN_S_TOUCH: /* TOUCH_TOLERANCE, on the flat floor */
+        reading = pa[1] - b->radius[p0 + ids[0]] <= 1e-3 ? 1.0 : 0.0;
+        break;
+    case AN_S_LENGTH: /* glam's distance: (a - b).length() */
+        for (int k = 0; k < 3; k++) {
+            d[k] = pa[k] - pb[k];
+        }
+        reading = sqrt(an_dot(d, d));
+        break;
+    case AN_S_ANGLE: /* angle_joint::angle_at(a, joint, b) */
+        for (int k = 0; k < 3; k++) {
+            d[k] = pa[k] - pb[k];
+            e[k] = pc[k] - pb[k];
+        }
+        an_cross(d, e, n);
+        reading = an_atan2(sqrt(an_dot(n, n)), an_dot(d, e));
+        break;
+    default: /* AN_S_TILT: a -> b from the vertical */
+        for (int k = 0; k < 3; k++) {
+            d[k] = pb[k] - pa[k];
+        }
+        reading = an_atan2(sqrt(d[0] * d[0] + d[2] * d[2]), d[1]);
+        break;
+    }
+    return an_unit((reading - param[3]) / (param[4] - param[3]));
+}
+
+/* Oscillator o (over the batch) of creature c at time t
+ * (brains/oscillator.rs: level = offset + amplitude sin(2 pi f t + phase)). */
+AN_FN void an_oscillator(const an_batch *b, long long c, long long o, double t, double dt) {
     long long s0 = b->first_spring[c], u0 = b->first_muscle[c];
-    for (long long o = b->first_osc[c]; o < b->first_osc[c + 1]; o++) {
-        double w = (6.283185307179586 * b->osc_frequency[o]) * t;
-        for (long long k = b->first_output[o]; k < b->first_output[o + 1]; k++) {
-            const double *g = b->output_gene + 4 * k;
-            double l = g[2] + g[0] * an_sin(w + g[1]);
-            if (g[3] == g[3]) {
-                l = l + g[3];
+    double w = (6.283185307179586 * b->osc_frequency[o]) * t;
+    for (long long k = b->first_output[o]; k < b->first_output[o + 1]; k++) {
+        const double *g = b->output_gene + 4 * k;
+        double l = g[2] + g[0] * an_sin(w + g[1]);
+        if (g[3] == g[3]) {
+            l = l + g[3];
+        }
+        an_slew(b, u0 + b->output_muscle[k], s0, l, dt);
+    }
+}
+
+/* Network m (over the batch) of creature c at time t (brains/neural.rs:
+ * inputs 2 level - 1, the clock's sine and cosine, tanh layers, a
+ * logistic output layer). */
+AN_FN void an_network(const an_batch *b, long long c, long long m, double t, double dt) {
+    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long r0 = b->net_first_scratch[m];
+    long long width = (b->net_first_scratch[m + 1] - r0) / 2;
+    double *x = b->net_scratch + r0, *y = x + width;
+    long long ni = 0;
+    for (long long i = b->net_first_input[m]; i < b->net_first_input[m + 1]; i++) {
+        x[ni++] = 2.0 * b->sensor_level[q0 + b->net_input[i]] - 1.0;
+    }
+    double f = b->net_clock[m];
+    if (f == f) {
+        double w = (6.283185307179586 * f) * t;
+        x[ni++] = an_sin(w);
+        x[ni++] = an_cos(w);
+    }
+    const int *sizes = b->layer_size + b->net_first_layer[m];
+    long long layers = b->net_first_layer[m + 1] - b->net_first_layer[m] - 1;
+    const double *wt = b->net_weight;
+    long long k = b->net_first_weight[m];
+    for (long long l = 0; l < layers; l++) {
+        long long n_in = sizes[l], n_out = sizes[l + 1];
+        long long biases = k + n_out * n_in;
+        for (long long j = 0; j < n_out; j++) {
+            double a = wt[biases + j];
+            for (long long i = 0; i < n_in; i++) {
+                a = a + wt[k + j * n_in + i] * x[i];
             }
-            an_slew(b, u0 + b->output_muscle[k], s0, l, dt);
+            y[j] = l + 1 == layers ? 1.0 / (1.0 + an_exp(-a)) : an_tanh(a);
+        }
+        k = biases + n_out;
+        double *swap = x;
+        x = y;
+        y = swap;
+    }
+    long long o0 = b->net_first_output[m];
+    for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
+        double l = x[o - o0];
+        double shift = b->net_output_shift[o];
+        if (shift == shift) {
+            l = l + shift;
+        }
+        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
+    }
+}
+
+/* The nervous system of creature c acts at time t (nervous_system.rs
+ * `act`): every sensor read, then every controller in the scene's order. */
+AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
+    long long k0 = b->first_ctrl[c], k1 = b->first_ctrl[c + 1];
+    if (k0 == k1) {
+        return;
+    }
+    long long p0 = b->first_particle[c];
+    for (long long q = b->first_sensor[c]; q < b->first_sensor[c + 1]; q++) {
+        b->sensor_level[q] = an_sensor(b, p0, q);
+    }
+    for (long long k = k0; k < k1; k++) {
+        if (b->ctrl_kind[k] == 0) {
+            an_oscillator(b, c, b->ctrl_index[k], t, dt);
+        } else {
+            an_network(b, c, b->ctrl_index[k], t, dt);
         }
     }
 }

@@ -130,6 +130,26 @@ typedef struct {
     const double *measure_weight;   /* a term's weight in the fitness */
     double *measure_sum;            /* per measure: its running sum, then its value */
     double *measure_start;          /* 3 per measure: the centre it starts from */
+    const long long *first_sensor; /* per creature: its sensors ([[sensor]]) */
+    const int *sensor_kind; /* AN_S_HEIGHT ... */
+    const int *sensor_particle; /* 3 per sensor, within the creature */
+    const double *sensor_param; /* 5 per sensor: axis x, y, z, min, max */
+    double *sensor_level; /* per sensor: its level this step */
+    const long long *first_ctrl; /* per creature: its controllers, in order */
+    const int *ctrl_kind; /* 0: an oscillator, 1: a network */
+    const int *ctrl_index; /* the oscillator or network, over the batch */
+    const long long *net_first_layer; /* per network, over the batch: its layer sizes */
+    const int *layer_size; /* inputs (clock included) first, outputs last */
+    const long long *net_first_weight; /* per network: its weights and biases */
+    const double *net_weight; /* as brains/neural.rs orders them */
+    const double *net_clock; /* per network: the clock's Hz (NaN: none) */
+    const long long *net_first_input; /* per network: its inputs */
+    const int *net_input; /* a sensor, within the creature */
+    const long long *net_first_output; /* per network: its outputs */
+    const int *net_output_muscle; /* the muscle driven, within the creature */
+    const double *net_output_shift; /* a trial's level offset (NaN: none) */
+    const long long *net_first_scratch; /* per network: two layers' room */
+    double *net_scratch; /* the layers being computed */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */

@@ -5,8 +5,9 @@
 //! `animats_scene::evaluate::evaluate` does, returning the same
 //! [`Evaluation`] to the bit.
 //!
-//! Covered: spring muscles (a spring's rest length between `min` and
-//! `max`, with or without a `rate`), oscillator brains, the centre of the
+//! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
+//! spring muscles (a spring's rest length between `min` and `max`, with or
+//! without a `rate`), oscillator and neural brains, the centre of the
 //! particles that count, `fail_on_touch` and `fail_on_stretch`, the
 //! divergence guard of a driven scene, the `[archive]` measures and
 //! `[evolve] terms` but `energy`, and the fitness's time, distance and
@@ -15,6 +16,10 @@
 
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
+use animats_creatures::brains::neural::Neural;
+use animats_creatures::nervous_system::Inputs;
+use animats_creatures::sensor::Sensor;
+use animats_creatures::sensors::probe::{Probe, ScaledSensor};
 use animats_engine::{DVec3, ParticleId, World};
 use animats_scene::archive::{Measure, Recorder};
 use animats_scene::evaluate::{Batches, Ended, Evaluation};
@@ -58,6 +63,26 @@ pub(crate) struct Rules {
     pub(crate) measure_weight: Vec<f64>,
     pub(crate) measure_sum: Vec<f64>,
     pub(crate) measure_start: Vec<f64>,
+    pub(crate) first_sensor: Vec<i64>,
+    pub(crate) sensor_kind: Vec<i32>,
+    pub(crate) sensor_particle: Vec<i32>,
+    pub(crate) sensor_param: Vec<f64>,
+    pub(crate) sensor_level: Vec<f64>,
+    pub(crate) first_ctrl: Vec<i64>,
+    pub(crate) ctrl_kind: Vec<i32>,
+    pub(crate) ctrl_index: Vec<i32>,
+    pub(crate) net_first_layer: Vec<i64>,
+    pub(crate) layer_size: Vec<i32>,
+    pub(crate) net_first_weight: Vec<i64>,
+    pub(crate) net_weight: Vec<f64>,
+    pub(crate) net_clock: Vec<f64>,
+    pub(crate) net_first_input: Vec<i64>,
+    pub(crate) net_input: Vec<i32>,
+    pub(crate) net_first_output: Vec<i64>,
+    pub(crate) net_output_muscle: Vec<i32>,
+    pub(crate) net_output_shift: Vec<f64>,
+    pub(crate) net_first_scratch: Vec<i64>,
+    pub(crate) net_scratch: Vec<f64>,
     /// Per creature: its `fail_on_touch` particles' names and its
     /// `fail_on_stretch` rules' names, for [`Ended`].
     names: Vec<(Vec<String>, Vec<String>)>,
@@ -81,15 +106,31 @@ impl Rules {
             &mut self.first_touch,
             &mut self.first_stretch,
             &mut self.first_measure,
+            &mut self.first_sensor,
+            &mut self.first_ctrl,
         ] {
             *offsets = vec![0; creatures + 1];
         }
         self.first_output = vec![0];
         self.measure_first_id = vec![0];
+        for offsets in self.net_offsets() {
+            *offsets = vec![0];
+        }
         self.eval_param = vec![0.0; 8 * creatures];
         self.eval_count = vec![0; 3 * creatures];
         self.result = vec![0.0; 3 * creatures];
         self.ended = vec![0; 2 * creatures];
+    }
+
+    /// The networks' offset arrays (over the batch: one more than networks).
+    fn net_offsets(&mut self) -> [&mut Vec<i64>; 5] {
+        [
+            &mut self.net_first_layer,
+            &mut self.net_first_weight,
+            &mut self.net_first_input,
+            &mut self.net_first_output,
+            &mut self.net_first_scratch,
+        ]
     }
 
     /// Appends `scene`'s muscles, oscillators and rules (its creature's
@@ -139,22 +180,54 @@ impl Rules {
             self.muscle_param.extend([min, max, rate.unwrap_or(-1.0)]);
             self.muscle_level.push(a.level());
         }
+        for (name, sensor) in &nervous.sensors {
+            self.add_sensor(name, sensor.as_ref())?;
+        }
         for c in &nervous.controllers {
             let kind = c.brain.kind();
+            let shift = |o: usize| nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
+            if let Some(net) = c.brain.as_any().and_then(|a| a.downcast_ref::<Neural>()) {
+                let Inputs::Sensors(inputs) = &c.inputs else {
+                    return Err(format!(
+                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
+                        c.name
+                    ));
+                };
+                self.ctrl_kind.push(1);
+                self.ctrl_index.push(self.net_clock.len() as i32);
+                self.layer_size.extend(net.sizes.iter().map(|&n| n as i32));
+                self.net_first_layer.push(self.layer_size.len() as i64);
+                self.net_weight.extend(&net.weights);
+                self.net_first_weight.push(self.net_weight.len() as i64);
+                self.net_clock.push(net.clock.unwrap_or(f64::NAN));
+                self.net_input.extend(inputs.iter().map(|&i| i as i32));
+                self.net_first_input.push(self.net_input.len() as i64);
+                for &o in &c.outputs {
+                    self.net_output_muscle.push(o as i32);
+                    self.net_output_shift.push(shift(o));
+                }
+                self.net_first_output
+                    .push(self.net_output_muscle.len() as i64);
+                let width = net.sizes.iter().copied().max().unwrap_or(0);
+                let room = self.net_first_scratch.last().copied().unwrap_or(0) + 2 * width as i64;
+                self.net_first_scratch.push(room);
+                continue;
+            }
             let g = c.brain.genome();
             let n = c.outputs.len();
             if kind != "oscillator" || g.len() != 1 + 3 * n {
                 return Err(format!(
-                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators are",
+                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators and neural networks are",
                     c.name
                 ));
             }
+            self.ctrl_kind.push(0);
+            self.ctrl_index.push(self.osc_frequency.len() as i32);
             self.osc_frequency.push(g[0]);
             for (j, &o) in c.outputs.iter().enumerate() {
                 self.output_muscle.push(o as i32);
-                let shift = nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
                 self.output_gene
-                    .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift]);
+                    .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift(o)]);
             }
             self.first_output.push(self.output_muscle.len() as i64);
         }
@@ -203,6 +276,34 @@ impl Rules {
         self.first_touch.push(self.touch_particle.len() as i64);
         self.first_stretch.push(self.stretch_length.len() as i64);
         self.first_measure.push(self.measure_kind.len() as i64);
+        self.first_sensor.push(self.sensor_kind.len() as i64);
+        self.first_ctrl.push(self.ctrl_kind.len() as i64);
+        Ok(())
+    }
+
+    /// Appends sensor `name` (a scene's `[[sensor]]`).
+    fn add_sensor(&mut self, name: &str, sensor: &dyn Sensor) -> Result<(), String> {
+        let Some(s) = sensor
+            .as_any()
+            .and_then(|a| a.downcast_ref::<ScaledSensor>())
+        else {
+            return Err(format!(
+                "the sensor `{name}` (a creature's own) is not in the GPU evaluation yet"
+            ));
+        };
+        let i = |p: &ParticleId| p.index() as i32;
+        let (kind, particles, axis) = match &s.probe {
+            Probe::Height(p) => (0, [i(p), 0, 0], DVec3::ZERO),
+            Probe::Speed(p, axis) => (1, [i(p), 0, 0], *axis),
+            Probe::Touch(p) => (2, [i(p), 0, 0], DVec3::ZERO),
+            Probe::Length(a, b) => (3, [i(a), i(b), 0], DVec3::ZERO),
+            Probe::Angle { a, joint, b } => (4, [i(a), i(joint), i(b)], DVec3::ZERO),
+            Probe::Tilt(a, b) => (5, [i(a), i(b), 0], DVec3::ZERO),
+        };
+        self.sensor_kind.push(kind);
+        self.sensor_particle.extend(particles);
+        self.sensor_param.extend(axis.to_array());
+        self.sensor_param.extend([s.min, s.max]);
         Ok(())
     }
 
@@ -276,12 +377,19 @@ impl Batch {
             first_stretch: vec![0],
             first_measure: vec![0],
             measure_first_id: vec![0],
+            first_sensor: vec![0],
+            first_ctrl: vec![0],
             ..Rules::default()
         };
+        for offsets in r.net_offsets() {
+            *offsets = vec![0];
+        }
         for (k, s) in scenes.iter().enumerate() {
             r.add(s).map_err(|e| format!("scene {k}: {e}"))?;
         }
         r.measure_sum = vec![0.0; r.measure_kind.len()];
+        r.sensor_level = vec![0.0; r.sensor_kind.len()];
+        r.net_scratch = vec![0.0; r.net_first_scratch.last().copied().unwrap_or(0) as usize];
         r.measure_start = vec![0.0; 3 * r.measure_kind.len()];
         r.result = vec![0.0; 3 * scenes.len()];
         r.ended = vec![0; 2 * scenes.len()];

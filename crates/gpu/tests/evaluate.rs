@@ -15,6 +15,7 @@ use animats_scene::Scene;
 
 const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
+const WALKER_CTRNN: &str = include_str!("../../../scenes/walker_ctrnn.toml");
 
 /// Evaluates `scenes` with the engine and, packed in one batch, with the
 /// C, and asserts every result and every final state equal to the bit.
@@ -205,6 +206,82 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn neural_brains_reading_every_kind_of_sensor_are_the_engine_s_to_the_bit() {
+    // The walker's oscillator replaced by a network (a hidden layer, the
+    // clock) reading a sensor of each kind; random weights.
+    let sensors = r#"
+[[sensor]]
+name = "h"
+kind = "height"
+particle = "hip_f"
+max = 0.3
+
+[[sensor]]
+name = "v"
+kind = "speed"
+particle = "hip_b"
+axis = [0.6, 0.8, 0.0]
+min = -1.0
+
+[[sensor]]
+name = "t"
+kind = "touch"
+particle = "foot_fl"
+
+[[sensor]]
+name = "l"
+kind = "length"
+a = "foot_fl"
+b = "foot_br"
+
+[[sensor]]
+name = "a"
+kind = "angle"
+a = "foot_fl"
+joint = "hip_f"
+b = "foot_fr"
+
+[[sensor]]
+name = "u"
+kind = "tilt"
+a = "hip_b"
+b = "hip_f"
+
+[[controller]]
+name = "gait"
+kind = "neural"
+inputs = ["h", "v", "t", "l", "a", "u"]
+outputs = ["leg_fl", "leg_fr", "leg_bl", "leg_br", "stride_l", "stride_r"]
+hidden = [5]
+clock = 2.0
+"#;
+    let start = WALKER.find("[[controller]]").unwrap();
+    let end = WALKER.find("[evolve]").unwrap();
+    let text = format!("{}{sensors}\n{}", &WALKER[..start], &WALKER[end..])
+        .replace("duration = 10.0", "duration = 2.0");
+    let got = assert_same(genomes(&text, 12, 6), "neural walker");
+    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
+    d.sort_unstable();
+    d.dedup();
+    assert!(d.len() > 6, "{got:?}");
+    // Evolved bodies with neural brains: touch sensors on every particle
+    // that can touch the floor, one output a muscle.
+    let text = BODIES_WALK
+        .replace("duration = 10.0", "duration = 2.0")
+        .replace("controller = \"oscillator\"", "controller = \"neural\"");
+    let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
+    let mut rng = Random::for_entry(12, 0);
+    let scenes: Vec<_> = (0..12)
+        .map(|_| {
+            let genes = problem.random(&mut rng);
+            animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap()
+        })
+        .collect();
+    assert!(scenes.iter().all(|s| !s.nervous.sensors.is_empty()));
+    assert_same(scenes, "neural bodies");
+}
+
+#[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
     // The energy measure, the energy weight.
     let text = BODIES_WALK.replace("{ kind = \"size\" }", "{ kind = \"energy\" }");
@@ -221,18 +298,17 @@ fn what_the_c_does_not_evaluate_is_refused_by_name() {
         .unwrap();
     let err = Batch::pack_scenes(&[&scene]).unwrap_err();
     assert!(err.contains("energy_weight"), "{err}");
-    let text = BODIES_WALK.to_string();
-    // A neural brain.
-    let neural = text.replace("controller = \"oscillator\"", "controller = \"neural\"");
-    let problem = MorphologyProblem::parse(&neural, "bodies_walk.toml").unwrap();
-    let genes = problem.random(&mut Random::for_entry(1, 0));
-    let scene = animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap();
+    // A CTRNN brain (beside a walker that packs).
     let walker = SceneProblem::parse(WALKER, "walker.toml")
         .unwrap()
         .fresh()
         .unwrap();
-    let err = Batch::pack_scenes(&[&walker, &scene]).unwrap_err();
-    assert!(err.contains("scene 1") && err.contains("neural"), "{err}");
+    let ctrnn = SceneProblem::parse(WALKER_CTRNN, "walker_ctrnn.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
+    let err = Batch::pack_scenes(&[&walker, &ctrnn]).unwrap_err();
+    assert!(err.contains("scene 1") && err.contains("ctrnn"), "{err}");
     // A scene without [evolve].
     let plain =
         animats_scene::parse(&WALKER[..WALKER.find("[evolve]").unwrap()], "walker.toml").unwrap();

@@ -98,5 +98,8 @@ fn the_body_ga_in_batches_writes_the_engine_s_log() {
         seed: Some(2),
         ..Choices::default()
     };
-    assert_same(&text, choices, "body GA");
+    assert_same(&text, choices.clone(), "body GA");
+    // With neural brains reading touch sensors.
+    let neural = text.replace("controller = \"oscillator\"", "controller = \"neural\"");
+    assert_same(&neural, choices, "body GA, neural brains");
 }

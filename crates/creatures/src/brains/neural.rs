@@ -145,6 +145,10 @@ impl Brain for Neural {
         "neural"
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     fn think(&mut self, t: f64, _dt: f64, inputs: &[f64], outputs: &mut [f64]) {
         let (x, y) = &mut self.scratch;
         network_inputs(x, inputs, self.clock, t);

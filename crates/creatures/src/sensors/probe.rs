@@ -84,6 +84,9 @@ impl Sensor for ScaledSensor {
     fn level(&self, world: &World) -> f64 {
         unit((self.probe.read(world) - self.min) / (self.max - self.min))
     }
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }
 
 /// `[[sensor]]`: a reading mapped linearly from [`min`, `max`] onto [0, 1],
