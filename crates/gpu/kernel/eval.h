@@ -168,6 +168,58 @@ AN_FN void an_network(const an_batch *b, long long c, long long m, double t, dou
     }
 }
 
+/* brains/ctrnn.rs `sigma`: the logistic function. */
+AN_FN double an_sigma(double z) { return 1.0 / (1.0 + an_exp(-z)); }
+
+/* CTRNN m (a network entry, over the batch) of creature c at time t
+ * (brains/ctrnn.rs: every neuron's rate from its state, then each state
+ * a semi-implicit Euler step, y <- (y + h drive) / (1 + h), h = dt / tau;
+ * neuron i drives output i). */
+AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, double dt) {
+    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    const int *sizes = b->layer_size + b->net_first_layer[m];
+    long long n = sizes[0], mi = sizes[1];
+    double *x = b->net_scratch + b->net_first_scratch[m], *rates = x + mi;
+    long long ni = 0;
+    for (long long i = b->net_first_input[m]; i < b->net_first_input[m + 1]; i++) {
+        x[ni++] = 2.0 * b->sensor_level[q0 + b->net_input[i]] - 1.0;
+    }
+    double f = b->net_clock[m];
+    if (f == f) {
+        double w = (6.283185307179586 * f) * t;
+        x[ni++] = an_sin(w);
+        x[ni++] = an_cos(w);
+    }
+    const double *np = b->neuron_param + 3 * b->net_first_neuron[m];
+    double *state = b->neuron_state + b->net_first_neuron[m];
+    for (long long i = 0; i < n; i++) {
+        rates[i] = an_sigma(np[3 * i + 2] * (state[i] + np[3 * i + 1]));
+    }
+    const double *w = b->net_weight + b->net_first_weight[m], *v = w + n * n;
+    for (long long i = 0; i < n; i++) {
+        double drive = 0.0;
+        for (long long j = 0; j < n; j++) {
+            drive = drive + w[i * n + j] * rates[j];
+        }
+        for (long long k = 0; k < mi; k++) {
+            drive = drive + v[i * mi + k] * x[k];
+        }
+        double tau = np[3 * i];
+        double h = dt / (tau > 1e-4 ? tau : 1e-4); /* tau.max(MIN_TAU) */
+        state[i] = (state[i] + h * drive) / (1.0 + h);
+    }
+    long long o0 = b->net_first_output[m];
+    for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
+        long long i = o - o0;
+        double l = an_sigma(np[3 * i + 2] * (state[i] + np[3 * i + 1]));
+        double shift = b->net_output_shift[o];
+        if (shift == shift) {
+            l = l + shift;
+        }
+        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
+    }
+}
+
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order. */
 AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
@@ -182,8 +234,10 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
     for (long long k = k0; k < k1; k++) {
         if (b->ctrl_kind[k] == 0) {
             an_oscillator(b, c, b->ctrl_index[k], t, dt);
-        } else {
+        } else if (b->ctrl_kind[k] == 1) {
             an_network(b, c, b->ctrl_index[k], t, dt);
+        } else {
+            an_ctrnn(b, c, b->ctrl_index[k], t, dt);
         }
     }
 }

@@ -136,7 +136,7 @@ typedef struct {
     const double *sensor_param; /* 5 per sensor: axis x, y, z, min, max */
     double *sensor_level; /* per sensor: its level this step */
     const long long *first_ctrl; /* per creature: its controllers, in order */
-    const int *ctrl_kind; /* 0: an oscillator, 1: a network */
+    const int *ctrl_kind; /* 0: an oscillator, 1: a neural network, 2: a CTRNN (a network entry) */
     const int *ctrl_index; /* the oscillator or network, over the batch */
     const long long *net_first_layer; /* per network, over the batch: its layer sizes */
     const int *layer_size; /* inputs (clock included) first, outputs last */
@@ -150,6 +150,9 @@ typedef struct {
     const double *net_output_shift; /* a trial's level offset (NaN: none) */
     const long long *net_first_scratch; /* per network: two layers' room */
     double *net_scratch; /* the layers being computed */
+    const long long *net_first_neuron; /* per network: a CTRNN's neurons */
+    const double *neuron_param; /* 3 per neuron: tau, bias, gain */
+    double *neuron_state; /* per neuron: its state y */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */

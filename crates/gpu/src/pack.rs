@@ -114,6 +114,9 @@ pub(crate) struct Raw {
     net_output_shift: *const c_double,
     net_first_scratch: *const c_longlong,
     net_scratch: *mut c_double,
+    net_first_neuron: *const c_longlong,
+    neuron_param: *const c_double,
+    neuron_state: *mut c_double,
 }
 
 extern "C" {
@@ -437,6 +440,7 @@ impl Batch {
             Array::MeasureStart => self.ev.measure_start.as_mut_ptr() as u64,
             Array::SensorLevel => self.ev.sensor_level.as_mut_ptr() as u64,
             Array::NetScratch => self.ev.net_scratch.as_mut_ptr() as u64,
+            Array::NeuronState => self.ev.neuron_state.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -540,6 +544,9 @@ impl Batch {
             Array::NetOutputShift => F64(&self.ev.net_output_shift),
             Array::NetFirstScratch => I64(&self.ev.net_first_scratch),
             Array::NetScratch => F64(&self.ev.net_scratch),
+            Array::NetFirstNeuron => I64(&self.ev.net_first_neuron),
+            Array::NeuronParam => F64(&self.ev.neuron_param),
+            Array::NeuronState => F64(&self.ev.neuron_state),
         }
     }
 
@@ -683,6 +690,9 @@ impl Batch {
             net_output_shift: c(Array::NetOutputShift),
             net_first_scratch: l(Array::NetFirstScratch),
             net_scratch: m(Array::NetScratch),
+            net_first_neuron: l(Array::NetFirstNeuron),
+            neuron_param: c(Array::NeuronParam),
+            neuron_state: m(Array::NeuronState),
         }
     }
 }
@@ -831,11 +841,14 @@ pub(crate) enum Array {
     NetOutputShift,
     NetFirstScratch,
     NetScratch,
+    NetFirstNeuron,
+    NeuronParam,
+    NeuronState,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 91] = [
+    pub(crate) const ALL: [Array; 94] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -927,6 +940,9 @@ impl Array {
         Array::NetOutputShift,
         Array::NetFirstScratch,
         Array::NetScratch,
+        Array::NetFirstNeuron,
+        Array::NeuronParam,
+        Array::NeuronState,
     ];
 }
 

@@ -7,7 +7,7 @@
 //!
 //! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
 //! spring muscles (a spring's rest length between `min` and `max`, with or
-//! without a `rate`), oscillator and neural brains, the centre of the
+//! without a `rate`), oscillator, neural and CTRNN brains, the centre of the
 //! particles that count, `fail_on_touch` and `fail_on_stretch`, the
 //! divergence guard of a driven scene, the `[archive]` measures and
 //! `[evolve] terms` but `energy`, and the fitness's time, distance and
@@ -16,6 +16,7 @@
 
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
+use animats_creatures::brains::ctrnn::Ctrnn;
 use animats_creatures::brains::neural::Neural;
 use animats_creatures::nervous_system::Inputs;
 use animats_creatures::sensor::Sensor;
@@ -83,6 +84,9 @@ pub(crate) struct Rules {
     pub(crate) net_output_shift: Vec<f64>,
     pub(crate) net_first_scratch: Vec<i64>,
     pub(crate) net_scratch: Vec<f64>,
+    pub(crate) net_first_neuron: Vec<i64>,
+    pub(crate) neuron_param: Vec<f64>,
+    pub(crate) neuron_state: Vec<f64>,
     /// Per creature: its `fail_on_touch` particles' names and its
     /// `fail_on_stretch` rules' names, for [`Ended`].
     names: Vec<(Vec<String>, Vec<String>)>,
@@ -122,9 +126,16 @@ impl Rules {
         self.ended = vec![0; 2 * creatures];
     }
 
+    /// Room for `n` doubles of a network's scratch.
+    fn push_scratch(&mut self, n: usize) {
+        let room = self.net_first_scratch.last().copied().unwrap_or(0) + n as i64;
+        self.net_first_scratch.push(room);
+    }
+
     /// The networks' offset arrays (over the batch: one more than networks).
-    fn net_offsets(&mut self) -> [&mut Vec<i64>; 5] {
+    fn net_offsets(&mut self) -> [&mut Vec<i64>; 6] {
         [
+            &mut self.net_first_neuron,
             &mut self.net_first_layer,
             &mut self.net_first_weight,
             &mut self.net_first_input,
@@ -209,15 +220,55 @@ impl Rules {
                 self.net_first_output
                     .push(self.net_output_muscle.len() as i64);
                 let width = net.sizes.iter().copied().max().unwrap_or(0);
-                let room = self.net_first_scratch.last().copied().unwrap_or(0) + 2 * width as i64;
-                self.net_first_scratch.push(room);
+                self.push_scratch(2 * width);
+                self.net_first_neuron.push(self.neuron_state.len() as i64);
+                continue;
+            }
+            if let Some(ct) = c.brain.as_any().and_then(|a| a.downcast_ref::<Ctrnn>()) {
+                let Inputs::Sensors(inputs) = &c.inputs else {
+                    return Err(format!(
+                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
+                        c.name
+                    ));
+                };
+                // A network entry: its layers say neurons, inputs (the
+                // clock's two counted) and outputs.
+                let n = ct.neurons();
+                let m = inputs.len() + if ct.clock.is_some() { 2 } else { 0 };
+                if ct.weights.len() != n * n || ct.input_weights.len() != n * m {
+                    return Err(format!("the controller `{}`: malformed CTRNN", c.name));
+                }
+                self.ctrl_kind.push(2);
+                self.ctrl_index.push(self.net_clock.len() as i32);
+                self.layer_size
+                    .extend([n as i32, m as i32, ct.outputs as i32]);
+                self.net_first_layer.push(self.layer_size.len() as i64);
+                self.net_weight.extend(&ct.weights);
+                self.net_weight.extend(&ct.input_weights);
+                self.net_first_weight.push(self.net_weight.len() as i64);
+                self.net_clock.push(ct.clock.unwrap_or(f64::NAN));
+                self.net_input.extend(inputs.iter().map(|&i| i as i32));
+                self.net_first_input.push(self.net_input.len() as i64);
+                for &o in &c.outputs {
+                    self.net_output_muscle.push(o as i32);
+                    self.net_output_shift.push(shift(o));
+                }
+                self.net_first_output
+                    .push(self.net_output_muscle.len() as i64);
+                self.push_scratch(m + n);
+                for i in 0..n {
+                    self.neuron_param
+                        .extend([ct.tau[i], ct.bias[i], ct.gain[i]]);
+                }
+                self.neuron_state.extend(&ct.state);
+                self.net_first_neuron.push(self.neuron_state.len() as i64);
                 continue;
             }
             let g = c.brain.genome();
             let n = c.outputs.len();
             if kind != "oscillator" || g.len() != 1 + 3 * n {
                 return Err(format!(
-                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators and neural networks are",
+                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks and CTRNNs are",
                     c.name
                 ));
             }

@@ -282,6 +282,24 @@ clock = 2.0
 }
 
 #[test]
+fn ctrnn_brains_are_the_engine_s_to_the_bit() {
+    // The walker's CTRNN (its recurrent neurons' states carried from step
+    // to step), its own and random genomes, and perturbed trials.
+    let text = WALKER_CTRNN.replace("duration = 10.0", "duration = 2.0");
+    let got = assert_same(genomes(&text, 12, 8), "CTRNN walker");
+    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
+    d.sort_unstable();
+    d.dedup();
+    assert!(d.len() > 6, "{got:?}");
+    let text = text.replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
+    let mut scenes = genomes(&text, 6, 9);
+    for (k, s) in scenes.iter_mut().enumerate() {
+        animats_scene::evaluate::perturb(s, k as u32).unwrap();
+    }
+    assert_same(scenes, "perturbed CTRNN walkers");
+}
+
+#[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
     // The energy measure, the energy weight.
     let text = BODIES_WALK.replace("{ kind = \"size\" }", "{ kind = \"energy\" }");
@@ -298,23 +316,22 @@ fn what_the_c_does_not_evaluate_is_refused_by_name() {
         .unwrap();
     let err = Batch::pack_scenes(&[&scene]).unwrap_err();
     assert!(err.contains("energy_weight"), "{err}");
-    // A CTRNN brain (beside a walker that packs).
-    let walker = SceneProblem::parse(WALKER, "walker.toml")
-        .unwrap()
-        .fresh()
-        .unwrap();
-    let ctrnn = SceneProblem::parse(WALKER_CTRNN, "walker_ctrnn.toml")
-        .unwrap()
-        .fresh()
-        .unwrap();
-    let err = Batch::pack_scenes(&[&walker, &ctrnn]).unwrap_err();
-    assert!(err.contains("scene 1") && err.contains("ctrnn"), "{err}");
+    // An FSM brain.
+    let pogo =
+        include_str!("../../../scenes/pogo.toml").to_string() + "\n[evolve]\nduration = 1.0\n";
+    let fsm = animats_scene::parse(&pogo, "pogo.toml").unwrap();
+    let err = Batch::pack_scenes(&[&fsm]).unwrap_err();
+    assert!(err.contains("scene 0") && err.contains("(fsm)"), "{err}");
     // A scene without [evolve].
     let plain =
         animats_scene::parse(&WALKER[..WALKER.find("[evolve]").unwrap()], "walker.toml").unwrap();
     let err = Batch::pack_scenes(&[&plain]).unwrap_err();
     assert!(err.contains("[evolve]"), "{err}");
     // Evaluated once.
+    let walker = SceneProblem::parse(WALKER, "walker.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
     let mut batch = Batch::pack_scenes(&[&walker]).unwrap();
     batch.evaluate_cpu().unwrap();
     assert!(batch.evaluate_cpu().unwrap_err().contains("once"));

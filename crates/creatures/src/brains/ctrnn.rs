@@ -190,6 +190,10 @@ impl Brain for Ctrnn {
         "ctrnn"
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
         let n = self.neurons();
         let (x, rates) = &mut self.scratch;
