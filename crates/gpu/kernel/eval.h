@@ -220,6 +220,66 @@ AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, doubl
     }
 }
 
+/* FSM m (a network entry, over the batch) of creature c at time t
+ * (brains/fsm.rs `think`): the first transition of the current state that
+ * fires (its sensor above or below a threshold, and `after` seconds in the
+ * state) moves it; each output moves towards the state's level at its
+ * rate. Its states are numbers in net_weight (scenes.rs says how); its
+ * inputs, levels, current state, entry time and start in net_scratch. */
+AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double dt) {
+    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long i0 = b->net_first_input[m], ni = b->net_first_input[m + 1] - i0;
+    long long o0 = b->net_first_output[m], no = b->net_first_output[m + 1] - o0;
+    double *x = b->net_scratch + b->net_first_scratch[m], *levels = x + ni, *own = levels + no;
+    for (long long i = 0; i < ni; i++) {
+        x[i] = b->sensor_level[q0 + b->net_input[i0 + i]];
+    }
+    const double *w = b->net_weight + b->net_first_weight[m];
+    if (own[2] == 0.0) { /* started */
+        own[2] = 1.0;
+        own[1] = t;
+    }
+    double in_state = t - own[1];
+    const double *st = w + (long long)w[1 + (long long)own[0]];
+    long long transitions = (long long)st[1];
+    const double *tr = st + 2 + no;
+    for (long long k = 0; k < transitions; k++, tr += 5) {
+        int kind = (int)tr[1];
+        double sensed = kind == 0 ? 1.0 : x[(long long)tr[2]];
+        int fires = kind == 0 || (kind == 1 ? sensed > tr[3] : sensed < tr[3]);
+        if (fires && (tr[4] != tr[4] || in_state >= tr[4])) {
+            own[0] = tr[0];
+            own[1] = t;
+            break;
+        }
+    }
+    st = w + (long long)w[1 + (long long)own[0]];
+    double rate = st[0];
+    for (long long o = 0; o < no; o++) {
+        double target = st[2 + o];
+        if (rate != rate) {
+            levels[o] = target;
+        } else {
+            double step = rate * dt, lo = -step, d = target - levels[o];
+            if (d < lo) {
+                d = lo;
+            }
+            if (d > step) {
+                d = step;
+            }
+            levels[o] = levels[o] + d;
+        }
+    }
+    for (long long o = 0; o < no; o++) {
+        double l = levels[o];
+        double shift = b->net_output_shift[o0 + o];
+        if (shift == shift) {
+            l = l + shift;
+        }
+        an_slew(b, u0 + b->net_output_muscle[o0 + o], s0, l, dt);
+    }
+}
+
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order. */
 AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
@@ -236,8 +296,10 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
             an_oscillator(b, c, b->ctrl_index[k], t, dt);
         } else if (b->ctrl_kind[k] == 1) {
             an_network(b, c, b->ctrl_index[k], t, dt);
-        } else {
+        } else if (b->ctrl_kind[k] == 2) {
             an_ctrnn(b, c, b->ctrl_index[k], t, dt);
+        } else {
+            an_fsm(b, c, b->ctrl_index[k], t, dt);
         }
     }
 }

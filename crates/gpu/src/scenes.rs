@@ -7,7 +7,7 @@
 //!
 //! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
 //! spring muscles (a spring's rest length between `min` and `max`, with or
-//! without a `rate`), oscillator, neural and CTRNN brains, the centre of the
+//! without a `rate`), oscillator, neural, CTRNN and FSM brains, the centre of the
 //! particles that count, `fail_on_touch` and `fail_on_stretch`, the
 //! divergence guard of a driven scene, the `[archive]` measures and
 //! `[evolve] terms` but `energy`, and the fitness's time, distance and
@@ -17,6 +17,7 @@
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
 use animats_creatures::brains::ctrnn::Ctrnn;
+use animats_creatures::brains::fsm::{Condition, Fsm};
 use animats_creatures::brains::neural::Neural;
 use animats_creatures::nervous_system::Inputs;
 use animats_creatures::sensor::Sensor;
@@ -126,10 +127,10 @@ impl Rules {
         self.ended = vec![0; 2 * creatures];
     }
 
-    /// Room for `n` doubles of a network's scratch.
+    /// Room for `n` doubles of a network's scratch, zero.
     fn push_scratch(&mut self, n: usize) {
-        let room = self.net_first_scratch.last().copied().unwrap_or(0) + n as i64;
-        self.net_first_scratch.push(room);
+        self.net_scratch.resize(self.net_scratch.len() + n, 0.0);
+        self.net_first_scratch.push(self.net_scratch.len() as i64);
     }
 
     /// The networks' offset arrays (over the batch: one more than networks).
@@ -264,11 +265,74 @@ impl Rules {
                 self.net_first_neuron.push(self.neuron_state.len() as i64);
                 continue;
             }
+            if let Some(fsm) = c.brain.as_any().and_then(|a| a.downcast_ref::<Fsm>()) {
+                let Inputs::Sensors(inputs) = &c.inputs else {
+                    return Err(format!(
+                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
+                        c.name
+                    ));
+                };
+                self.ctrl_kind.push(3);
+                self.ctrl_index.push(self.net_clock.len() as i32);
+                self.net_first_layer.push(self.layer_size.len() as i64);
+                // The states as numbers: their count, each one's offset,
+                // then each: rate (NaN: none), transitions, levels, and
+                // per transition to, condition (0 none, 1 above, 2
+                // below), input, threshold, after (NaN: none).
+                let w0 = self.net_weight.len();
+                let ns = fsm.states.len();
+                self.net_weight.push(ns as f64);
+                self.net_weight.resize(w0 + 1 + ns, 0.0);
+                for (k, st) in fsm.states.iter().enumerate() {
+                    self.net_weight[w0 + 1 + k] = (self.net_weight.len() - w0) as f64;
+                    self.net_weight
+                        .extend([st.rate.unwrap_or(f64::NAN), st.transitions.len() as f64]);
+                    self.net_weight.extend(&st.levels);
+                    for tr in &st.transitions {
+                        let (kind, input, threshold) = match tr.condition {
+                            Condition::None => (0.0, 0.0, 0.0),
+                            Condition::Above { input, threshold } => (1.0, input as f64, threshold),
+                            Condition::Below { input, threshold } => (2.0, input as f64, threshold),
+                        };
+                        self.net_weight.extend([
+                            tr.to as f64,
+                            kind,
+                            input,
+                            threshold,
+                            tr.after.unwrap_or(f64::NAN),
+                        ]);
+                    }
+                }
+                self.net_first_weight.push(self.net_weight.len() as i64);
+                self.net_clock.push(f64::NAN);
+                self.net_input.extend(inputs.iter().map(|&i| i as i32));
+                self.net_first_input.push(self.net_input.len() as i64);
+                for &o in &c.outputs {
+                    self.net_output_muscle.push(o as i32);
+                    self.net_output_shift.push(shift(o));
+                }
+                self.net_first_output
+                    .push(self.net_output_muscle.len() as i64);
+                // Scratch: the inputs, then the machine's own state: its
+                // levels, its current state, when it was entered, started.
+                let (entered, started) = fsm.entered();
+                self.net_scratch
+                    .resize(self.net_scratch.len() + inputs.len(), 0.0);
+                self.net_scratch.extend(fsm.levels());
+                self.net_scratch.extend([
+                    fsm.current() as f64,
+                    entered,
+                    if started { 1.0 } else { 0.0 },
+                ]);
+                self.net_first_scratch.push(self.net_scratch.len() as i64);
+                self.net_first_neuron.push(self.neuron_state.len() as i64);
+                continue;
+            }
             let g = c.brain.genome();
             let n = c.outputs.len();
             if kind != "oscillator" || g.len() != 1 + 3 * n {
                 return Err(format!(
-                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks and CTRNNs are",
+                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks, CTRNNs and FSMs are",
                     c.name
                 ));
             }
@@ -440,7 +504,6 @@ impl Batch {
         }
         r.measure_sum = vec![0.0; r.measure_kind.len()];
         r.sensor_level = vec![0.0; r.sensor_kind.len()];
-        r.net_scratch = vec![0.0; r.net_first_scratch.last().copied().unwrap_or(0) as usize];
         r.measure_start = vec![0.0; 3 * r.measure_kind.len()];
         r.result = vec![0.0; 3 * scenes.len()];
         r.ended = vec![0; 2 * scenes.len()];

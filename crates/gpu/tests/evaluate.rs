@@ -300,6 +300,27 @@ fn ctrnn_brains_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn fsm_brains_are_the_engine_s_to_the_bit() {
+    // The pogo hopper's FSM (touch and length sensors, timed and sensed
+    // transitions), its own and random genomes (levels, thresholds,
+    // times), with a state's own rate, and perturbed trials.
+    let pogo = include_str!("../../../scenes/pogo.toml")
+        .replace("levels = [0.7]", "levels = [0.7]\nrate = 3.0")
+        + "\n[evolve]\ncontroller = \"hop\"\nduration = 2.0\naxis = [0.0, 1.0, 0.0]\n";
+    let got = assert_same(genomes(&pogo, 12, 10), "pogo");
+    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
+    d.sort_unstable();
+    d.dedup();
+    assert!(d.len() > 6, "{got:?}");
+    let noisy = pogo.replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
+    let mut scenes = genomes(&noisy, 6, 11);
+    for (k, s) in scenes.iter_mut().enumerate() {
+        animats_scene::evaluate::perturb(s, k as u32).unwrap();
+    }
+    assert_same(scenes, "perturbed pogo");
+}
+
+#[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
     // The energy measure, the energy weight.
     let text = BODIES_WALK.replace("{ kind = \"size\" }", "{ kind = \"energy\" }");
@@ -316,12 +337,14 @@ fn what_the_c_does_not_evaluate_is_refused_by_name() {
         .unwrap();
     let err = Batch::pack_scenes(&[&scene]).unwrap_err();
     assert!(err.contains("energy_weight"), "{err}");
-    // An FSM brain.
-    let pogo =
-        include_str!("../../../scenes/pogo.toml").to_string() + "\n[evolve]\nduration = 1.0\n";
-    let fsm = animats_scene::parse(&pogo, "pogo.toml").unwrap();
-    let err = Batch::pack_scenes(&[&fsm]).unwrap_err();
-    assert!(err.contains("scene 0") && err.contains("(fsm)"), "{err}");
+    // A creature that acts by itself (the quadruped).
+    let dog = include_str!("../../../scenes/quadruped3_gait.toml");
+    let dog = SceneProblem::parse(dog, "quadruped3_gait.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
+    let err = Batch::pack_scenes(&[&dog]).unwrap_err();
+    assert!(err.contains("scene 0") && err.contains("`dog`"), "{err}");
     // A scene without [evolve].
     let plain =
         animats_scene::parse(&WALKER[..WALKER.find("[evolve]").unwrap()], "walker.toml").unwrap();

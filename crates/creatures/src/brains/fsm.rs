@@ -271,6 +271,18 @@ impl Fsm {
         self.current
     }
 
+    /// The levels it outputs now (each moving towards the current state's
+    /// at its `rate`).
+    pub fn levels(&self) -> &[f64] {
+        &self.levels
+    }
+
+    /// When the current state was entered, s, and whether the machine has
+    /// started (its first `think` sets the clock of its first state).
+    pub fn entered(&self) -> (f64, bool) {
+        (self.entered, self.started)
+    }
+
     fn fires(t: &Transition, inputs: &[f64], in_state: f64) -> bool {
         let sensed = match t.condition {
             Condition::Above { input, threshold } => inputs[input] > threshold,
@@ -321,6 +333,10 @@ impl Fsm {
 impl Brain for Fsm {
     fn kind(&self) -> &'static str {
         "fsm"
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 
     fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
