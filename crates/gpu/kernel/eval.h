@@ -120,14 +120,10 @@ AN_FN void an_oscillator(const an_batch *b, long long c, long long o, double t, 
     }
 }
 
-/* Network m (over the batch) of creature c at time t (brains/neural.rs:
- * inputs 2 level - 1, the clock's sine and cosine, tanh layers, a
- * logistic output layer). */
-AN_FN void an_network(const an_batch *b, long long c, long long m, double t, double dt) {
-    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
-    long long r0 = b->net_first_scratch[m];
-    long long width = (b->net_first_scratch[m + 1] - r0) / 2;
-    double *x = b->net_scratch + r0, *y = x + width;
+/* brain.rs `network_inputs` of network m, whose creature's sensors begin
+ * at q0, at time t, into x: each input level as 2 level - 1, then the
+ * clock's sine and cosine if it has one. */
+AN_FN void an_net_inputs(const an_batch *b, long long q0, long long m, double t, double *x) {
     long long ni = 0;
     for (long long i = b->net_first_input[m]; i < b->net_first_input[m + 1]; i++) {
         x[ni++] = 2.0 * b->sensor_level[q0 + b->net_input[i]] - 1.0;
@@ -138,6 +134,32 @@ AN_FN void an_network(const an_batch *b, long long c, long long m, double t, dou
         x[ni++] = an_sin(w);
         x[ni++] = an_cos(w);
     }
+}
+
+/* The levels of network m's outputs (a trial's offsets added) to its
+ * muscles, each slewed (creature c's springs begin at s0, muscles at u0). */
+AN_FN void an_net_outputs(const an_batch *b, long long s0, long long u0, long long m,
+                          const double *levels, double dt) {
+    long long o0 = b->net_first_output[m];
+    for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
+        double l = levels[o - o0];
+        double shift = b->net_output_shift[o];
+        if (shift == shift) {
+            l = l + shift;
+        }
+        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
+    }
+}
+
+/* Network m (over the batch) of creature c at time t (brains/neural.rs:
+ * inputs 2 level - 1, the clock's sine and cosine, tanh layers, a
+ * logistic output layer). */
+AN_FN void an_network(const an_batch *b, long long c, long long m, double t, double dt) {
+    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long r0 = b->net_first_scratch[m];
+    long long width = (b->net_first_scratch[m + 1] - r0) / 2;
+    double *x = b->net_scratch + r0, *y = x + width;
+    an_net_inputs(b, q0, m, t, x);
     const int *sizes = b->layer_size + b->net_first_layer[m];
     long long layers = b->net_first_layer[m + 1] - b->net_first_layer[m] - 1;
     const double *wt = b->net_weight;
@@ -157,15 +179,7 @@ AN_FN void an_network(const an_batch *b, long long c, long long m, double t, dou
         x = y;
         y = swap;
     }
-    long long o0 = b->net_first_output[m];
-    for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
-        double l = x[o - o0];
-        double shift = b->net_output_shift[o];
-        if (shift == shift) {
-            l = l + shift;
-        }
-        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
-    }
+    an_net_outputs(b, s0, u0, m, x, dt);
 }
 
 /* brains/ctrnn.rs `sigma`: the logistic function. */
@@ -180,16 +194,7 @@ AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, doubl
     const int *sizes = b->layer_size + b->net_first_layer[m];
     long long n = sizes[0], mi = sizes[1];
     double *x = b->net_scratch + b->net_first_scratch[m], *rates = x + mi;
-    long long ni = 0;
-    for (long long i = b->net_first_input[m]; i < b->net_first_input[m + 1]; i++) {
-        x[ni++] = 2.0 * b->sensor_level[q0 + b->net_input[i]] - 1.0;
-    }
-    double f = b->net_clock[m];
-    if (f == f) {
-        double w = (6.283185307179586 * f) * t;
-        x[ni++] = an_sin(w);
-        x[ni++] = an_cos(w);
-    }
+    an_net_inputs(b, q0, m, t, x);
     const double *np = b->neuron_param + 3 * b->net_first_neuron[m];
     double *state = b->neuron_state + b->net_first_neuron[m];
     for (long long i = 0; i < n; i++) {
@@ -208,16 +213,12 @@ AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, doubl
         double h = dt / (tau > 1e-4 ? tau : 1e-4); /* tau.max(MIN_TAU) */
         state[i] = (state[i] + h * drive) / (1.0 + h);
     }
-    long long o0 = b->net_first_output[m];
-    for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
-        long long i = o - o0;
-        double l = an_sigma(np[3 * i + 2] * (state[i] + np[3 * i + 1]));
-        double shift = b->net_output_shift[o];
-        if (shift == shift) {
-            l = l + shift;
-        }
-        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
+    /* Neuron i drives output i, at its rate after the step. */
+    long long outputs = b->net_first_output[m + 1] - b->net_first_output[m];
+    for (long long i = 0; i < outputs; i++) {
+        rates[i] = an_sigma(np[3 * i + 2] * (state[i] + np[3 * i + 1]));
     }
+    an_net_outputs(b, s0, u0, m, rates, dt);
 }
 
 /* FSM m (a network entry, over the batch) of creature c at time t
@@ -270,14 +271,7 @@ AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double 
             levels[o] = levels[o] + d;
         }
     }
-    for (long long o = 0; o < no; o++) {
-        double l = levels[o];
-        double shift = b->net_output_shift[o0 + o];
-        if (shift == shift) {
-            l = l + shift;
-        }
-        an_slew(b, u0 + b->net_output_muscle[o0 + o], s0, l, dt);
-    }
+    an_net_outputs(b, s0, u0, m, levels, dt);
 }
 
 /* The nervous system of creature c acts at time t (nervous_system.rs

@@ -19,7 +19,7 @@ use animats_creatures::actuators::AnyActuator;
 use animats_creatures::brains::ctrnn::Ctrnn;
 use animats_creatures::brains::fsm::{Condition, Fsm};
 use animats_creatures::brains::neural::Neural;
-use animats_creatures::nervous_system::Inputs;
+use animats_creatures::nervous_system::{Inputs, Wired};
 use animats_creatures::sensor::Sensor;
 use animats_creatures::sensors::probe::{Probe, ScaledSensor};
 use animats_engine::{DVec3, ParticleId, World};
@@ -196,138 +196,11 @@ impl Rules {
             self.add_sensor(name, sensor.as_ref())?;
         }
         for c in &nervous.controllers {
-            let kind = c.brain.kind();
             let shift = |o: usize| nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
-            if let Some(net) = c.brain.as_any().and_then(|a| a.downcast_ref::<Neural>()) {
-                let Inputs::Sensors(inputs) = &c.inputs else {
-                    return Err(format!(
-                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
-                        c.name
-                    ));
-                };
-                self.ctrl_kind.push(1);
-                self.ctrl_index.push(self.net_clock.len() as i32);
-                self.layer_size.extend(net.sizes.iter().map(|&n| n as i32));
-                self.net_first_layer.push(self.layer_size.len() as i64);
-                self.net_weight.extend(&net.weights);
-                self.net_first_weight.push(self.net_weight.len() as i64);
-                self.net_clock.push(net.clock.unwrap_or(f64::NAN));
-                self.net_input.extend(inputs.iter().map(|&i| i as i32));
-                self.net_first_input.push(self.net_input.len() as i64);
-                for &o in &c.outputs {
-                    self.net_output_muscle.push(o as i32);
-                    self.net_output_shift.push(shift(o));
-                }
-                self.net_first_output
-                    .push(self.net_output_muscle.len() as i64);
-                let width = net.sizes.iter().copied().max().unwrap_or(0);
-                self.push_scratch(2 * width);
-                self.net_first_neuron.push(self.neuron_state.len() as i64);
+            if self.add_network(c, &shift)? {
                 continue;
             }
-            if let Some(ct) = c.brain.as_any().and_then(|a| a.downcast_ref::<Ctrnn>()) {
-                let Inputs::Sensors(inputs) = &c.inputs else {
-                    return Err(format!(
-                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
-                        c.name
-                    ));
-                };
-                // A network entry: its layers say neurons, inputs (the
-                // clock's two counted) and outputs.
-                let n = ct.neurons();
-                let m = inputs.len() + if ct.clock.is_some() { 2 } else { 0 };
-                if ct.weights.len() != n * n || ct.input_weights.len() != n * m {
-                    return Err(format!("the controller `{}`: malformed CTRNN", c.name));
-                }
-                self.ctrl_kind.push(2);
-                self.ctrl_index.push(self.net_clock.len() as i32);
-                self.layer_size
-                    .extend([n as i32, m as i32, ct.outputs as i32]);
-                self.net_first_layer.push(self.layer_size.len() as i64);
-                self.net_weight.extend(&ct.weights);
-                self.net_weight.extend(&ct.input_weights);
-                self.net_first_weight.push(self.net_weight.len() as i64);
-                self.net_clock.push(ct.clock.unwrap_or(f64::NAN));
-                self.net_input.extend(inputs.iter().map(|&i| i as i32));
-                self.net_first_input.push(self.net_input.len() as i64);
-                for &o in &c.outputs {
-                    self.net_output_muscle.push(o as i32);
-                    self.net_output_shift.push(shift(o));
-                }
-                self.net_first_output
-                    .push(self.net_output_muscle.len() as i64);
-                self.push_scratch(m + n);
-                for i in 0..n {
-                    self.neuron_param
-                        .extend([ct.tau[i], ct.bias[i], ct.gain[i]]);
-                }
-                self.neuron_state.extend(&ct.state);
-                self.net_first_neuron.push(self.neuron_state.len() as i64);
-                continue;
-            }
-            if let Some(fsm) = c.brain.as_any().and_then(|a| a.downcast_ref::<Fsm>()) {
-                let Inputs::Sensors(inputs) = &c.inputs else {
-                    return Err(format!(
-                        "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
-                        c.name
-                    ));
-                };
-                self.ctrl_kind.push(3);
-                self.ctrl_index.push(self.net_clock.len() as i32);
-                self.net_first_layer.push(self.layer_size.len() as i64);
-                // The states as numbers: their count, each one's offset,
-                // then each: rate (NaN: none), transitions, levels, and
-                // per transition to, condition (0 none, 1 above, 2
-                // below), input, threshold, after (NaN: none).
-                let w0 = self.net_weight.len();
-                let ns = fsm.states.len();
-                self.net_weight.push(ns as f64);
-                self.net_weight.resize(w0 + 1 + ns, 0.0);
-                for (k, st) in fsm.states.iter().enumerate() {
-                    self.net_weight[w0 + 1 + k] = (self.net_weight.len() - w0) as f64;
-                    self.net_weight
-                        .extend([st.rate.unwrap_or(f64::NAN), st.transitions.len() as f64]);
-                    self.net_weight.extend(&st.levels);
-                    for tr in &st.transitions {
-                        let (kind, input, threshold) = match tr.condition {
-                            Condition::None => (0.0, 0.0, 0.0),
-                            Condition::Above { input, threshold } => (1.0, input as f64, threshold),
-                            Condition::Below { input, threshold } => (2.0, input as f64, threshold),
-                        };
-                        self.net_weight.extend([
-                            tr.to as f64,
-                            kind,
-                            input,
-                            threshold,
-                            tr.after.unwrap_or(f64::NAN),
-                        ]);
-                    }
-                }
-                self.net_first_weight.push(self.net_weight.len() as i64);
-                self.net_clock.push(f64::NAN);
-                self.net_input.extend(inputs.iter().map(|&i| i as i32));
-                self.net_first_input.push(self.net_input.len() as i64);
-                for &o in &c.outputs {
-                    self.net_output_muscle.push(o as i32);
-                    self.net_output_shift.push(shift(o));
-                }
-                self.net_first_output
-                    .push(self.net_output_muscle.len() as i64);
-                // Scratch: the inputs, then the machine's own state: its
-                // levels, its current state, when it was entered, started.
-                let (entered, started) = fsm.entered();
-                self.net_scratch
-                    .resize(self.net_scratch.len() + inputs.len(), 0.0);
-                self.net_scratch.extend(fsm.levels());
-                self.net_scratch.extend([
-                    fsm.current() as f64,
-                    entered,
-                    if started { 1.0 } else { 0.0 },
-                ]);
-                self.net_first_scratch.push(self.net_scratch.len() as i64);
-                self.net_first_neuron.push(self.neuron_state.len() as i64);
-                continue;
-            }
+            let kind = c.brain.kind();
             let g = c.brain.genome();
             let n = c.outputs.len();
             if kind != "oscillator" || g.len() != 1 + 3 * n {
@@ -394,6 +267,110 @@ impl Rules {
         self.first_sensor.push(self.sensor_kind.len() as i64);
         self.first_ctrl.push(self.ctrl_kind.len() as i64);
         Ok(())
+    }
+
+    /// Appends controller `c` if it is a network entry (a neural network,
+    /// a CTRNN or an FSM: sensors in, levels out, its numbers in
+    /// `net_weight`, its working state in `net_scratch`): `Ok(false)` for
+    /// another kind.
+    fn add_network(&mut self, c: &Wired, shift: &dyn Fn(usize) -> f64) -> Result<bool, String> {
+        let any = c.brain.as_any();
+        let neural = any.and_then(|a| a.downcast_ref::<Neural>());
+        let ctrnn = any.and_then(|a| a.downcast_ref::<Ctrnn>());
+        let fsm = any.and_then(|a| a.downcast_ref::<Fsm>());
+        if neural.is_none() && ctrnn.is_none() && fsm.is_none() {
+            return Ok(false);
+        }
+        let Inputs::Sensors(inputs) = &c.inputs else {
+            return Err(format!(
+                "the controller `{}` reads a creature's own senses, not [[sensor]]s: not in the GPU evaluation yet",
+                c.name
+            ));
+        };
+        self.ctrl_index.push(self.net_clock.len() as i32);
+        if let Some(net) = neural {
+            self.ctrl_kind.push(1);
+            self.layer_size.extend(net.sizes.iter().map(|&n| n as i32));
+            self.net_weight.extend(&net.weights);
+            self.net_clock.push(net.clock.unwrap_or(f64::NAN));
+            let width = net.sizes.iter().copied().max().unwrap_or(0);
+            self.push_scratch(2 * width);
+        } else if let Some(ct) = ctrnn {
+            // Its layers say neurons, inputs (the clock's two counted) and
+            // outputs; its weights are the recurrent, then the input ones.
+            let n = ct.neurons();
+            let m = inputs.len() + if ct.clock.is_some() { 2 } else { 0 };
+            if ct.weights.len() != n * n || ct.input_weights.len() != n * m {
+                return Err(format!("the controller `{}`: malformed CTRNN", c.name));
+            }
+            self.ctrl_kind.push(2);
+            self.layer_size
+                .extend([n as i32, m as i32, ct.outputs as i32]);
+            self.net_weight.extend(&ct.weights);
+            self.net_weight.extend(&ct.input_weights);
+            self.net_clock.push(ct.clock.unwrap_or(f64::NAN));
+            self.push_scratch(m + n);
+            for i in 0..n {
+                self.neuron_param
+                    .extend([ct.tau[i], ct.bias[i], ct.gain[i]]);
+            }
+            self.neuron_state.extend(&ct.state);
+        } else if let Some(fsm) = fsm {
+            self.ctrl_kind.push(3);
+            // The states as numbers: their count, each one's offset, then
+            // each: rate (NaN: none), transitions, levels, and per
+            // transition to, condition (0 none, 1 above, 2 below), input,
+            // threshold, after (NaN: none).
+            let w0 = self.net_weight.len();
+            let ns = fsm.states.len();
+            self.net_weight.push(ns as f64);
+            self.net_weight.resize(w0 + 1 + ns, 0.0);
+            for (k, st) in fsm.states.iter().enumerate() {
+                self.net_weight[w0 + 1 + k] = (self.net_weight.len() - w0) as f64;
+                self.net_weight
+                    .extend([st.rate.unwrap_or(f64::NAN), st.transitions.len() as f64]);
+                self.net_weight.extend(&st.levels);
+                for tr in &st.transitions {
+                    let (kind, input, threshold) = match tr.condition {
+                        Condition::None => (0.0, 0.0, 0.0),
+                        Condition::Above { input, threshold } => (1.0, input as f64, threshold),
+                        Condition::Below { input, threshold } => (2.0, input as f64, threshold),
+                    };
+                    self.net_weight.extend([
+                        tr.to as f64,
+                        kind,
+                        input,
+                        threshold,
+                        tr.after.unwrap_or(f64::NAN),
+                    ]);
+                }
+            }
+            self.net_clock.push(f64::NAN);
+            // Scratch: the inputs, then the machine's own state: its
+            // levels, its current state, when it was entered, started.
+            let (entered, started) = fsm.entered();
+            self.net_scratch
+                .resize(self.net_scratch.len() + inputs.len(), 0.0);
+            self.net_scratch.extend(fsm.levels());
+            self.net_scratch.extend([
+                fsm.current() as f64,
+                entered,
+                if started { 1.0 } else { 0.0 },
+            ]);
+            self.net_first_scratch.push(self.net_scratch.len() as i64);
+        }
+        self.net_first_layer.push(self.layer_size.len() as i64);
+        self.net_first_weight.push(self.net_weight.len() as i64);
+        self.net_first_neuron.push(self.neuron_state.len() as i64);
+        self.net_input.extend(inputs.iter().map(|&i| i as i32));
+        self.net_first_input.push(self.net_input.len() as i64);
+        for &o in &c.outputs {
+            self.net_output_muscle.push(o as i32);
+            self.net_output_shift.push(shift(o));
+        }
+        self.net_first_output
+            .push(self.net_output_muscle.len() as i64);
+        Ok(true)
     }
 
     /// Appends sensor `name` (a scene's `[[sensor]]`).
