@@ -21,6 +21,9 @@
 #include "trig.h"
 #include "exp.h"
 
+/* Numbers of eval_param per creature (step.h says which). */
+#define AN_PARAMS 16
+
 /* Why an evaluation ended, as scene::evaluate::Ended. */
 enum { AN_TIMEOUT = 0, AN_TOUCH = 1, AN_STRETCH = 2, AN_BLOWUP = 3 };
 
@@ -340,7 +343,8 @@ enum {
     AN_M_DISPLACEMENT = 2, /* the centre's final offset along an axis */
     AN_M_MEAN_HEIGHT = 3,  /* the centre's height, a step */
     AN_M_SPEED = 4,        /* the displacement over the time survived */
-    AN_M_FIXED = 5         /* particles, muscles, mass, size: fixed when built */
+    AN_M_FIXED = 5,        /* particles, muscles, mass, size: fixed when built */
+    AN_M_ENERGY = 6        /* the muscles' positive work, J */
 };
 
 /* Measure q's particles and their number. */
@@ -373,7 +377,7 @@ AN_FN void an_measures_begin(const an_batch *b, long long c) {
 /* Recorder::step: after each step. */
 AN_FN void an_measures_step(const an_batch *b, long long c) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
-    double tolerance = b->eval_param[8 * c + 5];
+    double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
         long long nk;
         const int *ids = an_measure_ids(b, q, &nk);
@@ -400,7 +404,8 @@ AN_FN void an_measures_step(const an_batch *b, long long c) {
 
 /* Recorder::finish: each measure's value, after `steps` steps and `time`
  * survived, into measure_sum. */
-AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, double time) {
+AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, double time,
+                               double work) {
     long long p0 = b->first_particle[c];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
         long long nk;
@@ -419,6 +424,8 @@ AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, d
             if (kind == AN_M_SPEED) {
                 value = time > 0.0 ? value / time : 0.0;
             }
+        } else if (kind == AN_M_ENERGY) {
+            value = work;
         } else {
             value = b->measure_fixed[q];
         }
@@ -432,7 +439,7 @@ AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, d
 AN_FN int an_ending(const an_batch *b, long long c, long long *which) {
     long long p0 = b->first_particle[c];
     const double *x = b->pos + 3 * p0;
-    double tolerance = b->eval_param[8 * c + 5];
+    double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long k = b->first_touch[c]; k < b->first_touch[c + 1]; k++) {
         long long p = b->touch_particle[k];
         if (x[3 * p + 1] - b->radius[p0 + p] <= tolerance) {
@@ -467,9 +474,44 @@ AN_FN int an_guard(const an_batch *b, long long c) {
     return 1;
 }
 
+/* work.rs `Work::before` for creature c's spring muscles: each spring's
+ * length and rest length before the step, into muscle_work. */
+AN_FN void an_work_before(const an_batch *b, long long c) {
+    long long p0 = b->first_particle[c], s0 = b->first_spring[c];
+    const double *x = b->pos + 3 * p0;
+    for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
+        long long s = s0 + b->muscle_spring[q];
+        double d[3];
+        for (int k = 0; k < 3; k++) {
+            d[k] = x[3 * b->spring_a[s] + k] - x[3 * b->spring_b[s] + k];
+        }
+        b->muscle_work[2 * q] = sqrt(an_dot(d, d));
+        b->muscle_work[2 * q + 1] = b->rest_length[s];
+    }
+}
+
+/* work.rs `Work::after`: the positive work creature c's muscles did in
+ * the step (each moved its rest length under the spring's tension), added
+ * to `positive` muscle by muscle. */
+AN_FN double an_work_after(const an_batch *b, long long c, double positive) {
+    long long s0 = b->first_spring[c];
+    for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
+        long long s = s0 + b->muscle_spring[q];
+        double now = b->muscle_work[2 * q], rest = b->muscle_work[2 * q + 1];
+        double r = b->rest_length[s], k = b->stiffness[s];
+        double done = 0.5 * k * ((now - r) * (now - r) - (now - rest) * (now - rest));
+        if (done > 0.0) {
+            positive = positive + done;
+        }
+    }
+    return positive;
+}
+
 /* The evaluation of creature c (scene::evaluate::evaluate_with). */
 AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
-    const double *param = b->eval_param + 8 * c;
+    const double *param = b->eval_param + AN_PARAMS * c;
+    int work = param[8] != 0.0;
+    double positive = 0.0;
     double dt = b->dt, t = param[6], carry = param[7];
     long long steps = b->eval_count[3 * c], taken = b->eval_count[3 * c + 1];
     long long done = 0, which = 0;
@@ -482,6 +524,9 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     int why = an_ending(b, c, &which);
     if (why == AN_TIMEOUT) {
         while (done < steps) {
+            if (work) {
+                an_work_before(b, c);
+            }
             an_act(b, c, t, dt); /* Scene::step: the nervous system first */
             if (!an_step_once(b, c)) {
                 why = AN_BLOWUP;
@@ -496,6 +541,9 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
             if (taken % 64 == 0 && !an_guard(b, c)) {
                 why = AN_BLOWUP;
                 break;
+            }
+            if (work) {
+                positive = an_work_after(b, c, positive);
             }
             done++;
             an_measures_step(b, c);
@@ -522,16 +570,29 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     if (why == AN_BLOWUP) {
         distance = distance < 0.0 ? distance : 0.0;
     }
-    an_measures_finish(b, c, done, time);
+    an_measures_finish(b, c, done, time, positive);
     double fitness = param[3] * time + param[4] * distance;
+    if (param[9] != 0.0) { /* energy_weight */
+        fitness -= param[9] * positive;
+    }
+    double off[3];
+    for (int d = 0; d < 3; d++) {
+        off[d] = last[d] - param[11 + d];
+    }
+    double target = sqrt(an_dot(off, off));
+    if (param[10] != 0.0) { /* target, its weight */
+        fitness -= param[14] * target;
+    }
     /* The terms, after the archive's measures: each times its weight. */
     for (long long q = b->first_measure[c] + b->eval_count[3 * c + 2]; q < b->first_measure[c + 1];
          q++) {
         fitness = fitness + b->measure_weight[q] * b->measure_sum[q];
     }
-    b->result[3 * c] = fitness;
-    b->result[3 * c + 1] = distance;
-    b->result[3 * c + 2] = time;
+    b->result[5 * c] = fitness;
+    b->result[5 * c + 1] = distance;
+    b->result[5 * c + 2] = time;
+    b->result[5 * c + 3] = positive;
+    b->result[5 * c + 4] = target;
     b->ended[2 * c] = why;
     b->ended[2 * c + 1] = which;
 }

@@ -115,11 +115,13 @@ typedef struct {
     const int *stretch_pair;        /* 2 per rule */
     const double *stretch_length;
     const int *fixed;              /* per particle: 1 where fixed (the guard skips it) */
-    const double *eval_param;      /* 8 per creature: axis x, y, z, time and distance
-                                      weights, touch tolerance, clock and its carry */
+    const double *eval_param;      /* 16 per creature: axis x, y, z, time and distance
+                                      weights, touch tolerance, clock and its carry;
+                                      1 if the muscles' work is summed, energy weight,
+                                      1 if a target counts, target x, y, z, its weight */
     const long long *eval_count;   /* 3 per creature: steps to run, steps taken before,
                                       measures of the archive (the rest are terms) */
-    double *result;                /* 3 per creature: fitness, distance, time */
+    double *result;                /* 5 per creature: fitness, distance, time, work, target distance */
     long long *ended;              /* 2 per creature: why (AN_TIMEOUT ...) and which rule */
     const long long *first_measure; /* per creature: its archive measures, then its terms */
     const int *measure_kind;        /* AN_M_CONTACT ... */
@@ -153,6 +155,7 @@ typedef struct {
     const long long *net_first_neuron; /* per network: a CTRNN's neurons */
     const double *neuron_param; /* 3 per neuron: tau, bias, gain */
     double *neuron_state; /* per neuron: its state y */
+    double *muscle_work; /* 2 per muscle: its spring's length and rest length before a step */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */

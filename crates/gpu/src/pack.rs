@@ -117,6 +117,7 @@ pub(crate) struct Raw {
     net_first_neuron: *const c_longlong,
     neuron_param: *const c_double,
     neuron_state: *mut c_double,
+    muscle_work: *mut c_double,
 }
 
 extern "C" {
@@ -441,6 +442,7 @@ impl Batch {
             Array::SensorLevel => self.ev.sensor_level.as_mut_ptr() as u64,
             Array::NetScratch => self.ev.net_scratch.as_mut_ptr() as u64,
             Array::NeuronState => self.ev.neuron_state.as_mut_ptr() as u64,
+            Array::MuscleWork => self.ev.muscle_work.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -547,6 +549,7 @@ impl Batch {
             Array::NetFirstNeuron => I64(&self.ev.net_first_neuron),
             Array::NeuronParam => F64(&self.ev.neuron_param),
             Array::NeuronState => F64(&self.ev.neuron_state),
+            Array::MuscleWork => F64(&self.ev.muscle_work),
         }
     }
 
@@ -693,6 +696,7 @@ impl Batch {
             net_first_neuron: l(Array::NetFirstNeuron),
             neuron_param: c(Array::NeuronParam),
             neuron_state: m(Array::NeuronState),
+            muscle_work: m(Array::MuscleWork),
         }
     }
 }
@@ -844,11 +848,12 @@ pub(crate) enum Array {
     NetFirstNeuron,
     NeuronParam,
     NeuronState,
+    MuscleWork,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 94] = [
+    pub(crate) const ALL: [Array; 95] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -943,6 +948,7 @@ impl Array {
         Array::NetFirstNeuron,
         Array::NeuronParam,
         Array::NeuronState,
+        Array::MuscleWork,
     ];
 }
 

@@ -1,18 +1,19 @@
 //! Scenes evaluated whole by the C (`kernel/eval.h`): a batch of scenes
-//! ([`Batch::pack_scenes`]) holds, beside each world, its spring muscles,
-//! its oscillators and its `[evolve]` rules, and [`Batch::evaluate_cpu`]
-//! (or [`crate::Device::evaluate`]) runs each scene's evaluation as
+//! ([`Batch::pack_scenes`]) holds, beside each world, its sensors, spring
+//! muscles, brains and `[evolve]` rules, and [`Batch::evaluate_cpu`] (or
+//! [`crate::Device::evaluate`]) runs each scene's evaluation as
 //! `animats_scene::evaluate::evaluate` does, returning the same
 //! [`Evaluation`] to the bit.
 //!
 //! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
 //! spring muscles (a spring's rest length between `min` and `max`, with or
-//! without a `rate`), oscillator, neural, CTRNN and FSM brains, the centre of the
-//! particles that count, `fail_on_touch` and `fail_on_stretch`, the
-//! divergence guard of a driven scene, the `[archive]` measures and
-//! `[evolve] terms` but `energy`, and the fitness's time, distance and
-//! measure terms. Anything else a scene holds is refused when it is packed, with a
-//! message naming the scene and the entry.
+//! without a `rate`) and the positive work they do, oscillator, neural,
+//! CTRNN and FSM brains, the centre of the particles that count,
+//! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
+//! scene, the `[archive]` measures and `[evolve] terms`, and every term of
+//! the fitness (time, distance, energy, target, measures). Anything else a
+//! scene holds is refused when it is packed, with a message naming the
+//! scene and the entry.
 
 use crate::pack::{Batch, Shared, CHUNK};
 use animats_creatures::actuators::AnyActuator;
@@ -31,6 +32,13 @@ use std::os::raw::c_longlong;
 extern "C" {
     fn animats_evaluate_range(batch: *const crate::pack::Raw, first: c_longlong, last: c_longlong);
 }
+
+/// Numbers of `eval_param` per creature (`kernel/step.h` says which).
+const PARAMS: usize = 16;
+
+/// Numbers of `result` per creature: fitness, distance, time, the
+/// muscles' positive work, the distance from the target.
+const RESULTS: usize = 5;
 
 /// The arrays of a scene's evaluation (the tail of the C's `an_batch`).
 #[derive(Clone, Debug, Default)]
@@ -88,6 +96,7 @@ pub(crate) struct Rules {
     pub(crate) net_first_neuron: Vec<i64>,
     pub(crate) neuron_param: Vec<f64>,
     pub(crate) neuron_state: Vec<f64>,
+    pub(crate) muscle_work: Vec<f64>,
     /// Per creature: its `fail_on_touch` particles' names and its
     /// `fail_on_stretch` rules' names, for [`Ended`].
     names: Vec<(Vec<String>, Vec<String>)>,
@@ -121,9 +130,9 @@ impl Rules {
         for offsets in self.net_offsets() {
             *offsets = vec![0];
         }
-        self.eval_param = vec![0.0; 8 * creatures];
+        self.eval_param = vec![0.0; PARAMS * creatures];
         self.eval_count = vec![0; 3 * creatures];
-        self.result = vec![0.0; 3 * creatures];
+        self.result = vec![0.0; RESULTS * creatures];
         self.ended = vec![0; 2 * creatures];
     }
 
@@ -161,11 +170,6 @@ impl Rules {
             return Err(format!(
                 "{who} (roobot, quadruped, jellyfish or bubble column) is not in the GPU evaluation yet"
             ));
-        }
-        if spec.energy_weight != 0.0 || spec.target.is_some() {
-            return Err(
-                "[evolve] energy_weight and target are not in the GPU evaluation yet".into(),
-            );
         }
         let nervous = &scene.nervous;
         let world = &scene.world;
@@ -236,12 +240,28 @@ impl Rules {
         self.names.push((touch, stretch));
         let clock = world.snapshot();
         self.eval_param.extend(spec.axis.to_array());
+        // The muscles' work is summed where the fitness or a measure
+        // needs it (as `evaluate_with` decides).
+        let work = spec.needs_work()
+            || scene
+                .archive
+                .as_ref()
+                .is_some_and(|a| a.measures.iter().any(|m| m.needs_work()));
+        let (target, target_weight) = spec.target.unwrap_or((DVec3::ZERO, 0.0));
         self.eval_param.extend([
             spec.time_weight,
             spec.distance_weight,
             spec.touch_tolerance,
             clock.time,
             clock.time_carry,
+            f64::from(u8::from(work)),
+            spec.energy_weight,
+            f64::from(u8::from(spec.target.is_some())),
+            target.x,
+            target.y,
+            target.z,
+            target_weight,
+            0.0,
         ]);
         // The archive's measures, then the terms of the fitness.
         let archive: &[Measure] = scene.archive.as_ref().map_or(&[], |a| &a.measures);
@@ -408,21 +428,17 @@ impl Rules {
         world: &World,
         muscles: usize,
     ) -> Result<(), String> {
-        let (kind, ids, axis): (i32, &[ParticleId], DVec3) =
-            match m {
-                Measure::ContactFraction(p) => (0, std::slice::from_ref(p), DVec3::ZERO),
-                Measure::Feet => (1, &[], DVec3::ZERO),
-                Measure::Displacement(ids, axis) => (2, ids, *axis),
-                Measure::MeanHeight(ids) => (3, ids, DVec3::ZERO),
-                Measure::Speed(ids, axis) => (4, ids, *axis),
-                Measure::Particles | Measure::Muscles | Measure::Mass | Measure::Size => {
-                    (5, &[], DVec3::ZERO)
-                }
-                Measure::Energy => return Err(
-                    "the measure `energy` (the actuators' work) is not in the GPU evaluation yet"
-                        .into(),
-                ),
-            };
+        let (kind, ids, axis): (i32, &[ParticleId], DVec3) = match m {
+            Measure::ContactFraction(p) => (0, std::slice::from_ref(p), DVec3::ZERO),
+            Measure::Feet => (1, &[], DVec3::ZERO),
+            Measure::Displacement(ids, axis) => (2, ids, *axis),
+            Measure::MeanHeight(ids) => (3, ids, DVec3::ZERO),
+            Measure::Speed(ids, axis) => (4, ids, *axis),
+            Measure::Particles | Measure::Muscles | Measure::Mass | Measure::Size => {
+                (5, &[], DVec3::ZERO)
+            }
+            Measure::Energy => (6, &[], DVec3::ZERO),
+        };
         // A measure fixed when built: the engine's own value.
         let fixed = if kind == 5 {
             Recorder::new(std::slice::from_ref(m), spec, world, muscles).finish(world, 0.0, 0.0)[0]
@@ -482,7 +498,8 @@ impl Batch {
         r.measure_sum = vec![0.0; r.measure_kind.len()];
         r.sensor_level = vec![0.0; r.sensor_kind.len()];
         r.measure_start = vec![0.0; 3 * r.measure_kind.len()];
-        r.result = vec![0.0; 3 * scenes.len()];
+        r.result = vec![0.0; RESULTS * scenes.len()];
+        r.muscle_work = vec![0.0; 2 * r.muscle_spring.len()];
         r.ended = vec![0; 2 * scenes.len()];
         r.ready = true;
         b.ev = r;
@@ -540,7 +557,8 @@ impl Batch {
     pub(crate) fn evaluations(&self) -> Vec<Evaluation> {
         (0..self.creatures())
             .map(|c| {
-                let r = &self.ev.result[3 * c..3 * c + 3];
+                let r = &self.ev.result[RESULTS * c..RESULTS * (c + 1)];
+                let param = &self.ev.eval_param[PARAMS * c..PARAMS * (c + 1)];
                 let (why, which) = (self.ev.ended[2 * c], self.ev.ended[2 * c + 1] as usize);
                 let (touch, stretch) = &self.ev.names[c];
                 let name = |names: &[String]| names.get(which).cloned().unwrap_or_default();
@@ -561,8 +579,8 @@ impl Batch {
                     time: r[2],
                     ended,
                     measures: self.ev.measure_sum[m0..split].to_vec(),
-                    energy: None,
-                    target_distance: None,
+                    energy: (param[8] != 0.0).then_some(r[3]),
+                    target_distance: (param[10] != 0.0).then_some(r[4]),
                     terms: self.ev.measure_sum[split..m1].to_vec(),
                 }
             })

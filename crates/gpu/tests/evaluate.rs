@@ -35,9 +35,15 @@ fn assert_same(scenes: Vec<Scene>, what: &str) -> Vec<Evaluation> {
                 .iter()
                 .chain(&e.measures)
                 .chain(&e.terms)
+                .chain(&e.energy)
+                .chain(&e.target_distance)
                 .map(|x| x.to_bits())
                 .collect();
-            b.push(e.measures.len() as u64);
+            b.extend([
+                e.measures.len() as u64,
+                u64::from(e.energy.is_some()),
+                u64::from(e.target_distance.is_some()),
+            ]);
             b
         };
         assert!(
@@ -150,7 +156,7 @@ fn end_rules_and_blow_ups_end_as_the_engine_s() {
 }
 
 #[test]
-fn every_measure_but_energy_and_every_term_are_the_engine_s_to_the_bit() {
+fn every_measure_and_every_term_are_the_engine_s_to_the_bit() {
     let archive = r#"
 [archive]
 measures = [
@@ -321,22 +327,30 @@ fn fsm_brains_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn the_muscles_work_and_a_target_in_the_fitness_are_the_engine_s_to_the_bit() {
+    // Energy and target in the fitness, the energy measure in the archive
+    // and among the terms: the muscles' positive work summed step by step.
+    let rules = "energy_weight = 0.5\ntarget = [1.0, 0.2, 0.3]\ntarget_weight = 2.0\nterms = [{ kind = \"energy\", weight = -0.25 }]";
+    let archive = "\n[archive]\nmeasures = [{ kind = \"energy\" }, { kind = \"feet\" }]\nbins = [4, 4]\nranges = [[0.0, 50.0], [0.0, 6.0]]\n";
+    let text = walker(2.0, "symplectic", "").replace("[evolve]\n", &format!("[evolve]\n{rules}\n"))
+        + archive;
+    let got = assert_same(genomes(&text, 12, 13), "walker paying for its work");
+    assert!(got
+        .iter()
+        .all(|e| e.energy.is_some() && e.target_distance.is_some()));
+    assert!(got
+        .iter()
+        .all(|e| e.energy == Some(e.measures[0]) && e.energy.unwrap() > 0.0));
+    // With the energy only in the archive, the fitness does not pay it.
+    let text = walker(2.0, "rk4", "") + archive;
+    let got = assert_same(genomes(&text, 6, 14), "walker measuring its work");
+    assert!(got
+        .iter()
+        .all(|e| e.energy.is_some() && e.target_distance.is_none()));
+}
+
+#[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
-    // The energy measure, the energy weight.
-    let text = BODIES_WALK.replace("{ kind = \"size\" }", "{ kind = \"energy\" }");
-    let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
-    let genes = problem.random(&mut Random::for_entry(1, 0));
-    let scene = animats_scene::parse(&problem.develop(&genes, "").unwrap(), "b.toml").unwrap();
-    let err = Batch::pack_scenes(&[&scene]).unwrap_err();
-    assert!(err.contains("scene 0") && err.contains("`energy`"), "{err}");
-    let tired =
-        walker(2.0, "symplectic", "").replace("[evolve]\n", "[evolve]\nenergy_weight = 0.1\n");
-    let scene = SceneProblem::parse(&tired, "w.toml")
-        .unwrap()
-        .fresh()
-        .unwrap();
-    let err = Batch::pack_scenes(&[&scene]).unwrap_err();
-    assert!(err.contains("energy_weight"), "{err}");
     // A creature that acts by itself (the quadruped).
     let dog = include_str!("../../../scenes/quadruped3_gait.toml");
     let dog = SceneProblem::parse(dog, "quadruped3_gait.toml")
