@@ -38,9 +38,42 @@ AN_FN double an_unit(double x) {
     return 0.0;
 }
 
-/* nervous_system.rs `slew` of muscle q (index over the batch) of a
- * creature whose springs begin at s0, towards level l over dt. */
-AN_FN void an_slew(const an_batch *b, long long q, long long s0, double l, double dt) {
+/* Actuated::set of muscle q (over the batch) of creature c: its target
+ * given `value` (actuators/: a spring's rest length, an angle joint's rest
+ * angle, a torque joint's torque, a constant force's vector scaled). */
+AN_FN void an_set_target(const an_batch *b, long long c, long long q, double value) {
+    long long i = b->muscle_spring[q];
+    switch (b->muscle_kind[q]) {
+    case 0:
+        b->rest_length[b->first_spring[c] + i] = value;
+        break;
+    case 1:
+        b->joint_rest[b->first_joint[c] + i] = value;
+        break;
+    case 2:
+        b->motor_torque[b->first_motor[c] + i] = value;
+        break;
+    default: {
+        long long k0 = b->first_push[c] + b->muscle_push[2 * q];
+        for (long long k = k0; k < k0 + b->muscle_push[2 * q + 1]; k++) {
+            for (int d = 0; d < 3; d++) {
+                b->push_force[3 * k + d] = b->muscle_base[3 * q + d] * value;
+            }
+        }
+        break;
+    }
+    }
+}
+
+/* The value muscle q's level gives: min + level (max - min). */
+AN_FN double an_muscle_value(const an_batch *b, long long q) {
+    double lo = b->muscle_param[3 * q], hi = b->muscle_param[3 * q + 1];
+    return lo + b->muscle_level[q] * (hi - lo);
+}
+
+/* nervous_system.rs `slew` of muscle q (index over the batch) of
+ * creature c, towards level l over dt. */
+AN_FN void an_slew(const an_batch *b, long long c, long long q, double l, double dt) {
     if (l != l) {
         return;
     }
@@ -59,8 +92,23 @@ AN_FN void an_slew(const an_batch *b, long long q, long long s0, double l, doubl
     }
     level = an_unit(level); /* Actuator::set_level */
     b->muscle_level[q] = level;
-    double lo = b->muscle_param[3 * q], hi = b->muscle_param[3 * q + 1];
-    b->rest_length[s0 + b->muscle_spring[q]] = lo + level * (hi - lo);
+    an_set_target(b, c, q, an_muscle_value(b, q));
+}
+
+/* NervousSystem::apply_gates: a gated torque joint or force holds its
+ * value while its sensor's level is above (or at or below) the threshold,
+ * else zero. */
+AN_FN void an_gates(const an_batch *b, long long c) {
+    long long q0 = b->first_sensor[c];
+    for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
+        const double *g = b->muscle_gate + 3 * q;
+        if (g[0] < 0.0) {
+            continue;
+        }
+        double l = b->sensor_level[q0 + (long long)g[0]];
+        int open = g[2] != 0.0 ? l > g[1] : l <= g[1];
+        an_set_target(b, c, q, open ? an_muscle_value(b, q) : 0.0);
+    }
 }
 
 /* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`). */
@@ -111,7 +159,7 @@ AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
 /* Oscillator o (over the batch) of creature c at time t
  * (brains/oscillator.rs: level = offset + amplitude sin(2 pi f t + phase)). */
 AN_FN void an_oscillator(const an_batch *b, long long c, long long o, double t, double dt) {
-    long long s0 = b->first_spring[c], u0 = b->first_muscle[c];
+    long long u0 = b->first_muscle[c];
     double w = (6.283185307179586 * b->osc_frequency[o]) * t;
     for (long long k = b->first_output[o]; k < b->first_output[o + 1]; k++) {
         const double *g = b->output_gene + 4 * k;
@@ -119,7 +167,7 @@ AN_FN void an_oscillator(const an_batch *b, long long c, long long o, double t, 
         if (g[3] == g[3]) {
             l = l + g[3];
         }
-        an_slew(b, u0 + b->output_muscle[k], s0, l, dt);
+        an_slew(b, c, u0 + b->output_muscle[k], l, dt);
     }
 }
 
@@ -140,8 +188,8 @@ AN_FN void an_net_inputs(const an_batch *b, long long q0, long long m, double t,
 }
 
 /* The levels of network m's outputs (a trial's offsets added) to its
- * muscles, each slewed (creature c's springs begin at s0, muscles at u0). */
-AN_FN void an_net_outputs(const an_batch *b, long long s0, long long u0, long long m,
+ * muscles, each slewed (creature c's muscles begin at u0). */
+AN_FN void an_net_outputs(const an_batch *b, long long c, long long u0, long long m,
                           const double *levels, double dt) {
     long long o0 = b->net_first_output[m];
     for (long long o = o0; o < b->net_first_output[m + 1]; o++) {
@@ -150,7 +198,7 @@ AN_FN void an_net_outputs(const an_batch *b, long long s0, long long u0, long lo
         if (shift == shift) {
             l = l + shift;
         }
-        an_slew(b, u0 + b->net_output_muscle[o], s0, l, dt);
+        an_slew(b, c, u0 + b->net_output_muscle[o], l, dt);
     }
 }
 
@@ -158,7 +206,7 @@ AN_FN void an_net_outputs(const an_batch *b, long long s0, long long u0, long lo
  * inputs 2 level - 1, the clock's sine and cosine, tanh layers, a
  * logistic output layer). */
 AN_FN void an_network(const an_batch *b, long long c, long long m, double t, double dt) {
-    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long u0 = b->first_muscle[c], q0 = b->first_sensor[c];
     long long r0 = b->net_first_scratch[m];
     long long width = (b->net_first_scratch[m + 1] - r0) / 2;
     double *x = b->net_scratch + r0, *y = x + width;
@@ -182,7 +230,7 @@ AN_FN void an_network(const an_batch *b, long long c, long long m, double t, dou
         x = y;
         y = swap;
     }
-    an_net_outputs(b, s0, u0, m, x, dt);
+    an_net_outputs(b, c, u0, m, x, dt);
 }
 
 /* brains/ctrnn.rs `sigma`: the logistic function. */
@@ -193,7 +241,7 @@ AN_FN double an_sigma(double z) { return 1.0 / (1.0 + an_exp(-z)); }
  * a semi-implicit Euler step, y <- (y + h drive) / (1 + h), h = dt / tau;
  * neuron i drives output i). */
 AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, double dt) {
-    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long u0 = b->first_muscle[c], q0 = b->first_sensor[c];
     const int *sizes = b->layer_size + b->net_first_layer[m];
     long long n = sizes[0], mi = sizes[1];
     double *x = b->net_scratch + b->net_first_scratch[m], *rates = x + mi;
@@ -221,7 +269,7 @@ AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, doubl
     for (long long i = 0; i < outputs; i++) {
         rates[i] = an_sigma(np[3 * i + 2] * (state[i] + np[3 * i + 1]));
     }
-    an_net_outputs(b, s0, u0, m, rates, dt);
+    an_net_outputs(b, c, u0, m, rates, dt);
 }
 
 /* FSM m (a network entry, over the batch) of creature c at time t
@@ -231,7 +279,7 @@ AN_FN void an_ctrnn(const an_batch *b, long long c, long long m, double t, doubl
  * rate. Its states are numbers in net_weight (scenes.rs says how); its
  * inputs, levels, current state, entry time and start in net_scratch. */
 AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double dt) {
-    long long s0 = b->first_spring[c], u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    long long u0 = b->first_muscle[c], q0 = b->first_sensor[c];
     long long i0 = b->net_first_input[m], ni = b->net_first_input[m + 1] - i0;
     long long o0 = b->net_first_output[m], no = b->net_first_output[m + 1] - o0;
     double *x = b->net_scratch + b->net_first_scratch[m], *levels = x + ni, *own = levels + no;
@@ -274,14 +322,18 @@ AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double 
             levels[o] = levels[o] + d;
         }
     }
-    an_net_outputs(b, s0, u0, m, levels, dt);
+    an_net_outputs(b, c, u0, m, levels, dt);
 }
 
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order. */
 AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
     long long k0 = b->first_ctrl[c], k1 = b->first_ctrl[c + 1];
-    if (k0 == k1) {
+    int gated = 0;
+    for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
+        gated |= b->muscle_gate[3 * q] >= 0.0;
+    }
+    if (k0 == k1 && !gated) {
         return;
     }
     long long p0 = b->first_particle[c];
@@ -299,6 +351,7 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
             an_fsm(b, c, b->ctrl_index[k], t, dt);
         }
     }
+    an_gates(b, c);
 }
 
 /* scene::evaluate::centre_at: the centre of mass of particles ids[0 ..
@@ -474,32 +527,144 @@ AN_FN int an_guard(const an_batch *b, long long c) {
     return 1;
 }
 
-/* work.rs `Work::before` for creature c's spring muscles: each spring's
- * length and rest length before the step, into muscle_work. */
+/* work.rs `omega`: the angular speed of torque joint k's end about its
+ * axis (0 with the end on the axis). */
+AN_FN double an_omega(const an_batch *b, long long p0, long long k) {
+    const double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0, *axis = b->motor_axis + 3 * k;
+    long long e = b->motor_end[k], j = b->motor_joint[k];
+    double r[3], rp[3], n[3], dv[3];
+    for (int d = 0; d < 3; d++) {
+        r[d] = x[3 * e + d] - x[3 * j + d];
+    }
+    double along = an_dot(r, axis);
+    for (int d = 0; d < 3; d++) {
+        rp[d] = r[d] - axis[d] * along;
+    }
+    double l2 = an_dot(rp, rp);
+    if (l2 == 0.0) {
+        return 0.0;
+    }
+    an_cross(axis, rp, n);
+    for (int d = 0; d < 3; d++) {
+        dv[d] = v[3 * e + d] - v[3 * j + d];
+    }
+    return an_dot(n, dv) / l2;
+}
+
+/* work.rs `velocity_sum` of constant force q's pushed particles. */
+AN_FN void an_push_velocity(const an_batch *b, long long c, long long q, double *out) {
+    long long p0 = b->first_particle[c];
+    long long k0 = b->first_push[c] + b->muscle_push[2 * q];
+    out[0] = 0.0;
+    out[1] = 0.0;
+    out[2] = 0.0;
+    for (long long k = k0; k < k0 + b->muscle_push[2 * q + 1]; k++) {
+        const double *v = b->vel + 3 * (p0 + b->push_particle[k]);
+        for (int d = 0; d < 3; d++) {
+            out[d] = out[d] + v[d];
+        }
+    }
+}
+
+/* The angle at angle joint k (angle_joint::angle_at). */
+AN_FN double an_joint_angle(const an_batch *b, long long p0, long long k) {
+    const double *x = b->pos + 3 * p0;
+    long long a = b->joint_a[k], j = b->joint_j[k], e = b->joint_b[k];
+    double ra[3], rb[3], n[3];
+    for (int d = 0; d < 3; d++) {
+        ra[d] = x[3 * a + d] - x[3 * j + d];
+        rb[d] = x[3 * e + d] - x[3 * j + d];
+    }
+    an_cross(ra, rb, n);
+    return an_atan2(sqrt(an_dot(n, n)), an_dot(ra, rb));
+}
+
+/* work.rs `Work::before` for creature c's muscles: each one's state
+ * before the step (a spring's length and rest length, an angle joint's
+ * angle and rest angle, a motor's angular speed, a force's particles'
+ * summed velocity), into muscle_work. */
 AN_FN void an_work_before(const an_batch *b, long long c) {
-    long long p0 = b->first_particle[c], s0 = b->first_spring[c];
+    long long p0 = b->first_particle[c];
     const double *x = b->pos + 3 * p0;
     for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
-        long long s = s0 + b->muscle_spring[q];
-        double d[3];
-        for (int k = 0; k < 3; k++) {
-            d[k] = x[3 * b->spring_a[s] + k] - x[3 * b->spring_b[s] + k];
+        double *w = b->muscle_work + 3 * q;
+        long long i = b->muscle_spring[q];
+        switch (b->muscle_kind[q]) {
+        case 0: {
+            long long s = b->first_spring[c] + i;
+            double d[3];
+            for (int k = 0; k < 3; k++) {
+                d[k] = x[3 * b->spring_a[s] + k] - x[3 * b->spring_b[s] + k];
+            }
+            w[0] = sqrt(an_dot(d, d));
+            w[1] = b->rest_length[s];
+            break;
         }
-        b->muscle_work[2 * q] = sqrt(an_dot(d, d));
-        b->muscle_work[2 * q + 1] = b->rest_length[s];
+        case 1: {
+            long long k = b->first_joint[c] + i;
+            w[0] = an_joint_angle(b, p0, k);
+            w[1] = b->joint_rest[k];
+            break;
+        }
+        case 2:
+            w[0] = an_omega(b, p0, b->first_motor[c] + i);
+            break;
+        default:
+            an_push_velocity(b, c, q, w);
+            break;
+        }
     }
 }
 
 /* work.rs `Work::after`: the positive work creature c's muscles did in
- * the step (each moved its rest length under the spring's tension), added
- * to `positive` muscle by muscle. */
-AN_FN double an_work_after(const an_batch *b, long long c, double positive) {
-    long long s0 = b->first_spring[c];
+ * the step of length h, added to `positive` muscle by muscle. */
+AN_FN double an_work_after(const an_batch *b, long long c, double h, double positive) {
+    long long p0 = b->first_particle[c];
     for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
-        long long s = s0 + b->muscle_spring[q];
-        double now = b->muscle_work[2 * q], rest = b->muscle_work[2 * q + 1];
-        double r = b->rest_length[s], k = b->stiffness[s];
-        double done = 0.5 * k * ((now - r) * (now - r) - (now - rest) * (now - rest));
+        const double *w = b->muscle_work + 3 * q;
+        long long i = b->muscle_spring[q];
+        double done;
+        switch (b->muscle_kind[q]) {
+        case 0: {
+            long long s = b->first_spring[c] + i;
+            double now = w[0], rest = w[1], r = b->rest_length[s], k = b->stiffness[s];
+            done = 0.5 * k * ((now - r) * (now - r) - (now - rest) * (now - rest));
+            break;
+        }
+        case 1: {
+            long long j = b->first_joint[c] + i;
+            double now = w[0], rest = w[1], r = b->joint_rest[j], k = b->joint_stiffness[j];
+            done = 0.5 * k * ((now - r) * (now - r) - (now - rest) * (now - rest));
+            break;
+        }
+        case 2: {
+            long long k = b->first_motor[c] + i;
+            double end = an_omega(b, p0, k);
+            done = b->motor_torque[k] * 0.5 * (w[0] + end) * h;
+            break;
+        }
+        default: {
+            double after[3], mid[3], f[3];
+            an_push_velocity(b, c, q, after);
+            for (int d = 0; d < 3; d++) {
+                mid[d] = 0.5 * (w[d] + after[d]);
+            }
+            /* The force now: its first push's vector (every push of a
+             * force carries the same). */
+            long long k0 = b->first_push[c] + b->muscle_push[2 * q];
+            if (b->muscle_push[2 * q + 1] > 0) {
+                for (int d = 0; d < 3; d++) {
+                    f[d] = b->push_force[3 * k0 + d];
+                }
+            } else {
+                for (int d = 0; d < 3; d++) {
+                    f[d] = b->muscle_base[3 * q + d] * an_muscle_value(b, q);
+                }
+            }
+            done = an_dot(f, mid) * h;
+            break;
+        }
+        }
         if (done > 0.0) {
             positive = positive + done;
         }
@@ -543,7 +708,7 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
                 break;
             }
             if (work) {
-                positive = an_work_after(b, c, positive);
+                positive = an_work_after(b, c, dt, positive);
             }
             done++;
             an_measures_step(b, c);

@@ -64,12 +64,12 @@ typedef struct {
     const int *joint_b;
     const double *joint_stiffness;
     const double *joint_damping;
-    const double *joint_rest;
+    double *joint_rest;   /* actuators move it (eval.h) */
     const long long *first_motor;
     const int *motor_end;
     const int *motor_joint;
     const double *motor_axis; /* 3 per motor */
-    const double *motor_torque;
+    double *motor_torque; /* actuators and gates move it (eval.h) */
     const long long *first_fluid;
     const double *fluid_drag;    /* -0.5 C rho pi, as the engine forms it */
     const double *fluid_density;
@@ -82,7 +82,7 @@ typedef struct {
     long long steps_before; /* steps the batch has taken in earlier runs */
     const long long *first_push; /* per creature: its constant forces' pushes */
     const int *push_particle;    /* one push: a constant force on one particle */
-    const double *push_force;    /* 3 per push */
+    double *push_force;          /* 3 per push; actuators and gates scale it (eval.h) */
     double gx, gy, gz;
     int gravity; /* 1: gravity pulls every particle; 0: none */
     int integrator;
@@ -155,7 +155,14 @@ typedef struct {
     const long long *net_first_neuron; /* per network: a CTRNN's neurons */
     const double *neuron_param; /* 3 per neuron: tau, bias, gain */
     double *neuron_state; /* per neuron: its state y */
-    double *muscle_work; /* 2 per muscle: its spring's length and rest length before a step */
+    double *muscle_work; /* 3 per muscle: its state before a step (work.rs `Before`) */
+    const int *muscle_kind;    /* per muscle: 0 a spring's rest length, 1 an angle joint's rest
+                                  angle, 2 a torque joint's torque, 3 a constant force's scale;
+                                  muscle_spring is then its spring, joint, motor or force */
+    const double *muscle_base; /* 3 per muscle: a force's vector at scale 1 */
+    const int *muscle_push;    /* 2 per muscle: a force's first push in the creature, pushes */
+    const double *muscle_gate; /* 3 per muscle: its gate's sensor (-1: none), threshold,
+                                  1 if open above it */
 } an_batch;
 
 /* glam's dot product and cross product, in its order. */

@@ -27,12 +27,12 @@ pub(crate) struct Raw {
     joint_b: *const c_int,
     joint_stiffness: *const c_double,
     joint_damping: *const c_double,
-    joint_rest: *const c_double,
+    joint_rest: *mut c_double,
     first_motor: *const c_longlong,
     motor_end: *const c_int,
     motor_joint: *const c_int,
     motor_axis: *const c_double,
-    motor_torque: *const c_double,
+    motor_torque: *mut c_double,
     first_fluid: *const c_longlong,
     fluid_drag: *const c_double,
     fluid_density: *const c_double,
@@ -45,7 +45,7 @@ pub(crate) struct Raw {
     steps_before: c_longlong,
     first_push: *const c_longlong,
     push_particle: *const c_int,
-    push_force: *const c_double,
+    push_force: *mut c_double,
     gx: c_double,
     gy: c_double,
     gz: c_double,
@@ -118,6 +118,10 @@ pub(crate) struct Raw {
     neuron_param: *const c_double,
     neuron_state: *mut c_double,
     muscle_work: *mut c_double,
+    muscle_kind: *const c_int,
+    muscle_base: *const c_double,
+    muscle_push: *const c_int,
+    muscle_gate: *const c_double,
 }
 
 extern "C" {
@@ -434,6 +438,9 @@ impl Batch {
             Array::Scratch => self.scratch.as_mut_ptr() as u64,
             Array::Failed => self.failed.as_mut_ptr() as u64,
             Array::RestLength => self.rest_length.as_mut_ptr() as u64,
+            Array::JointRest => self.joint_rest.as_mut_ptr() as u64,
+            Array::MotorTorque => self.motor_torque.as_mut_ptr() as u64,
+            Array::PushForce => self.push_force.as_mut_ptr() as u64,
             Array::MuscleLevel => self.ev.muscle_level.as_mut_ptr() as u64,
             Array::Result => self.ev.result.as_mut_ptr() as u64,
             Array::Ended => self.ev.ended.as_mut_ptr() as u64,
@@ -550,6 +557,10 @@ impl Batch {
             Array::NeuronParam => F64(&self.ev.neuron_param),
             Array::NeuronState => F64(&self.ev.neuron_state),
             Array::MuscleWork => F64(&self.ev.muscle_work),
+            Array::MuscleKind => I32(&self.ev.muscle_kind),
+            Array::MuscleBase => F64(&self.ev.muscle_base),
+            Array::MusclePush => I32(&self.ev.muscle_push),
+            Array::MuscleGate => F64(&self.ev.muscle_gate),
         }
     }
 
@@ -601,12 +612,12 @@ impl Batch {
             joint_b: i(Array::JointB),
             joint_stiffness: c(Array::JointStiffness),
             joint_damping: c(Array::JointDamping),
-            joint_rest: c(Array::JointRest),
+            joint_rest: m(Array::JointRest),
             first_motor: l(Array::FirstMotor),
             motor_end: i(Array::MotorEnd),
             motor_joint: i(Array::MotorJoint),
             motor_axis: c(Array::MotorAxis),
-            motor_torque: c(Array::MotorTorque),
+            motor_torque: m(Array::MotorTorque),
             first_fluid: l(Array::FirstFluid),
             fluid_drag: c(Array::FluidDrag),
             fluid_density: c(Array::FluidDensity),
@@ -619,7 +630,7 @@ impl Batch {
             steps_before: self.steps_run.min(i64::MAX as u64) as c_longlong,
             first_push: l(Array::FirstPush),
             push_particle: i(Array::PushParticle),
-            push_force: c(Array::PushForce),
+            push_force: m(Array::PushForce),
             gx: self.g.x,
             gy: self.g.y,
             gz: self.g.z,
@@ -697,6 +708,10 @@ impl Batch {
             neuron_param: c(Array::NeuronParam),
             neuron_state: m(Array::NeuronState),
             muscle_work: m(Array::MuscleWork),
+            muscle_kind: i(Array::MuscleKind),
+            muscle_base: c(Array::MuscleBase),
+            muscle_push: i(Array::MusclePush),
+            muscle_gate: c(Array::MuscleGate),
         }
     }
 }
@@ -849,11 +864,15 @@ pub(crate) enum Array {
     NeuronParam,
     NeuronState,
     MuscleWork,
+    MuscleKind,
+    MuscleBase,
+    MusclePush,
+    MuscleGate,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 95] = [
+    pub(crate) const ALL: [Array; 99] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -949,6 +968,10 @@ impl Array {
         Array::NeuronParam,
         Array::NeuronState,
         Array::MuscleWork,
+        Array::MuscleKind,
+        Array::MuscleBase,
+        Array::MusclePush,
+        Array::MuscleGate,
     ];
 }
 

@@ -6,8 +6,9 @@
 //! [`Evaluation`] to the bit.
 //!
 //! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
-//! spring muscles (a spring's rest length between `min` and `max`, with or
-//! without a `rate`) and the positive work they do, oscillator, neural,
+//! actuators (a spring's rest length, an angle joint's rest angle, a
+//! torque joint's torque, a constant force's scale; with or without a
+//! `rate`, gated or not) and the positive work they do, oscillator, neural,
 //! CTRNN and FSM brains, the centre of the particles that count,
 //! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
 //! scene, the `[archive]` measures and `[evolve] terms`, and every term of
@@ -97,6 +98,10 @@ pub(crate) struct Rules {
     pub(crate) neuron_param: Vec<f64>,
     pub(crate) neuron_state: Vec<f64>,
     pub(crate) muscle_work: Vec<f64>,
+    pub(crate) muscle_kind: Vec<i32>,
+    pub(crate) muscle_base: Vec<f64>,
+    pub(crate) muscle_push: Vec<i32>,
+    pub(crate) muscle_gate: Vec<f64>,
     /// Per creature: its `fail_on_touch` particles' names and its
     /// `fail_on_stretch` rules' names, for [`Ended`].
     names: Vec<(Vec<String>, Vec<String>)>,
@@ -176,25 +181,41 @@ impl Rules {
         if nervous.is_empty() && world.is_passive() {
             return Err("the divergence guard's energy check of a scene nothing drives is not in the GPU evaluation yet".into());
         }
-        for ((name, a), (gate, rate)) in nervous
+        // Each constant force's first push (the pushes are its particles,
+        // force by force, as `pack` lays them out).
+        let mut first_push = Vec::new();
+        let mut pushes = 0usize;
+        for cf in world.forces().constant_forces.iter() {
+            first_push.push((pushes, cf.particles().len()));
+            pushes += cf.particles().len();
+        }
+        for ((_, a), (gate, rate)) in nervous
             .actuators
             .iter()
             .zip(nervous.gates.iter().zip(&nervous.rates))
         {
-            let AnyActuator::Spring(a) = a else {
-                return Err(format!(
-                    "the actuator `{name}` (not a spring's rest length) is not in the GPU evaluation yet"
-                ));
+            let (kind, index, (min, max), level) = match a {
+                AnyActuator::Spring(a) => (0, a.target().0.index(), a.range(), a.level()),
+                AnyActuator::AngleJoint(a) => (1, a.target().0.index(), a.range(), a.level()),
+                AnyActuator::TorqueJoint(a) => (2, a.target().0.index(), a.range(), a.level()),
+                AnyActuator::ConstantForce(a) => {
+                    (3, a.target().force.index(), a.range(), a.level())
+                }
             };
-            if gate.is_some() {
-                return Err(format!(
-                    "the actuator `{name}`'s gate is not in the GPU evaluation yet"
-                ));
-            }
-            let (min, max) = a.range();
-            self.muscle_spring.push(a.target().0.index() as i32);
+            let (base, push) = match a {
+                AnyActuator::ConstantForce(a) => (a.target().base, first_push[index]),
+                _ => (DVec3::ZERO, (0, 0)),
+            };
+            self.muscle_kind.push(kind);
+            self.muscle_spring.push(index as i32);
             self.muscle_param.extend([min, max, rate.unwrap_or(-1.0)]);
-            self.muscle_level.push(a.level());
+            self.muscle_level.push(level);
+            self.muscle_base.extend(base.to_array());
+            self.muscle_push.extend([push.0 as i32, push.1 as i32]);
+            self.muscle_gate.extend(match gate {
+                Some(g) => [g.sensor as f64, g.threshold, f64::from(u8::from(g.above))],
+                None => [-1.0, 0.0, 0.0],
+            });
         }
         for (name, sensor) in &nervous.sensors {
             self.add_sensor(name, sensor.as_ref())?;
@@ -499,7 +520,7 @@ impl Batch {
         r.sensor_level = vec![0.0; r.sensor_kind.len()];
         r.measure_start = vec![0.0; 3 * r.measure_kind.len()];
         r.result = vec![0.0; RESULTS * scenes.len()];
-        r.muscle_work = vec![0.0; 2 * r.muscle_spring.len()];
+        r.muscle_work = vec![0.0; 3 * r.muscle_spring.len()];
         r.ended = vec![0; 2 * scenes.len()];
         r.ready = true;
         b.ev = r;

@@ -349,6 +349,160 @@ fn the_muscles_work_and_a_target_in_the_fitness_are_the_engine_s_to_the_bit() {
         .all(|e| e.energy.is_some() && e.target_distance.is_none()));
 }
 
+/// A crawler of our own for the other actuator targets: an angle joint's
+/// rest angle, a torque joint's torque (gated: only while its foot is off
+/// the floor), a constant force's scale (gated: only while the other foot
+/// touches), a spring muscle; an oscillator drives all four; the fitness
+/// pays for their work.
+const CRAWLER: &str = r#"
+[world]
+dt = 0.0005
+integrator = "symplectic"
+duration = 2.0
+
+[floor]
+
+[[particle]]
+name = "a"
+mass = 0.1
+position = [0.0, 0.03, 0.0]
+radius = 0.03
+
+[[particle]]
+name = "j"
+mass = 0.2
+position = [0.2, 0.1, 0.0]
+radius = 0.03
+
+[[particle]]
+name = "b"
+mass = 0.1
+position = [0.4, 0.03, 0.0]
+radius = 0.03
+
+[[particle]]
+name = "c"
+mass = 0.1
+position = [0.2, 0.25, 0.05]
+radius = 0.03
+
+[[spring]]
+a = "a"
+b = "j"
+stiffness = 300.0
+damping = 1.0
+
+[[spring]]
+a = "j"
+b = "b"
+stiffness = 300.0
+damping = 1.0
+
+[[spring]]
+name = "back"
+a = "j"
+b = "c"
+stiffness = 300.0
+damping = 1.0
+
+[[spring]]
+a = "a"
+b = "c"
+stiffness = 100.0
+damping = 1.0
+
+[[angle_joint]]
+name = "knee"
+a = "a"
+joint = "j"
+b = "b"
+stiffness = 3.0
+damping = 0.05
+
+[[torque_joint]]
+name = "hip"
+end = "c"
+joint = "j"
+axis = [0.0, 0.0, 1.0]
+
+[[constant_force]]
+name = "push"
+particles = ["a", "c"]
+force = [0.4, 0.0, 0.1]
+
+[[sensor]]
+name = "a_down"
+kind = "touch"
+particle = "a"
+
+[[sensor]]
+name = "b_down"
+kind = "touch"
+particle = "b"
+
+[[actuator]]
+name = "knee"
+angle_joint = "knee"
+min = 2.2
+max = 3.1
+rate = 6.0
+
+[[actuator]]
+name = "hip"
+torque_joint = "hip"
+min = -0.05
+max = 0.05
+gate = { sensor = "a_down", at_most = 0.5 }
+
+[[actuator]]
+name = "push"
+constant_force = "push"
+min = 0.0
+max = 2.0
+gate = { sensor = "b_down", above = 0.5 }
+
+[[actuator]]
+name = "back"
+spring = "back"
+min = 0.12
+max = 0.2
+rate = 4.0
+
+[[controller]]
+name = "gait"
+kind = "oscillator"
+outputs = ["knee", "hip", "push", "back"]
+frequency = 2.0
+
+[evolve]
+controller = "gait"
+duration = 2.0
+axis = [1.0, 0.0, 0.0]
+energy_weight = 0.2
+"#;
+
+#[test]
+fn joint_torque_and_force_actuators_and_their_gates_are_the_engine_s_to_the_bit() {
+    let got = assert_same(genomes(CRAWLER, 12, 15), "crawler");
+    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
+    d.sort_unstable();
+    d.dedup();
+    assert!(d.len() > 6, "{got:?}");
+    assert!(
+        got.iter().all(|e| e.energy.is_some_and(|j| j > 0.0)),
+        "{got:?}"
+    );
+    // Under RK4 too, with perturbed trials.
+    let text = CRAWLER
+        .replace("integrator = \"symplectic\"", "integrator = \"rk4\"")
+        .replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
+    let mut scenes = genomes(&text, 6, 16);
+    for (k, s) in scenes.iter_mut().enumerate() {
+        animats_scene::evaluate::perturb(s, k as u32).unwrap();
+    }
+    assert_same(scenes, "perturbed crawlers, RK4");
+}
+
 #[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
     // A creature that acts by itself (the quadruped).
