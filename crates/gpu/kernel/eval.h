@@ -1,18 +1,20 @@
 /*
  * A scene's whole evaluation in C, after the step (step.h): what
- * crates/scene/src/evaluate.rs `evaluate_with` does for a scene whose
- * brains are oscillators or neural networks driving spring muscles,
- * operation by operation. Each step: the nervous system acts
+ * crates/scene/src/evaluate.rs `evaluate_with` does, operation by
+ * operation. Each step: the actuators' state is noted where their work
+ * counts (scene/src/work.rs), the nervous system acts
  * (creatures/src/nervous_system.rs `act`: every sensor read, then every
- * controller's outputs at the world's time, each slewed by its muscle's
- * rate and clamped to [0, 1], the spring's rest length set), the
- * world steps, its clock advances (Kahan), the divergence guard checks
- * every 64th step (engine/src/guard.rs: a driven world's speed limit),
- * then the measures record the step (scene/src/archive.rs, Recorder), the
- * centre of the particles that count is taken and the end rules
- * (fail_on_touch, then fail_on_stretch) are tried. The fitness is the
- * [evolve] table's time and distance terms plus its measure terms. What this file does not cover
- * is refused when a scene is packed (crates/gpu/src/scenes.rs).
+ * controller — oscillator, neural network, CTRNN, FSM — in the scene's
+ * order, each output slewed by its actuator's rate and clamped to [0, 1]
+ * and its target set; then the gates), the world steps, its clock
+ * advances (Kahan), the divergence guard checks every 64th step
+ * (engine/src/guard.rs: a driven world's speed limit), the actuators'
+ * positive work is summed, the measures record the step
+ * (scene/src/archive.rs, Recorder), the centre of the particles that
+ * count is taken and the end rules (fail_on_touch, then fail_on_stretch)
+ * are tried. The fitness is the [evolve] table's: time, distance, energy,
+ * target and terms. What this file does not cover is refused when a scene
+ * is packed (crates/gpu/src/scenes.rs).
  */
 #ifndef ANIMATS_EVAL_H
 #define ANIMATS_EVAL_H
@@ -114,8 +116,9 @@ AN_FN void an_gates(const an_batch *b, long long c) {
 /* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`). */
 enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_ANGLE = 4, AN_S_TILT = 5 };
 
-/* ScaledSensor::level of sensor q of the creature whose particles begin at
- * p0: the probe's reading mapped from [min, max] onto [0, 1]. */
+/* ScaledSensor::level of sensor q (over the batch) of the creature whose
+ * particles begin at p0: the probe's reading mapped from [min, max] onto
+ * [0, 1]. */
 AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
     const int *ids = b->sensor_particle + 3 * q;
     const double *param = b->sensor_param + 5 * q;
