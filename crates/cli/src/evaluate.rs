@@ -73,7 +73,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
                 let build = || animats_scene::parse(&text, &file).map_err(|e| e.to_string());
                 let e = match batches(&args, &file, build)? {
                     None => score(build),
-                    Some(b) => score_all(&[&build], &|_| true, &*b.0)
+                    Some(b) => score_all(&[&build], &|_, _| true, &*b.0)
                         .and_then(|mut all| all.pop().ok_or_else(|| "no evaluation".to_string())),
                 };
                 return report(e.map_err(Failure::Other)?, args.json);

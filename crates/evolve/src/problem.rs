@@ -38,12 +38,13 @@ pub trait Problem: Send + Sync {
     }
     /// Every genome of a generation evaluated at once, where the problem
     /// runs its evaluations in batches (on a GPU: `animats_scene::evaluate::Batches`),
-    /// each as [`Problem::evaluate_screened`] would; `None` where it
-    /// evaluates them one by one.
+    /// genome `g` as [`Problem::evaluate_screened`] would with the screen
+    /// whose `fine` is `fine(g, …)`; `None` where it evaluates them one by
+    /// one.
     fn evaluate_population(
         &self,
         _genomes: &[Vec<f64>],
-        _screen: &Screen,
+        _fine: &dyn Fn(usize, &Outcome) -> bool,
     ) -> Option<Result<Vec<Outcome>, String>> {
         None
     }
@@ -100,10 +101,10 @@ impl Problem for SceneEvolution {
     fn evaluate_population(
         &self,
         genomes: &[Vec<f64>],
-        screen: &Screen,
+        fine: &dyn Fn(usize, &Outcome) -> bool,
     ) -> Option<Result<Vec<Outcome>, String>> {
         let b = self.0.batches()?;
-        Some(self.0.evaluate_all(genomes, &|o| screen.fine(o), &*b.0))
+        Some(self.0.evaluate_all(genomes, fine, &*b.0))
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())
@@ -143,10 +144,10 @@ impl Problem for BodyEvolution {
     fn evaluate_population(
         &self,
         genomes: &[Vec<f64>],
-        screen: &Screen,
+        fine: &dyn Fn(usize, &Outcome) -> bool,
     ) -> Option<Result<Vec<Outcome>, String>> {
         let b = self.0.batches()?;
-        Some(self.0.evaluate_all(genomes, &|o| screen.fine(o), &*b.0))
+        Some(self.0.evaluate_all(genomes, fine, &*b.0))
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())

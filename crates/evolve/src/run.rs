@@ -1021,7 +1021,8 @@ fn advance_lane(
         if let Some(t) = tracer {
             t.done(k, g, Piece::Ask, began);
         }
-        let outcomes: Vec<Outcome> = match problem.evaluate_population(&population, &screen) {
+        let batch = problem.evaluate_population(&population, &|_, o| screen.fine(o));
+        let outcomes: Vec<Outcome> = match batch {
             Some(batch) => batch?,
             None => population
                 .par_iter()

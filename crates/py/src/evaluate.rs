@@ -133,12 +133,11 @@ pub(crate) fn outcomes(
             )));
         }
     }
-    if screens.is_none() {
-        // A problem on a GPU evaluates the genomes as one batch.
-        let all = Screen::All;
-        if let Some(batch) = py.detach(|| on(pool, || problem.evaluate_population(&rows, &all))) {
-            return batch.map_err(runtime_error);
-        }
+    // A problem on a GPU evaluates the genomes as one batch, each with its
+    // screen.
+    let fine = |i: usize, o: &Outcome| screens.is_none_or(|s| s[i].fine(o));
+    if let Some(batch) = py.detach(|| on(pool, || problem.evaluate_population(&rows, &fine))) {
+        return batch.map_err(runtime_error);
     }
     py.detach(|| {
         on(pool, || {
@@ -216,7 +215,7 @@ pub fn evaluate_scenes<'py>(
             .collect();
         let makes: Vec<&Make<'_>> = makes.iter().map(|m| m as &Make<'_>).collect();
         let o = py
-            .detach(|| on(&pool, || score_all(&makes, &|_| true, &*b.0)))
+            .detach(|| on(&pool, || score_all(&makes, &|_, _| true, &*b.0)))
             .map_err(runtime_error)?;
         return outcome_dict(py, &o);
     }
@@ -312,13 +311,15 @@ pub struct Evaluator {
 #[pymethods]
 impl Evaluator {
     /// `scene`: an `animats.Scene`, a path, or `"roobot"`; `threads`: the
-    /// threads it evaluates on (default: every core).
+    /// threads it evaluates on (default: every core); `device`: "cpu", or
+    /// "cuda" to evaluate each call's genomes as batches on an NVIDIA GPU.
     #[new]
-    #[pyo3(signature = (scene, threads = None))]
-    fn new(scene: &Bound<'_, PyAny>, threads: Option<usize>) -> PyResult<Evaluator> {
+    #[pyo3(signature = (scene, threads = None, device = "cpu"))]
+    fn new(scene: &Bound<'_, PyAny>, threads: Option<usize>, device: &str) -> PyResult<Evaluator> {
         let spec = problem_spec(scene)?;
+        let batches = device_batches(device)?;
         Ok(Evaluator {
-            problem: build(&spec)?,
+            problem: spec.build_on(batches).map_err(scene_error)?,
             pool: pool(threads)?,
             roobot: spec == ProblemSpec::thesis(),
         })

@@ -209,9 +209,12 @@ pub struct Evolution {
 #[pymethods]
 impl Evolution {
     /// `scene`: an `animats.Scene`, a path, or "roobot" (the default). The
-    /// other arguments are `animats evolve`'s, with its defaults.
+    /// other arguments are `animats evolve`'s, with its defaults (`device`:
+    /// "cpu", or "cuda" for `run` to evaluate each generation on an NVIDIA
+    /// GPU).
     #[new]
-    #[pyo3(signature = (scene = None, *, lanes = None, generations = 100, seed = 1, optimiser = None, population = None, restarts = 0))]
+    #[pyo3(signature = (scene = None, *, lanes = None, generations = 100, seed = 1, optimiser = None, population = None, restarts = 0, device = "cpu"))]
+    #[allow(clippy::too_many_arguments)] // Python's keyword arguments
     fn new(
         scene: Option<&Bound<'_, PyAny>>,
         lanes: Option<usize>,
@@ -220,6 +223,7 @@ impl Evolution {
         optimiser: Option<&str>,
         population: Option<usize>,
         restarts: u32,
+        device: &str,
     ) -> PyResult<Evolution> {
         let spec = match scene {
             Some(s) => problem_spec(s)?,
@@ -237,7 +241,11 @@ impl Evolution {
             restarts: (restarts > 0).then_some(restarts),
         };
         let config = Config::new(spec, &choices).map_err(value_error)?;
-        let problem = build(&config.problem)?;
+        let batches = crate::evaluate::device_batches(device)?;
+        let problem = config
+            .problem
+            .build_on(batches)
+            .map_err(crate::scene_error)?;
         let state = State::new(config).map_err(value_error)?;
         Ok(Evolution {
             state,

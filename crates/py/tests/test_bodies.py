@@ -101,11 +101,21 @@ def test_device_cuda_gives_the_cpu_s_bits_or_says_what_is_missing():
         assert any(w in str(e) for w in ("driver", "device", "NVRTC")), e
         with pytest.raises(RuntimeError, match="driver|device|NVRTC"):
             animats.evaluate(scene, scene.start(), device="cuda")
+        with pytest.raises(RuntimeError, match="driver|device|NVRTC"):
+            animats.Evaluator(scene, device="cuda")
+        with pytest.raises(RuntimeError, match="driver|device|NVRTC"):
+            animats.Evolution(scene, device="cuda")
         return
     cpu = animats.evaluate_scenes([walker])
     assert gpu["fitness"].tolist() == cpu["fitness"].tolist()
     g = scene.start()[None, :]
     assert animats.evaluate(scene, g, device="cuda").tolist() == animats.evaluate(scene, g).tolist()
+    ev = animats.Evaluator(scene, device="cuda")
+    assert ev.evaluate(g).tolist() == animats.evaluate(scene, g).tolist()
+    runs = [animats.Evolution(scene, generations=2, seed=3, device=d) for d in ("cuda", "cpu")]
+    for r in runs:
+        r.run()
+    assert runs[0].best_fitness == runs[1].best_fitness
 
 
 def animats_root():

@@ -580,7 +580,7 @@ pub fn score_screened(
     fine: &dyn Fn(&Evaluation) -> bool,
 ) -> Result<Evaluation, String> {
     let make: &Make<'_> = &make;
-    let mut all = score_all(&[make], fine, &engine_runs)?;
+    let mut all = score_all(&[make], &|_, e| fine(e), &engine_runs)?;
     all.pop().ok_or_else(|| "no evaluation".to_string())
 }
 
@@ -599,13 +599,13 @@ pub fn engine_runs(scenes: Vec<Scene>) -> Result<Vec<Evaluation>, String> {
 }
 
 /// [`score_screened`] for many genomes at once, each `makes[g]` building
-/// genome `g`'s scene: every run at the scenes' step handed to `run` in one
+/// genome `g`'s scene and `fine(g, e)` its screen: every run at the scenes' step handed to `run` in one
 /// batch, then every run at half the step that a robust scene needs in a
 /// second one (a batch shares one step). The same scores as
 /// [`score_screened`] on each genome, where `run` gives the engine's bits.
 pub fn score_all(
     makes: &[&Make<'_>],
-    fine: &dyn Fn(&Evaluation) -> bool,
+    fine: &dyn Fn(usize, &Evaluation) -> bool,
     run: &dyn Fn(Vec<Scene>) -> Result<Vec<Evaluation>, String>,
 ) -> Result<Vec<Evaluation>, String> {
     use rayon::prelude::*;
@@ -652,7 +652,7 @@ pub fn score_all(
     let at: Vec<usize> = (0..trial.len())
         .filter(|&i| {
             let spec = &specs[trial[i].0];
-            spec.robust && (spec.noise > 0.0 || fine(&runs[i]))
+            spec.robust && (spec.noise > 0.0 || fine(trial[i].0, &runs[i]))
         })
         .collect();
     let finer = at
@@ -872,12 +872,13 @@ impl SceneProblem {
         self.batches.as_ref()
     }
 
-    /// [`SceneProblem::evaluate_screened`] on every genome of `genomes`, in
-    /// batches run by `run` ([`score_all`]).
+    /// [`SceneProblem::evaluate_screened`] on every genome of `genomes`
+    /// (genome `g` screened by `fine(g, …)`), in batches run by `run`
+    /// ([`score_all`]).
     pub fn evaluate_all(
         &self,
         genomes: &[Vec<f64>],
-        fine: &dyn Fn(&Evaluation) -> bool,
+        fine: &dyn Fn(usize, &Evaluation) -> bool,
         run: &Runner,
     ) -> Result<Vec<Evaluation>, String> {
         let makes: Vec<_> = genomes.iter().map(|g| move || self.scene(g)).collect();

@@ -219,7 +219,7 @@ impl MorphologyProblem {
     pub fn evaluate_all(
         &self,
         genomes: &[Vec<f64>],
-        fine: &dyn Fn(&Evaluation) -> bool,
+        fine: &dyn Fn(usize, &Evaluation) -> bool,
         run: &crate::evaluate::Runner,
     ) -> Result<Vec<Evaluation>, String> {
         use rayon::prelude::*;
