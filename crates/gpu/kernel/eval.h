@@ -113,6 +113,18 @@ AN_FN void an_gates(const an_batch *b, long long c) {
     }
 }
 
+/* angle_joint::angle_at: the angle at j between a and b, atan2(|ra x rb|,
+ * ra . rb). */
+AN_FN double an_angle_at(const double *a, const double *j, const double *b) {
+    double ra[3], rb[3], n[3];
+    for (int d = 0; d < 3; d++) {
+        ra[d] = a[d] - j[d];
+        rb[d] = b[d] - j[d];
+    }
+    an_cross(ra, rb, n);
+    return an_atan2(sqrt(an_dot(n, n)), an_dot(ra, rb));
+}
+
 /* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`). */
 enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_ANGLE = 4, AN_S_TILT = 5 };
 
@@ -124,7 +136,7 @@ AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
     const double *param = b->sensor_param + 5 * q;
     const double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0;
     const double *pa = x + 3 * ids[0], *pb = x + 3 * ids[1], *pc = x + 3 * ids[2];
-    double reading, d[3], e[3], n[3];
+    double reading, d[3];
     switch (b->sensor_kind[q]) {
     case AN_S_HEIGHT:
         reading = pa[1];
@@ -141,13 +153,8 @@ AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
         }
         reading = sqrt(an_dot(d, d));
         break;
-    case AN_S_ANGLE: /* angle_joint::angle_at(a, joint, b) */
-        for (int k = 0; k < 3; k++) {
-            d[k] = pa[k] - pb[k];
-            e[k] = pc[k] - pb[k];
-        }
-        an_cross(d, e, n);
-        reading = an_atan2(sqrt(an_dot(n, n)), an_dot(d, e));
+    case AN_S_ANGLE: /* at the second particle, between the first and third */
+        reading = an_angle_at(pa, pb, pc);
         break;
     default: /* AN_S_TILT: a -> b from the vertical */
         for (int k = 0; k < 3; k++) {
@@ -332,10 +339,7 @@ AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double 
  * `act`): every sensor read, then every controller in the scene's order. */
 AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
     long long k0 = b->first_ctrl[c], k1 = b->first_ctrl[c + 1];
-    int gated = 0;
-    for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
-        gated |= b->muscle_gate[3 * q] >= 0.0;
-    }
+    int gated = b->eval_param[AN_PARAMS * c + 15] != 0.0;
     if (k0 == k1 && !gated) {
         return;
     }
@@ -533,21 +537,14 @@ AN_FN int an_guard(const an_batch *b, long long c) {
 /* work.rs `omega`: the angular speed of torque joint k's end about its
  * axis (0 with the end on the axis). */
 AN_FN double an_omega(const an_batch *b, long long p0, long long k) {
-    const double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0, *axis = b->motor_axis + 3 * k;
+    const double *v = b->vel + 3 * p0;
     long long e = b->motor_end[k], j = b->motor_joint[k];
-    double r[3], rp[3], n[3], dv[3];
-    for (int d = 0; d < 3; d++) {
-        r[d] = x[3 * e + d] - x[3 * j + d];
-    }
-    double along = an_dot(r, axis);
-    for (int d = 0; d < 3; d++) {
-        rp[d] = r[d] - axis[d] * along;
-    }
-    double l2 = an_dot(rp, rp);
+    double rp[3], n[3], dv[3];
+    double l2 = an_lever(b, k, b->pos + 3 * p0, rp);
     if (l2 == 0.0) {
         return 0.0;
     }
-    an_cross(axis, rp, n);
+    an_cross(b->motor_axis + 3 * k, rp, n);
     for (int d = 0; d < 3; d++) {
         dv[d] = v[3 * e + d] - v[3 * j + d];
     }
@@ -569,17 +566,10 @@ AN_FN void an_push_velocity(const an_batch *b, long long c, long long q, double 
     }
 }
 
-/* The angle at angle joint k (angle_joint::angle_at). */
+/* The angle at angle joint k. */
 AN_FN double an_joint_angle(const an_batch *b, long long p0, long long k) {
     const double *x = b->pos + 3 * p0;
-    long long a = b->joint_a[k], j = b->joint_j[k], e = b->joint_b[k];
-    double ra[3], rb[3], n[3];
-    for (int d = 0; d < 3; d++) {
-        ra[d] = x[3 * a + d] - x[3 * j + d];
-        rb[d] = x[3 * e + d] - x[3 * j + d];
-    }
-    an_cross(ra, rb, n);
-    return an_atan2(sqrt(an_dot(n, n)), an_dot(ra, rb));
+    return an_angle_at(x + 3 * b->joint_a[k], x + 3 * b->joint_j[k], x + 3 * b->joint_b[k]);
 }
 
 /* work.rs `Work::before` for creature c's muscles: each one's state
@@ -653,16 +643,14 @@ AN_FN double an_work_after(const an_batch *b, long long c, double h, double posi
                 mid[d] = 0.5 * (w[d] + after[d]);
             }
             /* The force now: its first push's vector (every push of a
-             * force carries the same). */
+             * force carries the same; a force on no particle does none). */
             long long k0 = b->first_push[c] + b->muscle_push[2 * q];
-            if (b->muscle_push[2 * q + 1] > 0) {
-                for (int d = 0; d < 3; d++) {
-                    f[d] = b->push_force[3 * k0 + d];
-                }
-            } else {
-                for (int d = 0; d < 3; d++) {
-                    f[d] = b->muscle_base[3 * q + d] * an_muscle_value(b, q);
-                }
+            if (b->muscle_push[2 * q + 1] == 0) {
+                done = 0.0;
+                break;
+            }
+            for (int d = 0; d < 3; d++) {
+                f[d] = b->push_force[3 * k0 + d];
             }
             done = an_dot(f, mid) * h;
             break;

@@ -118,7 +118,8 @@ typedef struct {
     const double *eval_param;      /* 16 per creature: axis x, y, z, time and distance
                                       weights, touch tolerance, clock and its carry;
                                       1 if the muscles' work is summed, energy weight,
-                                      1 if a target counts, target x, y, z, its weight */
+                                      1 if a target counts, target x, y, z, its weight,
+                                      1 if an actuator is gated */
     const long long *eval_count;   /* 3 per creature: steps to run, steps taken before,
                                       measures of the archive (the rest are terms) */
     double *result;                /* 5 per creature: fitness, distance, time, work, target distance */
@@ -213,6 +214,23 @@ AN_FN void an_angle_joints(const an_batch *b, long long j0, long long nj, const 
     }
 }
 
+/* Torque joint q's lever arm at positions x: its end's offset from the
+ * joint, less its part along the axis, into perp; returns its length
+ * squared (0 with the end on the axis). */
+AN_FN double an_lever(const an_batch *b, long long q, const double *x, double *perp) {
+    long long e = b->motor_end[q], j = b->motor_joint[q];
+    const double *axis = b->motor_axis + 3 * q;
+    double r[3];
+    for (int k = 0; k < 3; k++) {
+        r[k] = x[3 * e + k] - x[3 * j + k];
+    }
+    double along = an_dot(r, axis);
+    for (int k = 0; k < 3; k++) {
+        perp[k] = r[k] - axis[k] * along;
+    }
+    return an_dot(perp, perp);
+}
+
 /* Torque joints m0 .. m0 + nm - 1 (forces/torque_joint.rs, `apply`). */
 AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double *x, double *f) {
     for (long long q = m0; q < m0 + nm; q++) {
@@ -221,20 +239,12 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
             continue;
         }
         long long e = b->motor_end[q], j = b->motor_joint[q];
-        const double *axis = b->motor_axis + 3 * q;
-        double r[3], perp[3], c[3];
-        for (int k = 0; k < 3; k++) {
-            r[k] = x[3 * e + k] - x[3 * j + k];
-        }
-        double along = an_dot(r, axis);
-        for (int k = 0; k < 3; k++) {
-            perp[k] = r[k] - axis[k] * along;
-        }
-        double l2 = an_dot(perp, perp);
+        double perp[3], c[3];
+        double l2 = an_lever(b, q, x, perp);
         if (l2 == 0.0) {
             continue; /* the end sits on the axis: no lever arm */
         }
-        an_cross(axis, perp, c);
+        an_cross(b->motor_axis + 3 * q, perp, c);
         double s = torque / l2;
         for (int k = 0; k < 3; k++) {
             double fk = c[k] * s;

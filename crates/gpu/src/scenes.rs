@@ -282,7 +282,7 @@ impl Rules {
             target.y,
             target.z,
             target_weight,
-            0.0,
+            f64::from(u8::from(nervous.gates.iter().any(Option::is_some))),
         ]);
         // The archive's measures, then the terms of the fitness.
         let archive: &[Measure] = scene.archive.as_ref().map_or(&[], |a| &a.measures);
@@ -495,24 +495,10 @@ impl Batch {
         }
         let worlds: Vec<&World> = scenes.iter().map(|s| &s.world).collect();
         let mut b = Batch::pack(&worlds, dt)?;
-        let fixed = std::mem::take(&mut b.ev.fixed);
-        let mut r = Rules {
-            fixed,
-            first_muscle: vec![0],
-            first_osc: vec![0],
-            first_output: vec![0],
-            first_centre: vec![0],
-            first_touch: vec![0],
-            first_stretch: vec![0],
-            first_measure: vec![0],
-            measure_first_id: vec![0],
-            first_sensor: vec![0],
-            first_ctrl: vec![0],
-            ..Rules::default()
-        };
-        for offsets in r.net_offsets() {
-            *offsets = vec![0];
-        }
+        // Rules for no scene yet (every offset array at [0]), the
+        // particles' fixed flags kept; each scene appends its own.
+        let mut r = std::mem::take(&mut b.ev);
+        r.no_rules(0);
         for (k, s) in scenes.iter().enumerate() {
             r.add(s).map_err(|e| format!("scene {k}: {e}"))?;
         }
