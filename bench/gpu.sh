@@ -15,8 +15,10 @@
 #
 # Builds nothing: it takes the examples built here, carried in an ignored
 # folder:
-#   cargo build --release -p animats -p animats-gpu --example gpu_check --example gpu_evaluate
+#   cargo build --release -p animats
+#   cargo build --release -p animats-gpu --example gpu_check --example gpu_evaluate
 #   mkdir -p target/carry && cp target/release/examples/gpu_{check,evaluate} target/release/animats target/carry/
+#   strip target/carry/*     # (the device carries at most 64 MiB)
 #   bench/gpu.sh
 # About four minutes on an H100 machine with 16 cores. Exit 1 if any bit
 # differs, 2 if no GPU can be used (the message says why).

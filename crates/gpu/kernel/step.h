@@ -543,7 +543,8 @@ AN_FN void an_floor_handle(const an_batch *b, long long p0, long long n, double 
         double w_at_plane = sqrt(wunder > 0.0 ? wunder : 0.0);
         double r1 = e * at_plane, r2 = e * w_at_plane - shift;
         double rebound = r1 < r2 ? r1 : r2;
-        double flight = accel < 0.0 ? 2.0 * rebound / -accel : INFINITY;
+        /* (+inf as bits: NVRTC has no math.h, hence no INFINITY) */
+        double flight = accel < 0.0 ? 2.0 * rebound / -accel : an_from_bits(0x7ff0000000000000ULL);
         v1[3 * i + 1] = (at_plane < b->rest_speed || flight <= step) ? 0.0 : rebound;
     }
 }
