@@ -18,7 +18,7 @@
 //!   compiles the same C for the GPU (a CUBIN for its architecture,
 //!   `--fmad=false`); [`Device::run`] steps a batch there, one thread per
 //!   creature. Where no driver, device or NVRTC is found, `open` says
-//!   which. Not yet run on a GPU (docs/GPU.md).
+//!   which. Run on an NVIDIA H200 with the CPU's bits (docs/GPU.md).
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
 //! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
