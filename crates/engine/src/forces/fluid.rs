@@ -66,10 +66,9 @@ impl FluidMedium {
     }
 }
 
-impl Force for FluidMedium {
-    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
-        let drag = -0.5 * self.drag_coefficient * self.density * PI;
-        let still = matches!(self.current, Current::Still);
+impl FluidMedium {
+    #[inline(always)]
+    fn apply_all(&self, ctx: &ForceContext, forces: &mut [DVec3], drag: f64, still: bool) {
         match &self.targets {
             Targets::All => {
                 for (i, f) in forces.iter_mut().enumerate() {
@@ -81,6 +80,20 @@ impl Force for FluidMedium {
                     forces[id.index()] += self.force_on(ctx, id.index(), drag, still);
                 }
             }
+        }
+    }
+}
+
+impl Force for FluidMedium {
+    fn apply(&mut self, ctx: &ForceContext, forces: &mut [DVec3]) {
+        let drag = -0.5 * self.drag_coefficient * self.density * PI;
+        // Two copies of the loop, one per kind of water: with one loop the
+        // compiler computes the current's loop-invariant parts (a square
+        // root and a division) on every call, still water or not.
+        if matches!(self.current, Current::Still) {
+            self.apply_all(ctx, forces, drag, true);
+        } else {
+            self.apply_all(ctx, forces, drag, false);
         }
     }
 
