@@ -12,7 +12,7 @@
 use animats_creatures::random::Random;
 use animats_engine::{FloorDef, IntegratorKind, World};
 use animats_gpu::bodies::random_body;
-use animats_gpu::{Batch, Device};
+use animats_gpu::{Batch, Device, Layout};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -100,6 +100,15 @@ fn main() {
         "C, every core:       {c_cpu:8.3} s  {:.3e} creature-steps/s",
         rate(c_cpu)
     );
+    let mut cpu_batch = packed.clone();
+    cpu_batch.set_layout(Layout::Batch);
+    let t = Instant::now();
+    cpu_batch.run_cpu(steps);
+    let c_batch = t.elapsed().as_secs_f64();
+    println!(
+        "C, state in the batch: {c_batch:6.3} s  {:.3e} creature-steps/s",
+        rate(c_batch)
+    );
     // Every creature's particles, the engine's, as bits.
     let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
     let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
@@ -122,7 +131,8 @@ fn main() {
             })
             .count()
     };
-    let bad = differ(&cpu, &|c, i| engine_bits[c][i]);
+    let bad =
+        differ(&cpu, &|c, i| engine_bits[c][i]) + differ(&cpu_batch, &|c, i| engine_bits[c][i]);
     println!("C on the CPU against the engine: {bad} of {creatures} creatures differ");
 
     let device = match Device::open() {
@@ -132,30 +142,39 @@ fn main() {
             std::process::exit(if bad == 0 { 2 } else { 1 });
         }
     };
-    let mut gpu = packed.clone();
     // Once to warm (the module is loaded; the first launch pays for it).
     let mut warm = packed.clone();
     if let Err(e) = device.run(&mut warm, 1) {
         eprintln!("gpu_check: {e}");
         std::process::exit(2);
     }
-    let t = Instant::now();
-    if let Err(e) = device.run(&mut gpu, steps) {
-        eprintln!("gpu_check: {e}");
-        std::process::exit(2);
+    // Each creature's state in the thread's local memory (the default),
+    // then in the batch's arrays.
+    let mut bad_gpu = 0;
+    for layout in [Layout::Local, Layout::Batch] {
+        let mut gpu = packed.clone();
+        gpu.set_layout(layout);
+        let t = Instant::now();
+        if let Err(e) = device.run(&mut gpu, steps) {
+            eprintln!("gpu_check: {e}");
+            std::process::exit(2);
+        }
+        let on_gpu = t.elapsed().as_secs_f64();
+        println!(
+            "GPU ({}), {layout:?}, copies included: {on_gpu:8.3} s  {:.3e} creature-steps/s: {:.1}x the engine on every core",
+            device.name(),
+            rate(on_gpu),
+            engine / on_gpu
+        );
+        let differ = differ(&gpu, &|c, i| {
+            let (x, v) = cpu.state(c, i).unwrap_or_default();
+            [bits(x), bits(v)]
+        });
+        println!(
+            "GPU, {layout:?}, against the C on the CPU: {differ} of {creatures} creatures differ"
+        );
+        bad_gpu += differ;
     }
-    let on_gpu = t.elapsed().as_secs_f64();
-    println!(
-        "GPU ({}), copies included: {on_gpu:8.3} s  {:.3e} creature-steps/s: {:.1}x the engine on every core",
-        device.name(),
-        rate(on_gpu),
-        engine / on_gpu
-    );
-    let bad_gpu = differ(&gpu, &|c, i| {
-        let (x, v) = cpu.state(c, i).unwrap_or_default();
-        [bits(x), bits(v)]
-    });
-    println!("GPU against the C on the CPU: {bad_gpu} of {creatures} creatures differ");
     if bad > 0 || bad_gpu > 0 {
         std::process::exit(1);
     }

@@ -15,7 +15,7 @@
 //! message says why), 1 if any bit differs.
 
 use animats_creatures::random::Random;
-use animats_gpu::{Batch, Device};
+use animats_gpu::{Batch, Device, Layout};
 use animats_scene::evaluate::{evaluate, Evaluation, SceneProblem};
 use animats_scene::morphology::MorphologyProblem;
 use animats_scene::Scene;
@@ -114,6 +114,11 @@ fn main() {
     let t = Instant::now();
     let c_cpu = cpu.evaluate_cpu().unwrap_or_else(|e| fail(e));
     report("C, every core:", t.elapsed().as_secs_f64());
+    let mut cpu_batch = packed.clone();
+    cpu_batch.set_layout(Layout::Batch);
+    let t = Instant::now();
+    let c_cpu_batch = cpu_batch.evaluate_cpu().unwrap_or_else(|e| fail(e));
+    report("C, state in the batch:", t.elapsed().as_secs_f64());
     let bits = |e: &Evaluation| {
         (
             [e.fitness, e.distance, e.time].map(f64::to_bits),
@@ -126,7 +131,7 @@ fn main() {
             .filter(|(a, b)| bits(a) != bits(b))
             .count()
     };
-    let bad = differ(&c_cpu);
+    let bad = differ(&c_cpu) + differ(&c_cpu_batch);
     println!("C on the CPU against the engine: {bad} of {count} evaluations differ");
     let best = engine
         .iter()
@@ -145,14 +150,27 @@ fn main() {
     let one = scene(kind, seconds, 0).unwrap_or_else(|e| fail(e));
     let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
     device.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
-    let mut gpu = packed.clone();
-    let t = Instant::now();
-    let on_gpu = device.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));
-    let secs = t.elapsed().as_secs_f64();
-    report(&format!("GPU ({}), copies included:", device.name()), secs);
-    println!("GPU: {:.1}x the engine on every core", on_engine / secs);
-    let bad_gpu = differ(&on_gpu);
-    println!("GPU against the engine: {bad_gpu} of {count} evaluations differ");
+    // Each creature's state in the thread's local memory (the default),
+    // then in the batch's arrays.
+    let mut bad_gpu = 0;
+    for layout in [Layout::Local, Layout::Batch] {
+        let mut gpu = packed.clone();
+        gpu.set_layout(layout);
+        let t = Instant::now();
+        let on_gpu = device.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));
+        let secs = t.elapsed().as_secs_f64();
+        report(
+            &format!("GPU ({}), {layout:?}, copies included:", device.name()),
+            secs,
+        );
+        println!(
+            "GPU, {layout:?}: {:.1}x the engine on every core",
+            on_engine / secs
+        );
+        let differ = differ(&on_gpu);
+        println!("GPU, {layout:?}, against the engine: {differ} of {count} evaluations differ");
+        bad_gpu += differ;
+    }
     if bad > 0 || bad_gpu > 0 {
         std::process::exit(1);
     }

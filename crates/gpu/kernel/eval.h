@@ -131,10 +131,10 @@ enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_AN
 /* ScaledSensor::level of sensor q (over the batch) of the creature whose
  * particles begin at p0: the probe's reading mapped from [min, max] onto
  * [0, 1]. */
-AN_FN double an_sensor(const an_batch *b, long long p0, long long q) {
+AN_FN double an_sensor(const an_batch *b, an_state st, long long p0, long long q) {
     const int *ids = b->sensor_particle + 3 * q;
     const double *param = b->sensor_param + 5 * q;
-    const double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0;
+    const double *x = st.x, *v = st.v;
     const double *pa = x + 3 * ids[0], *pb = x + 3 * ids[1], *pc = x + 3 * ids[2];
     double reading, d[3];
     switch (b->sensor_kind[q]) {
@@ -337,7 +337,7 @@ AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double 
 
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order. */
-AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
+AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double dt) {
     long long k0 = b->first_ctrl[c], k1 = b->first_ctrl[c + 1];
     int gated = b->eval_param[AN_PARAMS * c + 15] != 0.0;
     if (k0 == k1 && !gated) {
@@ -345,7 +345,7 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
     }
     long long p0 = b->first_particle[c];
     for (long long q = b->first_sensor[c]; q < b->first_sensor[c + 1]; q++) {
-        b->sensor_level[q] = an_sensor(b, p0, q);
+        b->sensor_level[q] = an_sensor(b, st, p0, q);
     }
     for (long long k = k0; k < k1; k++) {
         if (b->ctrl_kind[k] == 0) {
@@ -364,9 +364,9 @@ AN_FN void an_act(const an_batch *b, long long c, double t, double dt) {
 /* scene::evaluate::centre_at: the centre of mass of particles ids[0 ..
  * nk - 1] of the creature whose particles begin at p0 (of one: its
  * position; of massless ones: their mean). */
-AN_FN void an_centre_of(const an_batch *b, long long p0, const int *ids, long long nk,
+AN_FN void an_centre_of(const an_batch *b, an_state st, long long p0, const int *ids, long long nk,
                         double *out) {
-    const double *x = b->pos + 3 * p0;
+    const double *x = st.x;
     if (nk == 1) {
         long long p = ids[0];
         for (int d = 0; d < 3; d++) {
@@ -390,9 +390,9 @@ AN_FN void an_centre_of(const an_batch *b, long long p0, const int *ids, long lo
 }
 
 /* The centre of the particles of [evolve] that count. */
-AN_FN void an_centre(const an_batch *b, long long c, double *out) {
+AN_FN void an_centre(const an_batch *b, an_state st, long long c, double *out) {
     long long k0 = b->first_centre[c];
-    an_centre_of(b, b->first_particle[c], b->centre_particle + k0, b->first_centre[c + 1] - k0,
+    an_centre_of(b, st, b->first_particle[c], b->centre_particle + k0, b->first_centre[c + 1] - k0,
                  out);
 }
 
@@ -416,12 +416,12 @@ AN_FN const int *an_measure_ids(const an_batch *b, long long q, long long *nk) {
 
 /* Whether particle p (within the creature whose particles begin at p0)
  * touches the flat floor within `tolerance` (World::clearance). */
-AN_FN int an_on_floor(const an_batch *b, long long p0, long long p, double tolerance) {
-    return b->pos[3 * (p0 + p) + 1] - b->radius[p0 + p] <= tolerance;
+AN_FN int an_on_floor(const an_batch *b, an_state st, long long p0, long long p, double tolerance) {
+    return st.x[3 * p + 1] - b->radius[p0 + p] <= tolerance;
 }
 
 /* Recorder::new: the centres that displacements and speeds start from. */
-AN_FN void an_measures_begin(const an_batch *b, long long c) {
+AN_FN void an_measures_begin(const an_batch *b, an_state st, long long c) {
     long long p0 = b->first_particle[c];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
         long long nk;
@@ -429,13 +429,13 @@ AN_FN void an_measures_begin(const an_batch *b, long long c) {
         b->measure_sum[q] = 0.0;
         int kind = b->measure_kind[q];
         if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
-            an_centre_of(b, p0, ids, nk, b->measure_start + 3 * q);
+            an_centre_of(b, st, p0, ids, nk, b->measure_start + 3 * q);
         }
     }
 }
 
 /* Recorder::step: after each step. */
-AN_FN void an_measures_step(const an_batch *b, long long c) {
+AN_FN void an_measures_step(const an_batch *b, an_state st, long long c) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
@@ -443,20 +443,20 @@ AN_FN void an_measures_step(const an_batch *b, long long c) {
         const int *ids = an_measure_ids(b, q, &nk);
         int kind = b->measure_kind[q];
         if (kind == AN_M_CONTACT) {
-            if (an_on_floor(b, p0, ids[0], tolerance)) {
+            if (an_on_floor(b, st, p0, ids[0], tolerance)) {
                 b->measure_sum[q] = b->measure_sum[q] + 1.0;
             }
         } else if (kind == AN_M_FEET) {
             long long count = 0;
             for (long long i = 0; i < n; i++) {
-                if (b->inv_mass[p0 + i] > 0.0 && an_on_floor(b, p0, i, tolerance)) {
+                if (b->inv_mass[p0 + i] > 0.0 && an_on_floor(b, st, p0, i, tolerance)) {
                     count++;
                 }
             }
             b->measure_sum[q] = b->measure_sum[q] + (double)count;
         } else if (kind == AN_M_MEAN_HEIGHT) {
             double at[3];
-            an_centre_of(b, p0, ids, nk, at);
+            an_centre_of(b, st, p0, ids, nk, at);
             b->measure_sum[q] = b->measure_sum[q] + at[1];
         }
     }
@@ -464,7 +464,7 @@ AN_FN void an_measures_step(const an_batch *b, long long c) {
 
 /* Recorder::finish: each measure's value, after `steps` steps and `time`
  * survived, into measure_sum. */
-AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, double time,
+AN_FN void an_measures_finish(const an_batch *b, an_state st, long long c, long long steps, double time,
                                double work) {
     long long p0 = b->first_particle[c];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
@@ -476,7 +476,7 @@ AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, d
             value = steps == 0 ? 0.0 : b->measure_sum[q] / (double)steps;
         } else if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
             double at[3], moved[3];
-            an_centre_of(b, p0, ids, nk, at);
+            an_centre_of(b, st, p0, ids, nk, at);
             for (int d = 0; d < 3; d++) {
                 moved[d] = at[d] - b->measure_start[3 * q + d];
             }
@@ -496,9 +496,9 @@ AN_FN void an_measures_finish(const an_batch *b, long long c, long long steps, d
 /* EvolveSpec::ending: the first fail_on_touch particle within the
  * tolerance of the (flat) floor, else the first fail_on_stretch pair
  * stretched; AN_TIMEOUT where none holds. `which` gets the rule. */
-AN_FN int an_ending(const an_batch *b, long long c, long long *which) {
+AN_FN int an_ending(const an_batch *b, an_state st, long long c, long long *which) {
     long long p0 = b->first_particle[c];
-    const double *x = b->pos + 3 * p0;
+    const double *x = st.x;
     double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long k = b->first_touch[c]; k < b->first_touch[c + 1]; k++) {
         long long p = b->touch_particle[k];
@@ -523,9 +523,9 @@ AN_FN int an_ending(const an_batch *b, long long c, long long *which) {
 
 /* DivergenceGuard::check of a driven world: 0 where a particle that is
  * not fixed moves faster than 1000 m/s. */
-AN_FN int an_guard(const an_batch *b, long long c) {
+AN_FN int an_guard(const an_batch *b, an_state st, long long c) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
-    const double *v = b->vel + 3 * p0;
+    const double *v = st.v;
     for (long long i = 0; i < n; i++) {
         if (!b->fixed[p0 + i] && an_dot(v + 3 * i, v + 3 * i) > 1000.0 * 1000.0) {
             return 0;
@@ -536,11 +536,11 @@ AN_FN int an_guard(const an_batch *b, long long c) {
 
 /* work.rs `omega`: the angular speed of torque joint k's end about its
  * axis (0 with the end on the axis). */
-AN_FN double an_omega(const an_batch *b, long long p0, long long k) {
-    const double *v = b->vel + 3 * p0;
+AN_FN double an_omega(const an_batch *b, an_state st, long long k) {
+    const double *v = st.v;
     long long e = b->motor_end[k], j = b->motor_joint[k];
     double rp[3], n[3], dv[3];
-    double l2 = an_lever(b, k, b->pos + 3 * p0, rp);
+    double l2 = an_lever(b, k, st.x, rp);
     if (l2 == 0.0) {
         return 0.0;
     }
@@ -552,14 +552,13 @@ AN_FN double an_omega(const an_batch *b, long long p0, long long k) {
 }
 
 /* work.rs `velocity_sum` of constant force q's pushed particles. */
-AN_FN void an_push_velocity(const an_batch *b, long long c, long long q, double *out) {
-    long long p0 = b->first_particle[c];
+AN_FN void an_push_velocity(const an_batch *b, an_state st, long long c, long long q, double *out) {
     long long k0 = b->first_push[c] + b->muscle_push[2 * q];
     out[0] = 0.0;
     out[1] = 0.0;
     out[2] = 0.0;
     for (long long k = k0; k < k0 + b->muscle_push[2 * q + 1]; k++) {
-        const double *v = b->vel + 3 * (p0 + b->push_particle[k]);
+        const double *v = st.v + 3 * b->push_particle[k];
         for (int d = 0; d < 3; d++) {
             out[d] = out[d] + v[d];
         }
@@ -567,8 +566,8 @@ AN_FN void an_push_velocity(const an_batch *b, long long c, long long q, double 
 }
 
 /* The angle at angle joint k. */
-AN_FN double an_joint_angle(const an_batch *b, long long p0, long long k) {
-    const double *x = b->pos + 3 * p0;
+AN_FN double an_joint_angle(const an_batch *b, an_state st, long long k) {
+    const double *x = st.x;
     return an_angle_at(x + 3 * b->joint_a[k], x + 3 * b->joint_j[k], x + 3 * b->joint_b[k]);
 }
 
@@ -576,9 +575,8 @@ AN_FN double an_joint_angle(const an_batch *b, long long p0, long long k) {
  * before the step (a spring's length and rest length, an angle joint's
  * angle and rest angle, a motor's angular speed, a force's particles'
  * summed velocity), into muscle_work. */
-AN_FN void an_work_before(const an_batch *b, long long c) {
-    long long p0 = b->first_particle[c];
-    const double *x = b->pos + 3 * p0;
+AN_FN void an_work_before(const an_batch *b, an_state st, long long c) {
+    const double *x = st.x;
     for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
         double *w = b->muscle_work + 3 * q;
         long long i = b->muscle_spring[q];
@@ -595,15 +593,15 @@ AN_FN void an_work_before(const an_batch *b, long long c) {
         }
         case 1: {
             long long k = b->first_joint[c] + i;
-            w[0] = an_joint_angle(b, p0, k);
+            w[0] = an_joint_angle(b, st, k);
             w[1] = b->joint_rest[k];
             break;
         }
         case 2:
-            w[0] = an_omega(b, p0, b->first_motor[c] + i);
+            w[0] = an_omega(b, st, b->first_motor[c] + i);
             break;
         default:
-            an_push_velocity(b, c, q, w);
+            an_push_velocity(b, st, c, q, w);
             break;
         }
     }
@@ -611,8 +609,7 @@ AN_FN void an_work_before(const an_batch *b, long long c) {
 
 /* work.rs `Work::after`: the positive work creature c's muscles did in
  * the step of length h, added to `positive` muscle by muscle. */
-AN_FN double an_work_after(const an_batch *b, long long c, double h, double positive) {
-    long long p0 = b->first_particle[c];
+AN_FN double an_work_after(const an_batch *b, an_state st, long long c, double h, double positive) {
     for (long long q = b->first_muscle[c]; q < b->first_muscle[c + 1]; q++) {
         const double *w = b->muscle_work + 3 * q;
         long long i = b->muscle_spring[q];
@@ -632,13 +629,13 @@ AN_FN double an_work_after(const an_batch *b, long long c, double h, double posi
         }
         case 2: {
             long long k = b->first_motor[c] + i;
-            double end = an_omega(b, p0, k);
+            double end = an_omega(b, st, k);
             done = b->motor_torque[k] * 0.5 * (w[0] + end) * h;
             break;
         }
         default: {
             double after[3], mid[3], f[3];
-            an_push_velocity(b, c, q, after);
+            an_push_velocity(b, st, c, q, after);
             for (int d = 0; d < 3; d++) {
                 mid[d] = 0.5 * (w[d] + after[d]);
             }
@@ -664,7 +661,7 @@ AN_FN double an_work_after(const an_batch *b, long long c, double h, double posi
 }
 
 /* The evaluation of creature c (scene::evaluate::evaluate_with). */
-AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
+AN_FN void an_evaluate_creature(const an_batch *b, an_state st, long long c) {
     const double *param = b->eval_param + AN_PARAMS * c;
     int work = param[8] != 0.0;
     double positive = 0.0;
@@ -672,19 +669,19 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     long long steps = b->eval_count[3 * c], taken = b->eval_count[3 * c + 1];
     long long done = 0, which = 0;
     double start[3], last[3], now[3];
-    an_centre(b, c, start);
+    an_centre(b, st, c, start);
     for (int d = 0; d < 3; d++) {
         last[d] = start[d];
     }
-    an_measures_begin(b, c);
-    int why = an_ending(b, c, &which);
+    an_measures_begin(b, st, c);
+    int why = an_ending(b, st, c, &which);
     if (why == AN_TIMEOUT) {
         while (done < steps) {
             if (work) {
-                an_work_before(b, c);
+                an_work_before(b, st, c);
             }
-            an_act(b, c, t, dt); /* Scene::step: the nervous system first */
-            if (!an_step_once(b, c)) {
+            an_act(b, st, c, t, dt); /* Scene::step: the nervous system first */
+            if (!an_step_once(b, st, c)) {
                 why = AN_BLOWUP;
                 break;
             }
@@ -694,16 +691,16 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
             carry = (t1 - t) - y;
             t = t1;
             taken++;
-            if (taken % 64 == 0 && !an_guard(b, c)) {
+            if (taken % 64 == 0 && !an_guard(b, st, c)) {
                 why = AN_BLOWUP;
                 break;
             }
             if (work) {
-                positive = an_work_after(b, c, dt, positive);
+                positive = an_work_after(b, st, c, dt, positive);
             }
             done++;
-            an_measures_step(b, c);
-            an_centre(b, c, now);
+            an_measures_step(b, st, c);
+            an_centre(b, st, c, now);
             if (!(now[0] - now[0] == 0.0 && now[1] - now[1] == 0.0 && now[2] - now[2] == 0.0)) {
                 why = AN_BLOWUP;
                 break;
@@ -711,7 +708,7 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
             for (int d = 0; d < 3; d++) {
                 last[d] = now[d];
             }
-            why = an_ending(b, c, &which);
+            why = an_ending(b, st, c, &which);
             if (why != AN_TIMEOUT) {
                 break;
             }
@@ -726,7 +723,7 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     if (why == AN_BLOWUP) {
         distance = distance < 0.0 ? distance : 0.0;
     }
-    an_measures_finish(b, c, done, time, positive);
+    an_measures_finish(b, st, c, done, time, positive);
     double fitness = param[3] * time + param[4] * distance;
     if (param[9] != 0.0) { /* energy_weight */
         fitness -= param[9] * positive;
@@ -751,6 +748,20 @@ AN_FN void an_evaluate_creature(const an_batch *b, long long c) {
     b->result[5 * c + 4] = target;
     b->ended[2 * c] = why;
     b->ended[2 * c + 1] = which;
+}
+
+/* Creature c evaluated, its state held as an_step_in holds it. */
+AN_FN void an_evaluate_in(const an_batch *b, long long c, int local) {
+    double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    int fits = 0;
+    an_state st = local ? an_local(b, c, x, v, sc, &fits) : an_batch_state(b, c);
+    if (local && !fits) {
+        st = an_batch_state(b, c);
+    }
+    an_evaluate_creature(b, st, c);
+    if (fits) {
+        an_local_done(b, c, st);
+    }
 }
 
 #endif

@@ -18,16 +18,19 @@ double animats_expm1(double x) { return an_expm1(x); }
 double animats_tanh(double x) { return an_tanh(x); }
 
 /* Creatures first .. last - 1 of a batch: the CPU's threads each take a
- * range (every creature writes only its own particles and scratch). */
-void animats_step_range(const an_batch *b, long long first, long long last, long long steps) {
+ * range (every creature writes only its own particles and scratch); local:
+ * each creature's state in arrays of the thread's own while it is stepped
+ * (an_step_in). */
+void animats_step_range(const an_batch *b, long long first, long long last, long long steps,
+                        int local) {
     for (long long c = first; c < last; c++) {
-        an_step_creature(b, c, steps);
+        an_step_in(b, c, steps, local);
     }
 }
 
 /* Creatures first .. last - 1 of a batch evaluated whole (eval.h). */
-void animats_evaluate_range(const an_batch *b, long long first, long long last) {
+void animats_evaluate_range(const an_batch *b, long long first, long long last, int local) {
     for (long long c = first; c < last; c++) {
-        an_evaluate_creature(b, c);
+        an_evaluate_in(b, c, local);
     }
 }

@@ -166,6 +166,20 @@ typedef struct {
                                   1 if open above it */
 } an_batch;
 
+/* Where one creature's state is: its positions and velocities (3 doubles
+ * a particle) and the step's scratch (15 a particle); in the batch's arrays
+ * (an_batch_state) or in arrays of the thread's own (an_local). */
+typedef struct {
+    double *x, *v, *sc;
+} an_state;
+
+/* Creature c's state in the batch's arrays. */
+AN_FN an_state an_batch_state(const an_batch *b, long long c) {
+    long long p0 = b->first_particle[c];
+    an_state st = {b->pos + 3 * p0, b->vel + 3 * p0, b->scratch + 15 * p0};
+    return st;
+}
+
 /* glam's dot product and cross product, in its order. */
 AN_FN double an_dot(const double *a, const double *b) {
     return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
@@ -564,12 +578,12 @@ AN_FN int an_finite(const double *x, long long m3) {
  * missed down to 1/1024 of the step, and grown back once they line up).
  * Returns 1; or 0 where the state would stop being finite, leaving it at
  * its last finite state, as the engine's step refuses it. */
-AN_FN int an_step_once(const an_batch *b, long long c) {
+AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
     long long m3 = 3 * n;
-    double *x = b->pos + 3 * p0, *v = b->vel + 3 * p0;
-    double *sc = b->scratch + 15 * p0;
+    double *x = st.x, *v = st.v;
+    double *sc = st.sc;
     double *f = sc, *x1 = sc + m3, *v1 = sc + 2 * m3, *dx = sc + 3 * m3, *dv = sc + 4 * m3;
     double dt = b->dt;
     const long long total = 1LL << 10; /* MAX_BACKTRACK_DEPTH */
@@ -613,15 +627,67 @@ AN_FN int an_step_once(const an_batch *b, long long c) {
 /* `steps` steps of creature c. A non-finite state stops the creature at
  * its last finite state; `failed[c]` records the step (1-based, counted
  * over every run of the batch). */
-AN_FN void an_step_creature(const an_batch *b, long long c, long long steps) {
+AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long long steps) {
     if (b->failed[c] != 0) {
         return;
     }
     for (long long step = 0; step < steps; step++) {
-        if (!an_step_once(b, c)) {
+        if (!an_step_once(b, st, c)) {
             b->failed[c] = b->steps_before + step + 1;
             return;
         }
+    }
+}
+
+/* The most particles a creature may have for one thread to hold its state
+ * (positions, velocities and the step's scratch: 21 doubles a particle,
+ * 5.25 KiB) in arrays of its own. On a GPU these live in the thread's
+ * local memory, which the hardware interleaves thread by thread: a warp's
+ * 32 creatures read and write their k-th coordinate in one transaction,
+ * where in the batch's arrays (each creature's run contiguous) a warp
+ * touches 32 scattered places. */
+#define AN_LOCAL 32
+
+/* Copies creature c's positions and velocities into x and v (3 AN_LOCAL
+ * doubles each) and returns the state held there, with sc (15 AN_LOCAL
+ * doubles) as its scratch; sets *fits to 0, and copies nothing, where the
+ * creature has more than AN_LOCAL particles. */
+AN_FN an_state an_local(const an_batch *b, long long c, double *x, double *v, double *sc,
+                        int *fits) {
+    long long p0 = b->first_particle[c], m3 = 3 * (b->first_particle[c + 1] - p0);
+    an_state st = {x, v, sc};
+    *fits = m3 <= 3 * AN_LOCAL;
+    if (*fits) {
+        for (long long k = 0; k < m3; k++) {
+            x[k] = b->pos[3 * p0 + k];
+            v[k] = b->vel[3 * p0 + k];
+        }
+    }
+    return st;
+}
+
+/* The state held by an_local copied back into the batch's arrays. */
+AN_FN void an_local_done(const an_batch *b, long long c, an_state st) {
+    long long p0 = b->first_particle[c], m3 = 3 * (b->first_particle[c + 1] - p0);
+    for (long long k = 0; k < m3; k++) {
+        b->pos[3 * p0 + k] = st.x[k];
+        b->vel[3 * p0 + k] = st.v[k];
+    }
+}
+
+/* Creature c stepped `steps` times, its state held in the batch's arrays
+ * (local 0) or, where it fits, in the thread's own (local 1): the same
+ * operations on the same numbers either way, so the same bits. */
+AN_FN void an_step_in(const an_batch *b, long long c, long long steps, int local) {
+    double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    int fits = 0;
+    an_state st = local ? an_local(b, c, x, v, sc, &fits) : an_batch_state(b, c);
+    if (local && !fits) {
+        st = an_batch_state(b, c);
+    }
+    an_step_creature(b, st, c, steps);
+    if (fits) {
+        an_local_done(b, c, st);
     }
 }
 

@@ -106,11 +106,12 @@ impl Device {
         let (on_device, raw) = upload(s, batch)?;
         let creatures = batch.creatures() as i64;
         let steps = steps.min(i64::MAX as u64) as i64;
+        let local = batch.layout().flag();
         let mut launch = s.launch_builder(&self.function);
-        launch.arg(&raw).arg(&creatures).arg(&steps);
+        launch.arg(&raw).arg(&creatures).arg(&steps).arg(&local);
         // SAFETY: the kernel reads and writes within the arrays just
         // uploaded, at the offsets `Batch::pack` checked; the arguments
-        // match its signature (an_batch by value, two long longs).
+        // match its signature (an_batch by value, two long longs, an int).
         unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the step"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
@@ -132,10 +133,11 @@ impl Device {
         let s = &self.stream;
         let (on_device, raw) = upload(s, batch)?;
         let creatures = batch.creatures() as i64;
+        let local = batch.layout().flag();
         let mut launch = s.launch_builder(&self.evaluate);
-        launch.arg(&raw).arg(&creatures);
-        // SAFETY: as in `run`; the kernel takes an_batch by value and one
-        // long long.
+        launch.arg(&raw).arg(&creatures).arg(&local);
+        // SAFETY: as in `run`; the kernel takes an_batch by value, one
+        // long long and an int.
         unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the evaluation"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;

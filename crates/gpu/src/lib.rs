@@ -12,8 +12,12 @@
 //! - [`Batch::pack`] lays worlds out as the C's structure of arrays with
 //!   per-creature offsets, refusing (naming the world and the entry) what
 //!   the C does not step yet.
+//! - [`Batch::pack_scenes`] lays out whole scenes (sensors, actuators,
+//!   brains, the `[evolve]` rules and measures) and
+//!   [`Batch::evaluate_cpu`] / [`Device::evaluate`] evaluate them, with
+//!   the evaluations `animats evaluate` gives, to the bit.
 //! - [`Batch::run_cpu`] steps every creature with the C compiled for this
-//!   CPU.
+//!   CPU. [`Layout`] says where a thread keeps the creature's state.
 //! - [`Device::open`] loads the NVIDIA driver and NVRTC at run time and
 //!   compiles the same C for the GPU (a CUBIN for its architecture,
 //!   `--fmad=false`); [`Device::run`] steps a batch there, one thread per
@@ -24,8 +28,10 @@
 //! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
 //! torque joints, constant forces, still fluids, the flat floor (collisions
 //! located by backtracking, contact force), and the explicit integrators
-//! (Euler, midpoint, RK4, symplectic Euler). Sensors, brains and fitness
-//! are issue 42's next steps; docs/GPU.md says where it stands.
+//! (Euler, midpoint, RK4, symplectic Euler), soft contact between
+//! spheres; for evaluations, `[[sensor]]`s, every actuator target,
+//! oscillator, neural, CTRNN and FSM brains and the `[evolve]` fitness,
+//! end rules and archive measures. docs/GPU.md says what is refused.
 
 pub mod bodies;
 pub mod cuda;
@@ -34,5 +40,5 @@ pub mod ported;
 mod scenes;
 
 pub use cuda::Device;
-pub use pack::Batch;
+pub use pack::{Batch, Layout};
 pub use scenes::{c_batches, c_runs};

@@ -130,7 +130,31 @@ extern "C" {
         first: c_longlong,
         last: c_longlong,
         steps: c_longlong,
+        local: c_int,
     );
+}
+
+/// Where a thread keeps the state (positions, velocities, the step's
+/// scratch) of the creature it steps or evaluates. Either gives the same
+/// bits: the same operations on the same numbers, only stored elsewhere.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Layout {
+    /// In the batch's arrays, each creature's particles one contiguous run
+    /// (on a GPU, a warp's 32 threads read 32 scattered places at once).
+    Batch,
+    /// In arrays of the thread's own for creatures of at most 32 particles
+    /// (on a GPU, its local memory, which the hardware interleaves thread
+    /// by thread, so that a warp's reads of its creatures' k-th
+    /// coordinates are one transaction); larger creatures as `Batch`.
+    #[default]
+    Local,
+}
+
+impl Layout {
+    /// The C's flag (`local` of `an_step_in`).
+    pub(crate) fn flag(self) -> c_int {
+        c_int::from(self == Layout::Local)
+    }
 }
 
 /// Creatures a thread of [`Batch::run_cpu`] takes at a time.
@@ -191,6 +215,8 @@ pub struct Batch {
     failed: Vec<i64>,
     /// Steps taken by earlier runs (`failed` counts from the first).
     steps_run: u64,
+    /// Where a thread keeps the state of the creature it steps.
+    layout: Layout,
     first_push: Vec<i64>,
     push_particle: Vec<i32>,
     push_force: Vec<f64>,
@@ -265,6 +291,7 @@ impl Batch {
             mu_k: Vec::new(),
             failed: vec![0; worlds.len()],
             steps_run: 0,
+            layout: Layout::default(),
             first_push: vec![0],
             push_particle: Vec::new(),
             push_force: Vec::new(),
@@ -410,6 +437,7 @@ impl Batch {
         use rayon::prelude::*;
         let shared = Shared(self.raw());
         let steps = steps.min(i64::MAX as u64) as c_longlong;
+        let local = self.layout.flag();
         let n = self.creatures();
         (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|k| {
             let (first, last) = (k * CHUNK, ((k + 1) * CHUNK).min(n));
@@ -419,10 +447,27 @@ impl Batch {
             // within its creature, as packed), and creatures first..last
             // are this task's alone.
             unsafe {
-                animats_step_range(shared.get(), first as c_longlong, last as c_longlong, steps)
+                animats_step_range(
+                    shared.get(),
+                    first as c_longlong,
+                    last as c_longlong,
+                    steps,
+                    local,
+                )
             };
         });
         self.steps_run = self.steps_run.saturating_add(steps as u64);
+    }
+
+    /// Where the threads that step this batch keep each creature's state
+    /// (on the CPU and on a GPU): [`Layout::Local`] unless set.
+    pub fn set_layout(&mut self, layout: Layout) {
+        self.layout = layout;
+    }
+
+    /// Where the threads keep each creature's state.
+    pub fn layout(&self) -> Layout {
+        self.layout
     }
 
     pub(crate) fn raw(&mut self) -> Raw {

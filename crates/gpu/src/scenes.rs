@@ -31,7 +31,12 @@ use animats_scene::Scene;
 use std::os::raw::c_longlong;
 
 extern "C" {
-    fn animats_evaluate_range(batch: *const crate::pack::Raw, first: c_longlong, last: c_longlong);
+    fn animats_evaluate_range(
+        batch: *const crate::pack::Raw,
+        first: c_longlong,
+        last: c_longlong,
+        local: std::os::raw::c_int,
+    );
 }
 
 /// Numbers of `eval_param` per creature (`kernel/step.h` says which).
@@ -520,6 +525,7 @@ impl Batch {
         use rayon::prelude::*;
         self.take_ready()?;
         let shared = Shared(self.raw());
+        let local = self.layout().flag();
         let n = self.creatures();
         (0..n.div_ceil(CHUNK)).into_par_iter().for_each(|k| {
             let (first, last) = (k * CHUNK, ((k + 1) * CHUNK).min(n));
@@ -529,7 +535,7 @@ impl Batch {
             // first..last, with their springs, muscles and results, are
             // this task's alone.
             unsafe {
-                animats_evaluate_range(shared.get(), first as c_longlong, last as c_longlong)
+                animats_evaluate_range(shared.get(), first as c_longlong, last as c_longlong, local)
             };
         });
         Ok(self.evaluations())

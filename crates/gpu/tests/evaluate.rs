@@ -8,7 +8,7 @@
 //! does not evaluate is refused by name.
 
 use animats_creatures::random::Random;
-use animats_gpu::Batch;
+use animats_gpu::{Batch, Layout};
 use animats_scene::evaluate::{Ended, Evaluation, SceneProblem};
 use animats_scene::morphology::problem::MorphologyProblem;
 use animats_scene::Scene;
@@ -22,7 +22,18 @@ const WALKER_CTRNN: &str = include_str!("../../../scenes/walker_ctrnn.toml");
 fn assert_same(scenes: Vec<Scene>, what: &str) -> Vec<Evaluation> {
     let refs: Vec<&Scene> = scenes.iter().collect();
     let mut batch = Batch::pack_scenes(&refs).unwrap();
+    // The same scenes with each creature's state in the batch's arrays
+    // rather than in the thread's own (the default for creatures of at
+    // most 32 particles): the same bits.
+    let mut in_batch = batch.clone();
+    in_batch.set_layout(Layout::Batch);
     let got = batch.evaluate_cpu().unwrap();
+    let got_in_batch = in_batch.evaluate_cpu().unwrap();
+    assert_eq!(
+        format!("{got:?}"),
+        format!("{got_in_batch:?}"),
+        "{what}: the layouts differ"
+    );
     let mut want = Vec::new();
     for (c, scene) in scenes.into_iter().enumerate() {
         let mut last = None;
@@ -61,6 +72,11 @@ fn assert_same(scenes: Vec<Scene>, what: &str) -> Vec<Evaluation> {
         {
             let (x, v) = batch.state(c, i).unwrap();
             let b = |a: animats_engine::DVec3| a.to_array().map(f64::to_bits);
+            let (xb, vb) = in_batch.state(c, i).unwrap();
+            assert!(
+                b(x) == b(xb) && b(v) == b(vb),
+                "{what}: scene {c}, particle {i}: the layouts differ"
+            );
             assert!(
                 b(x) == b(pos[i]) && b(v) == b(vel[i]),
                 "{what}: scene {c}, particle {i}: C x = {x}, v = {v}; engine x = {}, v = {}",
@@ -209,6 +225,29 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
     d.dedup();
     assert!(d.len() > 8, "{got:?}");
+}
+
+#[test]
+fn lattice_bodies_too_big_for_a_thread_s_own_arrays_are_the_engine_s_to_the_bit() {
+    // The EvoGym walker of scenes/bodies_lattice.toml (more than the 32
+    // particles a thread holds in arrays of its own: kept in the batch's
+    // arrays instead) beside a small random body, 0.3 s each.
+    let text = include_str!("../../../scenes/bodies_lattice.toml")
+        .replace("duration = 10.0", "duration = 0.3");
+    let problem = MorphologyProblem::parse(&text, "bodies_lattice.toml").unwrap();
+    let start = problem.start().unwrap().to_vec();
+    let lattice = animats_scene::parse(&problem.develop(&start, "").unwrap(), "body.toml").unwrap();
+    let walk = BODIES_WALK.replace("duration = 10.0", "duration = 0.3");
+    let small = MorphologyProblem::parse(&walk, "bodies_walk.toml").unwrap();
+    let genes = small.random(&mut Random::for_entry(5, 0));
+    let body = animats_scene::parse(&small.develop(&genes, "").unwrap(), "body.toml").unwrap();
+    let sizes = [lattice.world.len(), body.world.len()];
+    assert!(sizes[0] > 32 && sizes[1] <= 32, "{sizes:?}");
+    let got = assert_same(
+        vec![lattice, body],
+        &format!("lattice and small body {sizes:?}"),
+    );
+    assert!(got[0].distance != 0.0, "{got:?}");
 }
 
 #[test]

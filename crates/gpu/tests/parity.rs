@@ -8,7 +8,7 @@
 //! each other through soft contact.
 
 use animats_engine::{DVec3, FloorDef, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
-use animats_gpu::Batch;
+use animats_gpu::{Batch, Layout};
 
 use animats_creatures::random::Random;
 use animats_gpu::bodies::{random_body, random_vec};
@@ -25,6 +25,11 @@ const INTEGRATORS: [IntegratorKind; 4] = [
 fn assert_same(worlds: &mut [World], dt: f64, steps: u64, rounds: usize, what: &str) {
     let refs: Vec<&World> = worlds.iter().collect();
     let mut batch = Batch::pack(&refs, dt).unwrap();
+    // The same creatures with their state kept in the batch's arrays
+    // rather than in each thread's own (Layout::Local, the default, for
+    // creatures of at most 32 particles): the same bits.
+    let mut in_batch = batch.clone();
+    in_batch.set_layout(Layout::Batch);
     // A world whose state stops being finite stays at its last finite
     // state; the C must stop its creature at the same step, in the same
     // state.
@@ -41,6 +46,7 @@ fn assert_same(worlds: &mut [World], dt: f64, steps: u64, rounds: usize, what: &
             }
         }
         batch.run_cpu(steps);
+        in_batch.run_cpu(steps);
         if round == rounds && failed.iter().any(Option::is_some) {
             eprintln!(
                 "{what}: blew up at steps {:?}",
@@ -49,7 +55,20 @@ fn assert_same(worlds: &mut [World], dt: f64, steps: u64, rounds: usize, what: &
         }
         for (c, w) in worlds.iter().enumerate() {
             assert_eq!(batch.failed(c), failed[c], "{what}: creature {c}'s blow-up");
+            assert_eq!(
+                in_batch.failed(c),
+                failed[c],
+                "{what}: creature {c}'s blow-up"
+            );
             for i in 0..w.len() {
+                let as_bits = |s: Option<(DVec3, DVec3)>| {
+                    s.map(|(x, v)| [x, v].map(|a| a.to_array().map(f64::to_bits)))
+                };
+                assert_eq!(
+                    as_bits(batch.state(c, i)),
+                    as_bits(in_batch.state(c, i)),
+                    "{what}: creature {c}, particle {i}: the layouts differ"
+                );
                 let (x, v) = batch.state(c, i).unwrap();
                 let (ex, ev) = (w.state().pos[i], w.state().vel[i]);
                 let bits = |a: DVec3| a.to_array().map(f64::to_bits);
