@@ -75,10 +75,31 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let cubin = compile(arch)?;
-        let module = ctx
-            .load_module(cudarc::nvrtc::Ptx::from_binary(cubin))
-            .map_err(|e| format!("loading the compiled step on {name}: {e}"))?;
+        let src = source();
+        let options = options(arch);
+        // The kernel compiled by an earlier run, where one was kept
+        // (src/cache.rs); else compiled now, and kept.
+        let kept = crate::cache::folder().map(|dir| {
+            crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch)
+        });
+        let load = |cubin: Vec<u8>| ctx.load_module(cudarc::nvrtc::Ptx::from_binary(cubin));
+        let cached = kept
+            .as_deref()
+            .and_then(crate::cache::read)
+            .and_then(|cubin| load(cubin).ok());
+        let module = match cached {
+            Some(module) => module,
+            None => {
+                let cubin = compile(&src, &options, arch)?;
+                let module = load(cubin.clone())
+                    .map_err(|e| format!("loading the compiled step on {name}: {e}"))?;
+                if let Some(path) = &kept {
+                    // Without a cache the next run compiles again: no error.
+                    let _ = crate::cache::write(path, &cubin);
+                }
+                module
+            }
+        };
         let function = module
             .load_function("animats_step_kernel")
             .map_err(|e| format!("the step's entry: {e}"))?;
@@ -252,20 +273,41 @@ struct DeviceBatch(Raw);
 // and ints, the layout of the kernel's `an_batch`.
 unsafe impl DeviceRepr for DeviceBatch {}
 
-/// NVRTC: the kernel to a CUBIN for `sm_{major}{minor}`, no contraction.
-fn compile((major, minor): (i32, i32)) -> Result<Vec<u8>, String> {
-    use cudarc::nvrtc::{result, sys};
-    let src = std::ffi::CString::new(source()).map_err(|e| format!("the kernel's source: {e}"))?;
-    let prog = result::create_program(&src, None).map_err(|e| format!("NVRTC: {e}"))?;
-    let options = [
+/// NVRTC's options for `sm_{major}{minor}`: strict IEEE arithmetic, no
+/// contraction into fused multiply-adds.
+fn options((major, minor): (i32, i32)) -> Vec<String> {
+    vec![
         format!("--gpu-architecture=sm_{major}{minor}"),
         "--fmad=false".to_string(),
         "--prec-div=true".to_string(),
         "--prec-sqrt=true".to_string(),
         "--ftz=false".to_string(),
-    ];
+    ]
+}
+
+/// NVRTC's version, as `major.minor` (part of a kept kernel's name).
+fn nvrtc_version() -> String {
+    let (mut major, mut minor) = (0, 0);
+    // SAFETY: NVRTC is loaded (checked in `open`); two ints receive it.
+    let got = unsafe { cudarc::nvrtc::sys::nvrtcVersion(&mut major, &mut minor) };
+    if got == cudarc::nvrtc::sys::nvrtcResult::NVRTC_SUCCESS {
+        format!("{major}.{minor}")
+    } else {
+        "unknown".into()
+    }
+}
+
+/// NVRTC: the kernel `source` to a CUBIN for `sm_{major}{minor}`.
+fn compile(
+    source: &str,
+    options: &[String],
+    (major, minor): (i32, i32),
+) -> Result<Vec<u8>, String> {
+    use cudarc::nvrtc::{result, sys};
+    let src = std::ffi::CString::new(source).map_err(|e| format!("the kernel's source: {e}"))?;
+    let prog = result::create_program(&src, None).map_err(|e| format!("NVRTC: {e}"))?;
     // SAFETY: `prog` is a live program; the options are valid C strings.
-    let compiled = unsafe { result::compile_program(prog, &options) };
+    let compiled = unsafe { result::compile_program(prog, options) };
     if let Err(e) = compiled {
         // SAFETY: as above.
         let log = unsafe { result::get_program_log(prog) }.unwrap_or_default();

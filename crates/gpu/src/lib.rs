@@ -22,7 +22,8 @@
 //!   compiles the same C for the GPU (a CUBIN for its architecture,
 //!   `--fmad=false`); [`Device::run`] steps a batch there, one thread per
 //!   creature. Where no driver, device or NVRTC is found, `open` says
-//!   which. Run on an NVIDIA H200 with the CPU's bits (docs/GPU.md).
+//!   which. The compiled kernel is kept on disk for the next run
+//!   ([`cache`]). Run on an NVIDIA H200 with the CPU's bits (docs/GPU.md).
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
 //! angle joints (with `atan2` ported from the `libm` crate, [`ported`]),
@@ -34,6 +35,7 @@
 //! end rules and archive measures. docs/GPU.md says what is refused.
 
 pub mod bodies;
+pub mod cache;
 pub mod cuda;
 mod pack;
 pub mod ported;
