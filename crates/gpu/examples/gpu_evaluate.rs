@@ -15,7 +15,7 @@
 //! message says why), 1 if any bit differs.
 
 use animats_creatures::random::Random;
-use animats_gpu::{Batch, Device, Layout};
+use animats_gpu::{Batch, Device, Layout, Schedule};
 use animats_scene::evaluate::{evaluate, Evaluation, SceneProblem};
 use animats_scene::morphology::MorphologyProblem;
 use animats_scene::Scene;
@@ -109,6 +109,20 @@ fn main() {
         )
     };
     report("engine, every core:", on_engine);
+    // A warp's 32 threads step until its longest evaluation ends: the share
+    // of their steps that evaluate something (creatures in batch order).
+    let lengths: Vec<f64> = engine.iter().map(|e| (e.time / dt).round()).collect();
+    let busy: f64 = lengths
+        .chunks(32)
+        .map(|w| {
+            w.iter().sum::<f64>() / (32.0 * w.iter().fold(0.0, |a: f64, &b| a.max(b))).max(1.0)
+        })
+        .sum::<f64>()
+        / lengths.len().div_ceil(32) as f64;
+    println!(
+        "warps of 32 busy {:.1} % of their steps (evaluations end at different times)",
+        100.0 * busy
+    );
 
     let mut cpu = packed.clone();
     let t = Instant::now();
@@ -139,7 +153,7 @@ fn main() {
         .fold(f64::NEG_INFINITY, f64::max);
     println!("best fitness {best}; the first: {:?}", engine[0]);
 
-    let device = match Device::open() {
+    let mut device = match Device::open() {
         Ok(d) => d,
         Err(e) => {
             eprintln!("gpu_evaluate: {e}");
@@ -151,24 +165,31 @@ fn main() {
     let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
     device.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
     // Each creature's state in the thread's local memory (the default),
-    // then in the batch's arrays.
+    // then in the batch's arrays; one thread per evaluation (the default),
+    // then threads taking evaluations from a queue.
     let mut bad_gpu = 0;
-    for layout in [Layout::Local, Layout::Batch] {
+    for (layout, schedule) in [
+        (Layout::Local, Schedule::Static),
+        (Layout::Batch, Schedule::Static),
+        (Layout::Local, Schedule::Queue),
+    ] {
         let mut gpu = packed.clone();
         gpu.set_layout(layout);
+        device.set_schedule(schedule);
         let t = Instant::now();
         let on_gpu = device.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));
         let secs = t.elapsed().as_secs_f64();
+        let how = format!("{layout:?}, {schedule:?}");
         report(
-            &format!("GPU ({}), {layout:?}, copies included:", device.name()),
+            &format!("GPU ({}), {how}, copies included:", device.name()),
             secs,
         );
         println!(
-            "GPU, {layout:?}: {:.1}x the engine on every core",
+            "GPU, {how}: {:.1}x the engine on every core",
             on_engine / secs
         );
         let differ = differ(&on_gpu);
-        println!("GPU, {layout:?}, against the engine: {differ} of {count} evaluations differ");
+        println!("GPU, {how}, against the engine: {differ} of {count} evaluations differ");
         bad_gpu += differ;
     }
     if bad > 0 || bad_gpu > 0 {

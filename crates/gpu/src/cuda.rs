@@ -44,6 +44,23 @@ pub struct Device {
     evaluate: CudaFunction,
     name: String,
     arch: (i32, i32),
+    /// Streaming multiprocessors.
+    sms: u32,
+    schedule: Schedule,
+}
+
+/// How a GPU's threads share the evaluations of a batch. Either gives the
+/// same bits (each evaluation is computed whole by one thread, whichever).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Schedule {
+    /// One thread per evaluation, in batch order. A warp's 32 threads run
+    /// until its longest evaluation ends (an end rule stops others early).
+    #[default]
+    Static,
+    /// As many threads as the GPU holds at once, each taking the next
+    /// evaluation from a shared counter when its last one ends, so that a
+    /// warp's threads keep evaluating while any evaluation is left.
+    Queue,
 }
 
 impl std::fmt::Debug for Device {
@@ -106,18 +123,31 @@ impl Device {
         let evaluate = module
             .load_function("animats_evaluate_kernel")
             .map_err(|e| format!("the evaluation's entry: {e}"))?;
+        let sms = ctx
+            .attribute(
+                cudarc::driver::sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT,
+            )
+            .map_or(1, |n| n.max(1) as u32);
         Ok(Device {
             stream: ctx.default_stream(),
             function,
             evaluate,
             name,
             arch,
+            sms,
+            schedule: Schedule::default(),
         })
     }
 
     /// The device's name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// How [`Device::evaluate`] shares a batch's evaluations among the
+    /// GPU's threads ([`Schedule::Static`] unless set).
+    pub fn set_schedule(&mut self, schedule: Schedule) {
+        self.schedule = schedule;
     }
 
     /// Steps every creature of `batch` `steps` times on the GPU (one
@@ -155,11 +185,33 @@ impl Device {
         let (on_device, raw) = upload(s, batch)?;
         let creatures = batch.creatures() as i64;
         let local = batch.layout().flag();
+        // The shared counter of the queue (zero: the first evaluation).
+        let next = s
+            .alloc_zeros::<u64>(1)
+            .map_err(err("the queue's counter"))?;
+        let (queue, threads) = match self.schedule {
+            Schedule::Static => (0i32, creatures),
+            Schedule::Queue => {
+                let per_sm = self
+                    .evaluate
+                    .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
+                    .map_err(err("the evaluation's occupancy"))?
+                    .max(1);
+                let resident = i64::from(self.sms) * i64::from(per_sm) * i64::from(BLOCK);
+                (1i32, creatures.min(resident))
+            }
+        };
         let mut launch = s.launch_builder(&self.evaluate);
-        launch.arg(&raw).arg(&creatures).arg(&local);
+        launch
+            .arg(&raw)
+            .arg(&creatures)
+            .arg(&local)
+            .arg(&next)
+            .arg(&queue);
         // SAFETY: as in `run`; the kernel takes an_batch by value, one
-        // long long and an int.
-        unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the evaluation"))?;
+        // long long, an int, the counter's device pointer and an int; with
+        // the queue, threads take evaluations below `creatures` only.
+        unsafe { launch.launch(config(threads)?) }.map_err(err("launching the evaluation"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
@@ -228,9 +280,12 @@ fn upload(s: &Arc<CudaStream>, batch: &Batch) -> Result<(Vec<OnDevice>, DeviceBa
     Ok((on_device, raw))
 }
 
-/// One thread per creature, in blocks of 128.
+/// Threads in a block.
+const BLOCK: u32 = 128;
+
+/// One thread per creature, in blocks of [`BLOCK`].
 fn config(creatures: i64) -> Result<LaunchConfig, String> {
-    let threads = 128u32;
+    let threads = BLOCK;
     let blocks = (creatures.max(0) as u64).div_ceil(threads as u64).max(1);
     Ok(LaunchConfig {
         grid_dim: (

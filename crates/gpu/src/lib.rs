@@ -41,6 +41,6 @@ mod pack;
 pub mod ported;
 mod scenes;
 
-pub use cuda::Device;
+pub use cuda::{Device, Schedule};
 pub use pack::{Batch, Layout};
 pub use scenes::{c_batches, c_runs};

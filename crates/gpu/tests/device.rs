@@ -3,7 +3,7 @@
 //! elsewhere (CI has none) the test says what is missing and passes.
 
 use animats_engine::{FluidMedium, IntegratorKind, World};
-use animats_gpu::{Batch, Device};
+use animats_gpu::{Batch, Device, Layout, Schedule};
 
 use animats_creatures::random::Random;
 use animats_gpu::bodies::random_body;
@@ -40,18 +40,22 @@ fn the_gpu_steps_every_creature_as_the_cpu_does_or_says_what_is_missing() {
             .collect();
         let refs: Vec<&World> = worlds.iter().collect();
         let mut cpu = Batch::pack(&refs, 1e-3).unwrap();
-        let mut gpu = cpu.clone();
+        let packed = cpu.clone();
         cpu.run_cpu(1000);
-        device.run(&mut gpu, 1000).unwrap();
-        for (c, w) in worlds.iter().enumerate() {
-            for i in 0..w.len() {
-                let (a, b) = (cpu.state(c, i).unwrap(), gpu.state(c, i).unwrap());
-                let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
-                assert!(
-                    bits(a.0) == bits(b.0) && bits(a.1) == bits(b.1),
-                    "{} ({kind:?}): creature {c}, particle {i}: CPU {a:?}, GPU {b:?}",
-                    device.name()
-                );
+        for layout in [Layout::Local, Layout::Batch] {
+            let mut gpu = packed.clone();
+            gpu.set_layout(layout);
+            device.run(&mut gpu, 1000).unwrap();
+            for (c, w) in worlds.iter().enumerate() {
+                for i in 0..w.len() {
+                    let (a, b) = (cpu.state(c, i).unwrap(), gpu.state(c, i).unwrap());
+                    let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
+                    assert!(
+                        bits(a.0) == bits(b.0) && bits(a.1) == bits(b.1),
+                        "{} ({kind:?}, {layout:?}): creature {c}, particle {i}: CPU {a:?}, GPU {b:?}",
+                        device.name()
+                    );
+                }
             }
         }
     }
@@ -84,17 +88,25 @@ fn the_gpu_evaluates_every_scene_as_the_cpu_does_or_says_what_is_missing() {
         .collect();
     let refs: Vec<&animats_scene::Scene> = scenes.iter().collect();
     let mut cpu = Batch::pack_scenes(&refs).unwrap();
-    let mut gpu = cpu.clone();
     let want = cpu.evaluate_cpu().unwrap();
-    let got = device.evaluate(&mut gpu).unwrap();
-    for (c, (a, b)) in want.iter().zip(&got).enumerate() {
-        let bits = |e: &animats_scene::evaluate::Evaluation| {
-            [e.fitness, e.distance, e.time].map(f64::to_bits)
-        };
-        assert!(
-            bits(a) == bits(b) && a.ended == b.ended,
-            "{}: walker {c}: CPU {a:?}, GPU {b:?}",
-            device.name()
-        );
+    // Every layout of the state and every schedule of the threads.
+    let mut device = device;
+    for layout in [Layout::Local, Layout::Batch] {
+        for schedule in [Schedule::Static, Schedule::Queue] {
+            let mut gpu = Batch::pack_scenes(&refs).unwrap();
+            gpu.set_layout(layout);
+            device.set_schedule(schedule);
+            let got = device.evaluate(&mut gpu).unwrap();
+            for (c, (a, b)) in want.iter().zip(&got).enumerate() {
+                let bits = |e: &animats_scene::evaluate::Evaluation| {
+                    [e.fitness, e.distance, e.time].map(f64::to_bits)
+                };
+                assert!(
+                    bits(a) == bits(b) && a.ended == b.ended,
+                    "{}, {layout:?}, {schedule:?}: walker {c}: CPU {a:?}, GPU {b:?}",
+                    device.name()
+                );
+            }
+        }
     }
 }
