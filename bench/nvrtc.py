@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+"""Compiles the GPU kernel (crates/gpu/kernel) with NVRTC as
+`animats_gpu::Device::open` does (the same headers in the same order, the
+same strict options) for a GPU architecture, with no GPU: NVRTC only needs
+its own libraries, which the PyPI package nvidia-cuda-nvrtc provides. Prints
+ptxas's registers, stack and spills for each entry; exit 1 if NVRTC refuses
+the kernel (its log printed), 2 if NVRTC cannot be found.
+
+    python3 -m venv target/venv-nvrtc
+    target/venv-nvrtc/bin/pip install nvidia-cuda-nvrtc
+    target/venv-nvrtc/bin/python bench/nvrtc.py [sm_90 ...]
+
+CI runs it, so that the kernel keeps compiling where the tests cannot run
+it (they compile the same C with the C compiler instead)."""
+
+import ctypes
+import glob
+import os
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+KERNEL = os.path.join(ROOT, "crates", "gpu", "kernel")
+# In the order of crates/gpu/src/cuda.rs's `source`.
+PARTS = ["libm.h", "trig.h", "exp.h", "step.h", "eval.h", "kernel.cu"]
+# As crates/gpu/src/cuda.rs's `options`, with ptxas's report.
+OPTIONS = ["--fmad=false", "--prec-div=true", "--prec-sqrt=true", "--ftz=false", "--ptxas-options=-v"]
+
+
+def nvrtc():
+    """NVRTC from the nvidia-cuda-nvrtc package (or $NVRTC_LIB)."""
+    folders = [os.environ["NVRTC_LIB"]] if os.environ.get("NVRTC_LIB") else []
+    try:
+        import nvidia  # the namespace package nvidia-cuda-nvrtc installs into
+
+        for base in nvidia.__path__:
+            folders += glob.glob(os.path.join(base, "*", "lib"))
+    except ImportError:
+        pass
+    for folder in folders:
+        libs = sorted(glob.glob(os.path.join(folder, "libnvrtc.so*")))
+        builtins = sorted(glob.glob(os.path.join(folder, "libnvrtc-builtins.so*")))
+        if libs and builtins:
+            # The builtins first: NVRTC loads them by name at compile time.
+            ctypes.CDLL(builtins[-1], mode=ctypes.RTLD_GLOBAL)
+            return ctypes.CDLL(libs[-1])
+    sys.exit("nvrtc.py: no NVRTC found: pip install nvidia-cuda-nvrtc (or set NVRTC_LIB to its folder)")
+
+
+def source():
+    text = []
+    for part in PARTS:
+        with open(os.path.join(KERNEL, part)) as f:
+            text.append("\n".join(l for l in f.read().split("\n") if not l.lstrip().startswith("#include")))
+    return "\n".join(text)
+
+
+def compile_for(lib, arch, src):
+    prog = ctypes.c_void_p()
+    if lib.nvrtcCreateProgram(ctypes.byref(prog), src.encode(), b"kernel.cu", 0, None, None) != 0:
+        return False, "nvrtcCreateProgram failed"
+    opts = [f"--gpu-architecture={arch}"] + OPTIONS
+    arr = (ctypes.c_char_p * len(opts))(*[o.encode() for o in opts])
+    result = lib.nvrtcCompileProgram(prog, len(opts), arr)
+    size = ctypes.c_size_t()
+    lib.nvrtcGetProgramLogSize(prog, ctypes.byref(size))
+    log = ctypes.create_string_buffer(size.value)
+    lib.nvrtcGetProgramLog(prog, log)
+    cubin = ctypes.c_size_t()
+    lib.nvrtcGetCUBINSize(prog, ctypes.byref(cubin))
+    lib.nvrtcDestroyProgram(ctypes.byref(prog))
+    return result == 0 and cubin.value > 0, log.value.decode(errors="replace")
+
+
+def main():
+    lib = nvrtc()
+    major, minor = ctypes.c_int(), ctypes.c_int()
+    lib.nvrtcVersion(ctypes.byref(major), ctypes.byref(minor))
+    src = source()
+    failed = False
+    for arch in sys.argv[1:] or ["sm_90"]:
+        ok, log = compile_for(lib, arch, src)
+        print(f"NVRTC {major.value}.{minor.value}, {arch}: {'compiled' if ok else 'REFUSED'}")
+        for line in log.splitlines():
+            if not ok or "entry function" in line or "registers" in line or "stack frame" in line or "warning" in line:
+                print("  " + line.strip())
+        failed |= not ok
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
