@@ -100,15 +100,6 @@ fn main() {
         "C, every core:       {c_cpu:8.3} s  {:.3e} creature-steps/s",
         rate(c_cpu)
     );
-    let mut cpu_batch = packed.clone();
-    cpu_batch.set_layout(Layout::Batch);
-    let t = Instant::now();
-    cpu_batch.run_cpu(steps);
-    let c_batch = t.elapsed().as_secs_f64();
-    println!(
-        "C, state in the batch: {c_batch:6.3} s  {:.3e} creature-steps/s",
-        rate(c_batch)
-    );
     // Every creature's particles, the engine's, as bits.
     let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
     let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
@@ -131,8 +122,7 @@ fn main() {
             })
             .count()
     };
-    let bad =
-        differ(&cpu, &|c, i| engine_bits[c][i]) + differ(&cpu_batch, &|c, i| engine_bits[c][i]);
+    let bad = differ(&cpu, &|c, i| engine_bits[c][i]);
     println!("C on the CPU against the engine: {bad} of {creatures} creatures differ");
 
     let device = match Device::open() {
