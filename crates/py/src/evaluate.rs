@@ -147,6 +147,9 @@ pub(crate) fn outcomes(
                     Some(s) => problem.evaluate_screened(g, &s[i]),
                     None => problem.evaluate(g),
                 })
+                // (The first genome's failure, whichever thread failed first.)
+                .collect::<Vec<_>>()
+                .into_iter()
                 .collect::<Result<Vec<_>, _>>()
         })
     })

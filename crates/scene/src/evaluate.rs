@@ -637,6 +637,10 @@ pub fn score_all(
             }
             Ok((spec, scenes))
         })
+        // (Collected first, so that of several failures the first genome's
+        // is reported, whichever thread failed first.)
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect::<Result<Vec<_>, String>>()?;
     let (mut specs, mut coarse, mut trial) = (Vec::new(), Vec::new(), Vec::new());
     for (g, (spec, scenes)) in built.into_iter().enumerate() {
@@ -666,6 +670,8 @@ pub fn score_all(
             s.dt *= 0.5;
             Ok(s)
         })
+        .collect::<Vec<_>>()
+        .into_iter()
         .collect::<Result<Vec<_>, String>>()?;
     for (i, e) in at.into_iter().zip(run_checked(run, finer)?) {
         let full = std::mem::replace(&mut runs[i], e.clone());

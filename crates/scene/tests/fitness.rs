@@ -181,3 +181,34 @@ fn bad_fitness_keys_are_named() {
     );
     bad("energy_weight = nan", "evolve.energy_weight");
 }
+
+#[test]
+fn of_several_genomes_that_fail_to_build_the_first_is_reported() {
+    // Genome 1 fails slowly, genome 6 at once: on two threads genome 6's
+    // failure comes first in time, but the report names genome 1, as one
+    // thread would.
+    use animats_scene::evaluate::{engine_runs, score_all, Make};
+    let text = muscle("");
+    let builds: Vec<Box<Make<'_>>> = (0..8)
+        .map(|g| -> Box<Make<'_>> {
+            let text = text.clone();
+            Box::new(move || match g {
+                1 => {
+                    std::thread::sleep(std::time::Duration::from_millis(200));
+                    Err("genome 1 cannot be built".to_string())
+                }
+                6 => Err("genome 6 cannot be built".to_string()),
+                _ => animats_scene::parse(&text, "f.toml").map_err(|e| e.to_string()),
+            })
+        })
+        .collect();
+    let makes: Vec<&Make<'_>> = builds.iter().map(|b| b.as_ref()).collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    for _ in 0..3 {
+        let got = pool.install(|| score_all(&makes, &|_, _| true, &engine_runs));
+        assert_eq!(got.unwrap_err(), "genome 1 cannot be built");
+    }
+}

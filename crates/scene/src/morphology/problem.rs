@@ -229,6 +229,9 @@ impl MorphologyProblem {
                 let text = self.develop(g, "")?;
                 SceneProblem::parse(&text, &self.file).map_err(|e| e.to_string())
             })
+            // (The first genome's failure, whichever thread failed first.)
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect::<Result<Vec<_>, String>>()?;
         let makes: Vec<_> = problems
             .iter()
