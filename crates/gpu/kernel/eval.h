@@ -752,12 +752,9 @@ AN_FN void an_evaluate_creature(const an_batch *b, an_state st, long long c) {
 
 /* Creature c evaluated, its state held as an_step_in holds it. */
 AN_FN void an_evaluate_in(const an_batch *b, long long c, int local) {
-    double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    an_local_store m;
     int fits = 0;
-    an_state st = local ? an_local(b, c, x, v, sc, &fits) : an_batch_state(b, c);
-    if (local && !fits) {
-        st = an_batch_state(b, c);
-    }
+    an_state st = local ? an_local(b, c, &m, &fits) : an_batch_state(b, c);
     an_evaluate_creature(b, st, c);
     if (fits) {
         an_local_done(b, c, st);

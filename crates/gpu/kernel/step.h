@@ -167,16 +167,21 @@ typedef struct {
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
- * a particle) and the step's scratch (15 a particle); in the batch's arrays
- * (an_batch_state) or in arrays of the thread's own (an_local). */
+ * a particle) and the step's scratch (15 a particle), and its springs'
+ * constants read every step (ends, stiffness, damping; spring 0 the
+ * creature's first); in the batch's arrays (an_batch_state) or in arrays
+ * of the thread's own (an_local). */
 typedef struct {
     double *x, *v, *sc;
+    const int *sa, *sb;
+    const double *k, *d;
 } an_state;
 
 /* Creature c's state in the batch's arrays. */
 AN_FN an_state an_batch_state(const an_batch *b, long long c) {
-    long long p0 = b->first_particle[c];
-    an_state st = {b->pos + 3 * p0, b->vel + 3 * p0, b->scratch + 15 * p0};
+    long long p0 = b->first_particle[c], s0 = b->first_spring[c];
+    an_state st = {b->pos + 3 * p0,  b->vel + 3 * p0,  b->scratch + 15 * p0, b->spring_a + s0,
+                   b->spring_b + s0, b->stiffness + s0, b->damping + s0};
     return st;
 }
 
@@ -379,8 +384,9 @@ AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, con
  * joints, torque joints, constant forces, fluids, soft contact (a user
  * force of the body stage), the floor's contact force. h: the step
  * of the trial. */
-AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, long long s0,
-                     long long ns, const double *x, const double *v, double *f, double h) {
+AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, long long n,
+                     long long s0, long long ns, const double *x, const double *v, double *f,
+                     double h) {
     for (long long i = 0; i < n; i++) {
         if (b->gravity) {
             double m = b->mass[p0 + i];
@@ -394,7 +400,7 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
         }
     }
     for (long long s = s0; s < s0 + ns; s++) {
-        long long a = b->spring_a[s], e = b->spring_b[s];
+        long long a = st.sa[s - s0], e = st.sb[s - s0];
         double dx = x[3 * e] - x[3 * a];
         double dy = x[3 * e + 1] - x[3 * a + 1];
         double dz = x[3 * e + 2] - x[3 * a + 2];
@@ -404,8 +410,8 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
         double wx = v[3 * e] - v[3 * a];
         double wy = v[3 * e + 1] - v[3 * a + 1];
         double wz = v[3 * e + 2] - v[3 * a + 2];
-        double t = b->stiffness[s] * (len - b->rest_length[s])
-                 + b->damping[s] * ((wx * nx + wy * ny) + wz * nz);
+        double t = st.k[s - s0] * (len - b->rest_length[s])
+                 + st.d[s - s0] * ((wx * nx + wy * ny) + wz * nz);
         double fx = nx * t, fy = ny * t, fz = nz * t;
         f[3 * a] += fx;
         f[3 * a + 1] += fy;
@@ -436,14 +442,14 @@ AN_FN void an_forces(const an_batch *b, long long c, long long p0, long long n, 
 
 /* One integrator step of size h from (x0, v0) into (x1, v1)
  * (the files of integrators/); f, dx, dv: scratch. */
-AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long n, long long s0,
-                        long long ns, double h, const double *x0, const double *v0, double *x1,
-                        double *v1, double *f, double *dx, double *dv) {
+AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p0, long long n,
+                        long long s0, long long ns, double h, const double *x0, const double *v0,
+                        double *x1, double *v1, double *f, double *dx, double *dv) {
     long long m3 = 3 * n;
     const double *w = b->inv_mass + p0;
     switch (b->integrator) {
     case AN_EULER:
-        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
         for (long long k = 0; k < m3; k++) {
             x1[k] = x0[k] + h * v0[k];
             v1[k] = v0[k] + (h * w[k / 3]) * f[k];
@@ -451,12 +457,12 @@ AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long 
         break;
     case AN_MIDPOINT: {
         double half = 0.5 * h;
-        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
         for (long long k = 0; k < m3; k++) {
             x1[k] = x0[k] + half * v0[k];
             v1[k] = v0[k] + (half * w[k / 3]) * f[k];
         }
-        an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
         for (long long k = 0; k < m3; k++) {
             double vm = v1[k];
             x1[k] = x0[k] + h * vm;
@@ -466,7 +472,7 @@ AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long 
     }
     case AN_RK4: {
         double half = 0.5 * h;
-        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
         for (long long k = 0; k < m3; k++) {
             double a = f[k] * w[k / 3];
             dx[k] = v0[k];
@@ -476,7 +482,7 @@ AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long 
         }
         for (int stage = 0; stage < 2; stage++) {
             double to = stage == 0 ? half : h;
-            an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+            an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
             for (long long k = 0; k < m3; k++) {
                 double a = f[k] * w[k / 3];
                 double vi = v1[k];
@@ -486,7 +492,7 @@ AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long 
                 v1[k] = v0[k] + a * to;
             }
         }
-        an_forces(b, c, p0, n, s0, ns, x1, v1, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
         double sixth = h / 6.0;
         for (long long k = 0; k < m3; k++) {
             double a = f[k] * w[k / 3];
@@ -498,7 +504,7 @@ AN_FN void an_integrate(const an_batch *b, long long c, long long p0, long long 
         break;
     }
     default: /* AN_SYMPLECTIC */
-        an_forces(b, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
         for (long long k = 0; k < m3; k++) {
             double vk = v0[k] + f[k] * (h * w[k / 3]);
             v1[k] = vk;
@@ -590,7 +596,7 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     long long done = 0, piece = total;
     while (done < total) {
         double h = piece == total ? dt : dt * ((double)piece / (double)total);
-        an_integrate(b, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
+        an_integrate(b, st, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
         int state = b->floor ? an_floor_check(b, p0, n, x1) : AN_NONE;
         if (state == AN_MISSED) {
             if (piece == total) {
@@ -639,34 +645,50 @@ AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long lo
     }
 }
 
-/* The most particles a creature may have for one thread to hold its state
- * (positions, velocities and the step's scratch: 21 doubles a particle,
- * 5.25 KiB) in arrays of its own. On a GPU these live in the thread's
+/* The most particles, and springs, a creature may have for one thread to
+ * hold its state (positions, velocities and the step's scratch: 21 doubles
+ * a particle; each spring's ends, stiffness and damping) in arrays of its
+ * own, an_local_store (8.25 KiB). On a GPU these live in the thread's
  * local memory, which the hardware interleaves thread by thread: a warp's
- * 32 creatures read and write their k-th coordinate in one transaction,
- * where in the batch's arrays (each creature's run contiguous) a warp
- * touches 32 scattered places. */
+ * 32 creatures read and write their k-th coordinate (or spring) in one
+ * transaction, where in the batch's arrays (each creature's run
+ * contiguous) a warp touches 32 scattered places. (A spring's rest length,
+ * which muscles move, stays in the batch's arrays.) */
 #define AN_LOCAL 32
+#define AN_LOCAL_SPRINGS 128
 
-/* Copies creature c's positions and velocities into x and v (3 AN_LOCAL
- * doubles each) and returns the state held there, with sc (15 AN_LOCAL
- * doubles) as its scratch; sets *fits to 0, and copies nothing, where the
- * creature has more than AN_LOCAL particles. */
-AN_FN an_state an_local(const an_batch *b, long long c, double *x, double *v, double *sc,
-                        int *fits) {
+typedef struct {
+    double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    int sa[AN_LOCAL_SPRINGS], sb[AN_LOCAL_SPRINGS];
+    double k[AN_LOCAL_SPRINGS], d[AN_LOCAL_SPRINGS];
+} an_local_store;
+
+/* Creature c's state: copied into m and held there where the creature has
+ * at most AN_LOCAL particles and AN_LOCAL_SPRINGS springs (*fits 1), else
+ * in the batch's arrays (*fits 0, nothing copied). */
+AN_FN an_state an_local(const an_batch *b, long long c, an_local_store *m, int *fits) {
     long long p0 = b->first_particle[c], m3 = 3 * (b->first_particle[c + 1] - p0);
-    an_state st = {x, v, sc};
-    *fits = m3 <= 3 * AN_LOCAL;
-    if (*fits) {
-        for (long long k = 0; k < m3; k++) {
-            x[k] = b->pos[3 * p0 + k];
-            v[k] = b->vel[3 * p0 + k];
-        }
+    long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
+    *fits = m3 <= 3 * AN_LOCAL && ns <= AN_LOCAL_SPRINGS;
+    if (!*fits) {
+        return an_batch_state(b, c);
     }
+    for (long long k = 0; k < m3; k++) {
+        m->x[k] = b->pos[3 * p0 + k];
+        m->v[k] = b->vel[3 * p0 + k];
+    }
+    for (long long s = 0; s < ns; s++) {
+        m->sa[s] = b->spring_a[s0 + s];
+        m->sb[s] = b->spring_b[s0 + s];
+        m->k[s] = b->stiffness[s0 + s];
+        m->d[s] = b->damping[s0 + s];
+    }
+    an_state st = {m->x, m->v, m->sc, m->sa, m->sb, m->k, m->d};
     return st;
 }
 
-/* The state held by an_local copied back into the batch's arrays. */
+/* The positions and velocities held by an_local copied back into the
+ * batch's arrays (the springs' constants were only read). */
 AN_FN void an_local_done(const an_batch *b, long long c, an_state st) {
     long long p0 = b->first_particle[c], m3 = 3 * (b->first_particle[c + 1] - p0);
     for (long long k = 0; k < m3; k++) {
@@ -679,12 +701,9 @@ AN_FN void an_local_done(const an_batch *b, long long c, an_state st) {
  * (local 0) or, where it fits, in the thread's own (local 1): the same
  * operations on the same numbers either way, so the same bits. */
 AN_FN void an_step_in(const an_batch *b, long long c, long long steps, int local) {
-    double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    an_local_store m;
     int fits = 0;
-    an_state st = local ? an_local(b, c, x, v, sc, &fits) : an_batch_state(b, c);
-    if (local && !fits) {
-        st = an_batch_state(b, c);
-    }
+    an_state st = local ? an_local(b, c, &m, &fits) : an_batch_state(b, c);
     an_step_creature(b, st, c, steps);
     if (fits) {
         an_local_done(b, c, st);

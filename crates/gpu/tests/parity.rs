@@ -103,6 +103,36 @@ fn a_hanging_chain_is_the_engine_s_to_the_bit_under_every_integrator() {
 }
 
 #[test]
+fn a_body_with_more_springs_than_a_thread_holds_is_the_engine_s_to_the_bit() {
+    // 20 particles, every pair joined: 190 springs, more than the 128 a
+    // thread holds in arrays of its own (it works in the batch's), beside
+    // the same body with 120 of them (held).
+    let body = |springs: usize| {
+        let mut w = World::new();
+        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+        w.set_integrator(IntegratorKind::Rk4);
+        let ids: Vec<_> = (0..20)
+            .map(|i| {
+                let at = DVec3::new(
+                    0.1 * (i % 5) as f64,
+                    1.0 + 0.1 * (i / 5) as f64,
+                    0.01 * i as f64,
+                );
+                w.add_particle(ParticleDef::new(0.1).at(at)).unwrap()
+            })
+            .collect();
+        let pairs = (0..20).flat_map(|i| (i + 1..20).map(move |j| (i, j)));
+        for (i, j) in pairs.take(springs) {
+            w.add_spring(SpringDef::new(ids[i], ids[j], 50.0, 0.1))
+                .unwrap();
+        }
+        w.add_floor(FloorDef::default()).unwrap();
+        w
+    };
+    assert_same(&mut [body(190), body(120)], 1e-3, 300, 2, "dense bodies");
+}
+
+#[test]
 fn batches_of_random_bodies_of_mixed_sizes_are_the_engine_s_to_the_bit() {
     let mut rng = Random::for_entry(42, 0);
     for kind in INTEGRATORS {
