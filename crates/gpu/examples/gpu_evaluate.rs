@@ -86,11 +86,13 @@ fn main() {
     let scenes = build();
     let built = t.elapsed().as_secs_f64();
     let refs: Vec<&Scene> = scenes.iter().collect();
+    let t = Instant::now();
     let packed = Batch::pack_scenes(&refs).unwrap_or_else(|e| fail(e));
+    let pack = t.elapsed().as_secs_f64();
     let particles: usize = scenes.iter().map(|s| s.world.len()).sum();
     let dt = scenes[0].dt;
     println!(
-        "{count} {kind} evaluations of {seconds} s ({particles} particles, steps of {dt} s), {} CPU threads; scenes built in {built:.2} s",
+        "{count} {kind} evaluations of {seconds} s ({particles} particles, steps of {dt} s), {} CPU threads; scenes built in {built:.2} s, packed in {pack:.2} s",
         rayon::current_num_threads()
     );
 
