@@ -67,6 +67,8 @@ impl FluidMedium {
 }
 
 impl FluidMedium {
+    /// The fluid's force on each particle it surrounds, added into
+    /// `forces` in particle order; `still` as for `force_on`.
     #[inline(always)]
     fn apply_all(&self, ctx: &ForceContext, forces: &mut [DVec3], drag: f64, still: bool) {
         match &self.targets {
