@@ -167,21 +167,25 @@ typedef struct {
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
- * a particle) and the step's scratch (15 a particle), and its springs'
- * constants read every step (ends, stiffness, damping; spring 0 the
- * creature's first); in the batch's arrays (an_batch_state) or in arrays
+ * a particle) and the step's scratch (15 a particle), and the constants
+ * read every step: its springs' ends, stiffness and damping (spring 0 the
+ * creature's first), its particles' inverse masses, masses and radii
+ * (particle 0 the creature's first); in the batch's arrays (an_batch_state) or in arrays
  * of the thread's own (an_local). */
 typedef struct {
     double *x, *v, *sc;
     const int *sa, *sb;
     const double *k, *d;
+    const double *w, *m, *r; /* the particles' inverse masses, masses and radii */
 } an_state;
 
 /* Creature c's state in the batch's arrays. */
 AN_FN an_state an_batch_state(const an_batch *b, long long c) {
     long long p0 = b->first_particle[c], s0 = b->first_spring[c];
-    an_state st = {b->pos + 3 * p0,  b->vel + 3 * p0,  b->scratch + 15 * p0, b->spring_a + s0,
-                   b->spring_b + s0, b->stiffness + s0, b->damping + s0};
+    an_state st = {b->pos + 3 * p0,     b->vel + 3 * p0,  b->scratch + 15 * p0,
+                   b->spring_a + s0,    b->spring_b + s0, b->stiffness + s0,
+                   b->damping + s0,     b->inv_mass + p0, b->mass + p0,
+                   b->radius + p0};
     return st;
 }
 
@@ -275,8 +279,8 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
 
 /* Still fluids q0 .. q0 + nq - 1 on every particle of the creature
  * (forces/fluid.rs, `force_on`): quadratic drag and buoyancy. */
-AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0, long long nq,
-                     const double *v, double *f) {
+AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, long long q0,
+                     long long nq, const double *v, double *f) {
     double g[3] = {b->gx, b->gy, b->gz};
     if (!b->gravity) {
         g[0] = 0.0;
@@ -286,7 +290,7 @@ AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0,
     for (long long q = q0; q < q0 + nq; q++) {
         double drag = b->fluid_drag[q], density = b->fluid_density[q];
         for (long long i = 0; i < n; i++) {
-            double r = b->radius[p0 + i];
+            double r = st.r[i];
             const double *vr = v + 3 * i;
             double speed = sqrt(an_dot(vr, vr));
             double s = drag * r * r * speed;
@@ -302,7 +306,7 @@ AN_FN void an_fluids(const an_batch *b, long long p0, long long n, long long q0,
  * (forces/soft_contact.rs, `pair`): F = k overlap - c u_n along the line of
  * centres, never pulling; the engine's sweep tests only pairs whose boxes
  * overlap, with the same forces as testing all, as here. */
-AN_FN void an_soft_contact(const an_batch *b, long long p0, long long q0, long long nq,
+AN_FN void an_soft_contact(const an_batch *b, an_state st, long long q0, long long nq,
                            const double *x, const double *v, double *f) {
     for (long long q = q0; q < q0 + nq; q++) {
         long long a = b->pair_a[q], e = b->pair_b[q];
@@ -311,7 +315,7 @@ AN_FN void an_soft_contact(const an_batch *b, long long p0, long long q0, long l
             d[k] = x[3 * e + k] - x[3 * a + k];
         }
         double dist = sqrt(an_dot(d, d));
-        double overlap = b->radius[p0 + a] + b->radius[p0 + e] - dist;
+        double overlap = st.r[a] + st.r[e] - dist;
         if (overlap <= 0.0 || dist <= 0.0) {
             continue;
         }
@@ -333,9 +337,9 @@ AN_FN void an_soft_contact(const an_batch *b, long long p0, long long q0, long l
 /* The flat floor's contact force on particle i (forces/floor_contact.rs,
  * `contact` and `friction`): a sphere resting on the plane and pressed
  * into it is held up, and rubs. h is the trial's step. */
-AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, const double *v,
-                            double *f, double h) {
-    if (b->inv_mass[p] == 0.0 || x[1] - b->radius[p] > b->contact_tolerance) {
+AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long long p,
+                            const double *x, const double *v, double *f, double h) {
+    if (st.w[i] == 0.0 || x[1] - st.r[i] > b->contact_tolerance) {
         return;
     }
     if (v[1] > 0.0 || v[1] < -b->rest_speed || f[1] >= 0.0) {
@@ -344,7 +348,7 @@ AN_FN void an_floor_contact(const an_batch *b, long long p, const double *x, con
     double normal = -f[1];
     f[1] = 0.0;
     double vt[3] = {v[0], 0.0, v[2]}, ft[3] = {f[0], 0.0, f[2]}, fr[3];
-    double m = b->mass[p];
+    double m = st.m[i];
     double speed = sqrt(an_dot(vt, vt));
     if (speed < b->static_speed) {
         double hold[3];
@@ -389,7 +393,7 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
                      double h) {
     for (long long i = 0; i < n; i++) {
         if (b->gravity) {
-            double m = b->mass[p0 + i];
+            double m = st.m[i];
             f[3 * i] = m * b->gx;
             f[3 * i + 1] = m * b->gy;
             f[3 * i + 2] = m * b->gz;
@@ -430,12 +434,12 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
         }
     }
     long long q0 = b->first_fluid[c];
-    an_fluids(b, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
+    an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
     long long c0 = b->first_pair[c];
-    an_soft_contact(b, p0, c0, b->first_pair[c + 1] - c0, x, v, f);
+    an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
     if (b->floor && b->floor_contact) {
         for (long long i = 0; i < n; i++) {
-            an_floor_contact(b, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);
+            an_floor_contact(b, st, i, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);
         }
     }
 }
@@ -446,7 +450,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
                         long long s0, long long ns, double h, const double *x0, const double *v0,
                         double *x1, double *v1, double *f, double *dx, double *dv) {
     long long m3 = 3 * n;
-    const double *w = b->inv_mass + p0;
+    const double *w = st.w;
     switch (b->integrator) {
     case AN_EULER:
         an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
@@ -518,12 +522,12 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
 enum { AN_NONE = 0, AN_OCCURRING = 1, AN_MISSED = 2 };
 
 /* The flat floor's check of a trial: the deepest sphere below the plane. */
-AN_FN int an_floor_check(const an_batch *b, long long p0, long long n, const double *x1) {
+AN_FN int an_floor_check(const an_batch *b, an_state st, long long n, const double *x1) {
     double deepest = 0.0;
     int any = 0;
     for (long long i = 0; i < n; i++) {
-        double gap = x1[3 * i + 1] - b->radius[p0 + i];
-        if (gap < 0.0 && b->inv_mass[p0 + i] != 0.0) {
+        double gap = x1[3 * i + 1] - st.r[i];
+        if (gap < 0.0 && st.w[i] != 0.0) {
             any = 1;
             deepest = deepest < gap ? deepest : gap;
         }
@@ -537,13 +541,13 @@ AN_FN int an_floor_check(const an_batch *b, long long p0, long long n, const dou
 /* The flat floor's handling of a trial of step h (part of the step
  * `step`): each sphere below the plane moved up onto it and its impact
  * resolved (`resolve` and `normal_speed`). */
-AN_FN void an_floor_handle(const an_batch *b, long long p0, long long n, double h, double step,
-                           const double *v0, double *x1, double *v1) {
+AN_FN void an_floor_handle(const an_batch *b, an_state st, long long p0, long long n, double h,
+                           double step, const double *v0, double *x1, double *v1) {
     for (long long i = 0; i < n; i++) {
         long long p = p0 + i;
-        double r = b->radius[p];
+        double r = st.r[i];
         double gap = x1[3 * i + 1] - r;
-        if (!(gap < 0.0) || b->inv_mass[p] == 0.0) {
+        if (!(gap < 0.0) || st.w[i] == 0.0) {
             continue;
         }
         double accel = (v1[3 * i + 1] - v0[3 * i + 1]) / h;
@@ -597,7 +601,7 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     while (done < total) {
         double h = piece == total ? dt : dt * ((double)piece / (double)total);
         an_integrate(b, st, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
-        int state = b->floor ? an_floor_check(b, p0, n, x1) : AN_NONE;
+        int state = b->floor ? an_floor_check(b, st, n, x1) : AN_NONE;
         if (state == AN_MISSED) {
             if (piece == total) {
                 piece = total / 2; /* the step again, in pieces */
@@ -610,7 +614,7 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
             state = AN_OCCURRING; /* cannot split further */
         }
         if (state != AN_NONE) {
-            an_floor_handle(b, p0, n, h, dt, v, x1, v1);
+            an_floor_handle(b, st, p0, n, h, dt, v, x1, v1);
         }
         if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
             return 0;
@@ -646,9 +650,9 @@ AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long lo
 }
 
 /* The most particles, and springs, a creature may have for one thread to
- * hold its state (positions, velocities and the step's scratch: 21 doubles
- * a particle; each spring's ends, stiffness and damping) in arrays of its
- * own, an_local_store (8.25 KiB). On a GPU these live in the thread's
+ * hold its state (positions, velocities, the step's scratch, inverse mass,
+ * mass and radius: 24 doubles a particle; each spring's ends, stiffness
+ * and damping) in arrays of its own, an_local_store (9 KiB). On a GPU these live in the thread's
  * local memory, which the hardware interleaves thread by thread: a warp's
  * 32 creatures read and write their k-th coordinate (or spring) in one
  * transaction, where in the batch's arrays (each creature's run
@@ -659,6 +663,7 @@ AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long lo
 
 typedef struct {
     double x[3 * AN_LOCAL], v[3 * AN_LOCAL], sc[15 * AN_LOCAL];
+    double w[AN_LOCAL], m[AN_LOCAL], r[AN_LOCAL];
     int sa[AN_LOCAL_SPRINGS], sb[AN_LOCAL_SPRINGS];
     double k[AN_LOCAL_SPRINGS], d[AN_LOCAL_SPRINGS];
 } an_local_store;
@@ -677,13 +682,18 @@ AN_FN an_state an_local(const an_batch *b, long long c, an_local_store *m, int *
         m->x[k] = b->pos[3 * p0 + k];
         m->v[k] = b->vel[3 * p0 + k];
     }
+    for (long long i = 0; i < m3 / 3; i++) {
+        m->w[i] = b->inv_mass[p0 + i];
+        m->m[i] = b->mass[p0 + i];
+        m->r[i] = b->radius[p0 + i];
+    }
     for (long long s = 0; s < ns; s++) {
         m->sa[s] = b->spring_a[s0 + s];
         m->sb[s] = b->spring_b[s0 + s];
         m->k[s] = b->stiffness[s0 + s];
         m->d[s] = b->damping[s0 + s];
     }
-    an_state st = {m->x, m->v, m->sc, m->sa, m->sb, m->k, m->d};
+    an_state st = {m->x, m->v, m->sc, m->sa, m->sb, m->k, m->d, m->w, m->m, m->r};
     return st;
 }
 

@@ -135,16 +135,17 @@ extern "C" {
 }
 
 /// Where a thread keeps the state (positions, velocities, the step's
-/// scratch, the springs' constants) of the creature it steps or
-/// evaluates. Either gives the same bits: the same operations on the same
+/// scratch, the particles' and springs' constants) of the creature it
+/// steps or evaluates. Either gives the same bits: the same operations on the same
 /// numbers, only stored elsewhere.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Layout {
     /// In the batch's arrays, each creature's particles one contiguous run
     /// (on a GPU, a warp's 32 threads read 32 scattered places at once).
     Batch,
-    /// In arrays of the thread's own, with the springs' ends, stiffness
-    /// and damping, for creatures of at most 32 particles and 128 springs
+    /// In arrays of the thread's own, with the particles' inverse masses,
+    /// masses and radii and the springs' ends, stiffness and damping, for
+    /// creatures of at most 32 particles and 128 springs
     /// (on a GPU, its local memory, which the hardware interleaves thread
     /// by thread, so that a warp's reads of its creatures' k-th
     /// coordinates are one transaction); larger creatures as `Batch`.
