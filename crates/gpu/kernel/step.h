@@ -652,12 +652,12 @@ AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long lo
 /* The most particles, and springs, a creature may have for one thread to
  * hold its state (positions, velocities, the step's scratch, inverse mass,
  * mass and radius: 24 doubles a particle; each spring's ends, stiffness
- * and damping) in arrays of its own, an_local_store (9 KiB). On a GPU these live in the thread's
- * local memory, which the hardware interleaves thread by thread: a warp's
- * 32 creatures read and write their k-th coordinate (or spring) in one
- * transaction, where in the batch's arrays (each creature's run
- * contiguous) a warp touches 32 scattered places. (A spring's rest length,
- * which muscles move, stays in the batch's arrays.) */
+ * and damping) in arrays of its own, an_local_store (9 KiB). On a GPU
+ * these live in the thread's local memory, which the hardware interleaves
+ * thread by thread: a warp's 32 creatures read and write their k-th
+ * coordinate (or spring) in one transaction, where in the batch's arrays
+ * (each creature's run contiguous) a warp touches 32 scattered places. (A
+ * spring's rest length, which muscles move, stays in the batch's arrays.) */
 #define AN_LOCAL 32
 #define AN_LOCAL_SPRINGS 128
 
@@ -698,7 +698,7 @@ AN_FN an_state an_local(const an_batch *b, long long c, an_local_store *m, int *
 }
 
 /* The positions and velocities held by an_local copied back into the
- * batch's arrays (the springs' constants were only read). */
+ * batch's arrays (the constants were only read). */
 AN_FN void an_local_done(const an_batch *b, long long c, an_state st) {
     long long p0 = b->first_particle[c], m3 = 3 * (b->first_particle[c + 1] - p0);
     for (long long k = 0; k < m3; k++) {
