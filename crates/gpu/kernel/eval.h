@@ -129,9 +129,8 @@ AN_FN double an_angle_at(const double *a, const double *j, const double *b) {
 enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_ANGLE = 4, AN_S_TILT = 5 };
 
 /* ScaledSensor::level of sensor q (over the batch) of the creature whose
- * particles begin at p0: the probe's reading mapped from [min, max] onto
- * [0, 1]. */
-AN_FN double an_sensor(const an_batch *b, an_state st, long long p0, long long q) {
+ * state is st: the probe's reading mapped from [min, max] onto [0, 1]. */
+AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
     const int *ids = b->sensor_particle + 3 * q;
     const double *param = b->sensor_param + 5 * q;
     const double *x = st.x, *v = st.v;
@@ -145,7 +144,7 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long p0, long long q
         reading = an_dot(v + 3 * ids[0], param);
         break;
     case AN_S_TOUCH: /* TOUCH_TOLERANCE, on the flat floor */
-        reading = pa[1] - b->radius[p0 + ids[0]] <= 1e-3 ? 1.0 : 0.0;
+        reading = pa[1] - st.r[ids[0]] <= 1e-3 ? 1.0 : 0.0;
         break;
     case AN_S_LENGTH: /* glam's distance: (a - b).length() */
         for (int k = 0; k < 3; k++) {
@@ -343,9 +342,8 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
     if (k0 == k1 && !gated) {
         return;
     }
-    long long p0 = b->first_particle[c];
     for (long long q = b->first_sensor[c]; q < b->first_sensor[c + 1]; q++) {
-        b->sensor_level[q] = an_sensor(b, st, p0, q);
+        b->sensor_level[q] = an_sensor(b, st, q);
     }
     for (long long k = k0; k < k1; k++) {
         if (b->ctrl_kind[k] == 0) {
@@ -362,10 +360,9 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
 }
 
 /* scene::evaluate::centre_at: the centre of mass of particles ids[0 ..
- * nk - 1] of the creature whose particles begin at p0 (of one: its
- * position; of massless ones: their mean). */
-AN_FN void an_centre_of(const an_batch *b, an_state st, long long p0, const int *ids, long long nk,
-                        double *out) {
+ * nk - 1] of the creature whose state is st (of one: its position; of
+ * massless ones: their mean). */
+AN_FN void an_centre_of(an_state st, const int *ids, long long nk, double *out) {
     const double *x = st.x;
     if (nk == 1) {
         long long p = ids[0];
@@ -377,7 +374,7 @@ AN_FN void an_centre_of(const an_batch *b, an_state st, long long p0, const int 
     double sum[3] = {0.0, 0.0, 0.0}, m = 0.0;
     for (long long k = 0; k < nk; k++) {
         long long p = ids[k];
-        double mp = b->mass[p0 + p];
+        double mp = st.m[p];
         for (int d = 0; d < 3; d++) {
             sum[d] = sum[d] + x[3 * p + d] * mp;
         }
@@ -392,8 +389,7 @@ AN_FN void an_centre_of(const an_batch *b, an_state st, long long p0, const int 
 /* The centre of the particles of [evolve] that count. */
 AN_FN void an_centre(const an_batch *b, an_state st, long long c, double *out) {
     long long k0 = b->first_centre[c];
-    an_centre_of(b, st, b->first_particle[c], b->centre_particle + k0, b->first_centre[c + 1] - k0,
-                 out);
+    an_centre_of(st, b->centre_particle + k0, b->first_centre[c + 1] - k0, out);
 }
 
 /* Measures (scene/src/archive.rs, `Measure`), as packed. */
@@ -414,22 +410,21 @@ AN_FN const int *an_measure_ids(const an_batch *b, long long q, long long *nk) {
     return b->measure_id + k0;
 }
 
-/* Whether particle p (within the creature whose particles begin at p0)
- * touches the flat floor within `tolerance` (World::clearance). */
-AN_FN int an_on_floor(const an_batch *b, an_state st, long long p0, long long p, double tolerance) {
-    return st.x[3 * p + 1] - b->radius[p0 + p] <= tolerance;
+/* Whether particle p of the creature whose state is st touches the flat
+ * floor within `tolerance` (World::clearance). */
+AN_FN int an_on_floor(an_state st, long long p, double tolerance) {
+    return st.x[3 * p + 1] - st.r[p] <= tolerance;
 }
 
 /* Recorder::new: the centres that displacements and speeds start from. */
 AN_FN void an_measures_begin(const an_batch *b, an_state st, long long c) {
-    long long p0 = b->first_particle[c];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
         long long nk;
         const int *ids = an_measure_ids(b, q, &nk);
         b->measure_sum[q] = 0.0;
         int kind = b->measure_kind[q];
         if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
-            an_centre_of(b, st, p0, ids, nk, b->measure_start + 3 * q);
+            an_centre_of(st, ids, nk, b->measure_start + 3 * q);
         }
     }
 }
@@ -443,20 +438,20 @@ AN_FN void an_measures_step(const an_batch *b, an_state st, long long c) {
         const int *ids = an_measure_ids(b, q, &nk);
         int kind = b->measure_kind[q];
         if (kind == AN_M_CONTACT) {
-            if (an_on_floor(b, st, p0, ids[0], tolerance)) {
+            if (an_on_floor(st, ids[0], tolerance)) {
                 b->measure_sum[q] = b->measure_sum[q] + 1.0;
             }
         } else if (kind == AN_M_FEET) {
             long long count = 0;
             for (long long i = 0; i < n; i++) {
-                if (b->inv_mass[p0 + i] > 0.0 && an_on_floor(b, st, p0, i, tolerance)) {
+                if (st.w[i] > 0.0 && an_on_floor(st, i, tolerance)) {
                     count++;
                 }
             }
             b->measure_sum[q] = b->measure_sum[q] + (double)count;
         } else if (kind == AN_M_MEAN_HEIGHT) {
             double at[3];
-            an_centre_of(b, st, p0, ids, nk, at);
+            an_centre_of(st, ids, nk, at);
             b->measure_sum[q] = b->measure_sum[q] + at[1];
         }
     }
@@ -466,7 +461,6 @@ AN_FN void an_measures_step(const an_batch *b, an_state st, long long c) {
  * survived, into measure_sum. */
 AN_FN void an_measures_finish(const an_batch *b, an_state st, long long c, long long steps, double time,
                                double work) {
-    long long p0 = b->first_particle[c];
     for (long long q = b->first_measure[c]; q < b->first_measure[c + 1]; q++) {
         long long nk;
         const int *ids = an_measure_ids(b, q, &nk);
@@ -476,7 +470,7 @@ AN_FN void an_measures_finish(const an_batch *b, an_state st, long long c, long 
             value = steps == 0 ? 0.0 : b->measure_sum[q] / (double)steps;
         } else if (kind == AN_M_DISPLACEMENT || kind == AN_M_SPEED) {
             double at[3], moved[3];
-            an_centre_of(b, st, p0, ids, nk, at);
+            an_centre_of(st, ids, nk, at);
             for (int d = 0; d < 3; d++) {
                 moved[d] = at[d] - b->measure_start[3 * q + d];
             }
@@ -497,12 +491,11 @@ AN_FN void an_measures_finish(const an_batch *b, an_state st, long long c, long 
  * tolerance of the (flat) floor, else the first fail_on_stretch pair
  * stretched; AN_TIMEOUT where none holds. `which` gets the rule. */
 AN_FN int an_ending(const an_batch *b, an_state st, long long c, long long *which) {
-    long long p0 = b->first_particle[c];
     const double *x = st.x;
     double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long k = b->first_touch[c]; k < b->first_touch[c + 1]; k++) {
         long long p = b->touch_particle[k];
-        if (x[3 * p + 1] - b->radius[p0 + p] <= tolerance) {
+        if (x[3 * p + 1] - st.r[p] <= tolerance) {
             *which = k - b->first_touch[c];
             return AN_TOUCH;
         }
