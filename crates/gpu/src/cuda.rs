@@ -44,8 +44,10 @@ pub struct Device {
     evaluate: CudaFunction,
     name: String,
     arch: (i32, i32),
-    /// Streaming multiprocessors.
-    sms: u32,
+    /// Evaluation threads the GPU holds at once (its multiprocessors
+    /// times the blocks of the evaluation each holds, times [`BLOCK`]):
+    /// the threads of a [`Schedule::Queue`] launch.
+    resident: i64,
     schedule: Schedule,
 }
 
@@ -127,14 +129,19 @@ impl Device {
             .attribute(
                 cudarc::driver::sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT,
             )
-            .map_or(1, |n| n.max(1) as u32);
+            .map_or(1, |n| i64::from(n.max(1)));
+        let per_sm = evaluate
+            .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
+            .map_err(|e| format!("the evaluation's occupancy: {e}"))?
+            .max(1);
+        let resident = sms * i64::from(per_sm) * i64::from(BLOCK);
         Ok(Device {
             stream: ctx.default_stream(),
             function,
             evaluate,
             name,
             arch,
-            sms,
+            resident,
             schedule: Schedule::default(),
         })
     }
@@ -191,15 +198,7 @@ impl Device {
             .map_err(err("the queue's counter"))?;
         let (queue, threads) = match self.schedule {
             Schedule::Static => (0i32, creatures),
-            Schedule::Queue => {
-                let per_sm = self
-                    .evaluate
-                    .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
-                    .map_err(err("the evaluation's occupancy"))?
-                    .max(1);
-                let resident = i64::from(self.sms) * i64::from(per_sm) * i64::from(BLOCK);
-                (1i32, creatures.min(resident))
-            }
+            Schedule::Queue => (1i32, creatures.min(self.resident)),
         };
         let mut launch = s.launch_builder(&self.evaluate);
         launch
