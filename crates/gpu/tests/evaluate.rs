@@ -120,6 +120,25 @@ fn genomes(text: &str, n: usize, seed: u64) -> Vec<Scene> {
     scenes
 }
 
+/// How many different distances (as bits) the evaluations went: that the
+/// genomes matter.
+fn distinct_distances(got: &[Evaluation]) -> usize {
+    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
+    d.sort_unstable();
+    d.dedup();
+    d.len()
+}
+
+/// `genomes(text, n, seed)`, each perturbed as the engine's `k`-th trial
+/// would be (`text` has `[evolve] noise`).
+fn perturbed(text: &str, n: usize, seed: u64) -> Vec<Scene> {
+    let mut scenes = genomes(text, n, seed);
+    for (k, s) in scenes.iter_mut().enumerate() {
+        animats_scene::evaluate::perturb(s, k as u32).unwrap();
+    }
+    scenes
+}
+
 #[test]
 fn the_walker_s_evaluation_is_the_engine_s_to_the_bit_under_every_integrator() {
     for (k, integrator) in ["symplectic", "rk4", "midpoint", "euler"]
@@ -132,9 +151,7 @@ fn the_walker_s_evaluation_is_the_engine_s_to_the_bit_under_every_integrator() {
             &format!("walker, {integrator}"),
         );
         // They walk (or fall) different distances: the genomes matter.
-        let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-        d.dedup();
-        assert!(d.len() > 6, "{integrator}: {got:?}");
+        assert!(distinct_distances(&got) > 6, "{integrator}: {got:?}");
     }
 }
 
@@ -222,9 +239,7 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     }
     let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
     let got = assert_same(scenes, &format!("random bodies {sizes:?}"));
-    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-    d.dedup();
-    assert!(d.len() > 8, "{got:?}");
+    assert!(distinct_distances(&got) > 8, "{got:?}");
 }
 
 #[test]
@@ -305,10 +320,7 @@ clock = 2.0
     let text = format!("{}{sensors}\n{}", &WALKER[..start], &WALKER[end..])
         .replace("duration = 10.0", "duration = 2.0");
     let got = assert_same(genomes(&text, 12, 6), "neural walker");
-    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-    d.sort_unstable();
-    d.dedup();
-    assert!(d.len() > 6, "{got:?}");
+    assert!(distinct_distances(&got) > 6, "{got:?}");
     // Evolved bodies with neural brains: touch sensors on every particle
     // that can touch the floor, one output a muscle.
     let text = BODIES_WALK
@@ -332,15 +344,9 @@ fn ctrnn_brains_are_the_engine_s_to_the_bit() {
     // to step), its own and random genomes, and perturbed trials.
     let text = WALKER_CTRNN.replace("duration = 10.0", "duration = 2.0");
     let got = assert_same(genomes(&text, 12, 8), "CTRNN walker");
-    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-    d.sort_unstable();
-    d.dedup();
-    assert!(d.len() > 6, "{got:?}");
+    assert!(distinct_distances(&got) > 6, "{got:?}");
     let text = text.replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
-    let mut scenes = genomes(&text, 6, 9);
-    for (k, s) in scenes.iter_mut().enumerate() {
-        animats_scene::evaluate::perturb(s, k as u32).unwrap();
-    }
+    let scenes = perturbed(&text, 6, 9);
     assert_same(scenes, "perturbed CTRNN walkers");
 }
 
@@ -353,15 +359,9 @@ fn fsm_brains_are_the_engine_s_to_the_bit() {
         .replace("levels = [0.7]", "levels = [0.7]\nrate = 3.0")
         + "\n[evolve]\ncontroller = \"hop\"\nduration = 2.0\naxis = [0.0, 1.0, 0.0]\n";
     let got = assert_same(genomes(&pogo, 12, 10), "pogo");
-    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-    d.sort_unstable();
-    d.dedup();
-    assert!(d.len() > 6, "{got:?}");
+    assert!(distinct_distances(&got) > 6, "{got:?}");
     let noisy = pogo.replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
-    let mut scenes = genomes(&noisy, 6, 11);
-    for (k, s) in scenes.iter_mut().enumerate() {
-        animats_scene::evaluate::perturb(s, k as u32).unwrap();
-    }
+    let scenes = perturbed(&noisy, 6, 11);
     assert_same(scenes, "perturbed pogo");
 }
 
@@ -523,10 +523,7 @@ energy_weight = 0.2
 #[test]
 fn joint_torque_and_force_actuators_and_their_gates_are_the_engine_s_to_the_bit() {
     let got = assert_same(genomes(CRAWLER, 12, 15), "crawler");
-    let mut d: Vec<u64> = got.iter().map(|e| e.distance.to_bits()).collect();
-    d.sort_unstable();
-    d.dedup();
-    assert!(d.len() > 6, "{got:?}");
+    assert!(distinct_distances(&got) > 6, "{got:?}");
     assert!(
         got.iter().all(|e| e.energy.is_some_and(|j| j > 0.0)),
         "{got:?}"
@@ -535,10 +532,7 @@ fn joint_torque_and_force_actuators_and_their_gates_are_the_engine_s_to_the_bit(
     let text = CRAWLER
         .replace("integrator = \"symplectic\"", "integrator = \"rk4\"")
         .replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
-    let mut scenes = genomes(&text, 6, 16);
-    for (k, s) in scenes.iter_mut().enumerate() {
-        animats_scene::evaluate::perturb(s, k as u32).unwrap();
-    }
+    let scenes = perturbed(&text, 6, 16);
     assert_same(scenes, "perturbed crawlers, RK4");
 }
 
@@ -572,9 +566,8 @@ fn perturbed_trials_are_the_engine_s_to_the_bit() {
     // `[evolve] noise`: each trial's start moved and each muscle's level
     // offset (NervousSystem::offsets), as the engine's trials are.
     let text = walker(2.0, "symplectic", "").replace("[evolve]\n", "[evolve]\nnoise = 0.2\n");
-    let mut scenes = genomes(&text, 8, 5);
-    for (k, s) in scenes.iter_mut().enumerate() {
-        animats_scene::evaluate::perturb(s, k as u32).unwrap();
+    let scenes = perturbed(&text, 8, 5);
+    for s in &scenes {
         assert!(s.nervous.offsets.iter().any(|&o| o != 0.0));
     }
     assert_same(scenes, "perturbed walkers");
