@@ -62,6 +62,7 @@ pub use forces::{
     gravity::Gravity,
     linear_drag::LinearDrag,
     nbody::NBodyGravity,
+    rod_drag::RodDrag,
     soft_contact::SoftContact,
     spring::{Spring, SpringDef, SpringId},
     torque_joint::{TorqueJoint, TorqueJointDef, TorqueJointId},

@@ -240,6 +240,11 @@ pub fn build(def: &SceneDef, src: &Source) -> Result<Scene, SceneError> {
         terrain: None,
     };
     crate::entries::build_all(def, &mut cx)?;
+    if let Some(fluid) = &def.fluid {
+        fluid
+            .get_ref()
+            .add_rods(&at(src, "fluid", fluid), &mut cx)?;
+    }
     // `[terrain]` without `[floor]`: the floor's defaults, so shaped.
     if let (Some(terrain), Some(entry)) = (cx.terrain.take(), &def.terrain) {
         cx.world

@@ -9,6 +9,7 @@ pub mod fluid;
 pub mod gravity;
 pub mod linear_drag;
 pub mod nbody;
+pub mod rod_drag;
 pub mod soft_contact;
 pub mod spring;
 pub mod torque_joint;

@@ -17,6 +17,25 @@ pub struct FluidEntry {
     pub current: CurrentEntry,
     /// Default: all particles.
     pub particles: Option<Vec<String>>,
+    /// `springs = { diameter = 0.02 }`: every spring whose two ends are in
+    /// the fluid is also a thin rod the fluid pushes on across its length
+    /// (`RodDrag`, Sims's water); default none, the thesis's fluid.
+    pub springs: Option<RodsEntry>,
+}
+
+/// `[fluid] springs`: drag across the springs as rods.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RodsEntry {
+    /// m: every rod's diameter.
+    pub diameter: f64,
+    /// A cylinder across the flow's; default 1.2.
+    #[serde(default = "default_rod_drag")]
+    pub drag_coefficient: f64,
+}
+
+fn default_rod_drag() -> f64 {
+    1.2
 }
 
 fn default_density() -> f64 {
@@ -68,7 +87,49 @@ impl Build for FluidEntry {
             targets,
         };
         cx.world.add_fluid(fluid).map_err(|e| at.model(e))?;
+        if let Some(rods) = &f.springs {
+            at.positive("springs.diameter", rods.diameter)?;
+            at.finite("springs.drag_coefficient", rods.drag_coefficient)?;
+            if rods.drag_coefficient < 0.0 {
+                return Err(at.err(
+                    "springs.drag_coefficient",
+                    format!("must be >= 0, got {}", rods.drag_coefficient),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
 
+impl FluidEntry {
+    /// After every entry is built: the springs' rods, if the fluid has
+    /// them (the springs are not known when `[fluid]` is built).
+    pub(crate) fn add_rods(&self, at: &At, cx: &mut Builder) -> Result<(), SceneError> {
+        let Some(rods) = &self.springs else {
+            return Ok(());
+        };
+        let mut immersed = vec![false; cx.world.len()];
+        cx.names
+            .targets(at, &self.particles)?
+            .for_each(immersed.len(), |i| immersed[i] = true);
+        let current = current(at, &self.current, cx.gravity.length())?;
+        let ends: Vec<(ParticleId, ParticleId)> = cx
+            .world
+            .forces()
+            .springs
+            .iter()
+            .map(|s| s.ends())
+            .filter(|&(a, b)| immersed[a.index()] && immersed[b.index()])
+            .collect();
+        let force = animats_engine::RodDrag::new(
+            self.density,
+            rods.drag_coefficient,
+            rods.diameter,
+            current,
+            &ends,
+        )
+        .map_err(|e| at.model(e))?;
+        cx.world.add_force(Box::new(force));
         Ok(())
     }
 }
