@@ -105,7 +105,8 @@ pub struct Args {
     fps: f64,
     /// Camera: `auto` (the live view's framing, following the scene's
     /// `[evolve]` particles, `--follow NAME` or its one creature, in steps
-    /// of two floor squares so the floor stands still), `follow` (the same,
+    /// of two floor squares so the floor stands still; without a floor,
+    /// smoothly and up and down too), `follow` (the same,
     /// or the centre of all creatures when the scene follows nothing),
     /// `fixed` (the opening framing, still) or `EYE:TARGET` as
     /// `x,y,z:x,y,z`, metres.
@@ -342,8 +343,10 @@ struct Cameras {
     start: DVec3,
     period: f64,
     fov: f64,
-    /// Also follow up and down (in the same whole periods): hoppers.
+    /// Also follow upwards (in the same whole periods): hoppers.
     vertical: bool,
+    /// No floor (a swimmer): follow every way, smoothly.
+    floorless: bool,
 }
 
 impl Cameras {
@@ -376,6 +379,7 @@ impl Cameras {
             period: 2.0 * describe.drawing.floor.unwrap_or(0.5),
             fov: args.fov,
             vertical: false,
+            floorless: describe.drawing.floor.is_none(),
         }
     }
 
@@ -405,8 +409,14 @@ impl Cameras {
         let c = match &self.spec {
             CameraSpec::Auto | CameraSpec::Follow if self.follows => {
                 let moved = centre_of(&self.watched, &s.positions) - self.start;
-                let up = if self.vertical { moved.y.max(0.0) } else { 0.0 };
-                let shift = (DVec3::new(moved.x, up, moved.z) / self.period).round() * self.period;
+                // Without a floor (a swimmer) nothing needs to stand still:
+                // the camera moves with the creature, every way.
+                let shift = if self.floorless {
+                    moved
+                } else {
+                    let up = if self.vertical { moved.y.max(0.0) } else { 0.0 };
+                    (DVec3::new(moved.x, up, moved.z) / self.period).round() * self.period
+                };
                 Camera {
                     eye: base.eye + shift,
                     target: base.target + shift,
