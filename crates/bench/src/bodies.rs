@@ -1,5 +1,7 @@
 //! `bodies` (on request; issue 39): evolving bodies, for the land and the
-//! water task (`scenes/bodies_walk.toml`, `scenes/bodies_swim.toml`). A
+//! water tasks (`scenes/bodies_walk.toml`, `scenes/bodies_swim.toml`, and
+//! `scenes/bodies_swim_rods.toml`: the same bodies with drag across their
+//! springs, whose row against swim's is what that drag costs). A
 //! population of 16 checked random bodies (the body GA's first generation,
 //! seed 1):
 //!
@@ -28,6 +30,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     for (name, path) in [
         ("walk", "scenes/bodies_walk.toml"),
         ("swim", "scenes/bodies_swim.toml"),
+        ("swim-rods", "scenes/bodies_swim_rods.toml"),
     ] {
         let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
         rows.extend(task(name, path, &text, runs)?);
