@@ -117,6 +117,53 @@ fn writable(dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
+/// Prints the check a winner must pass before it is believed: the best
+/// (best.toml) at a quarter of the step with another integrator
+/// (`animats_scene::evaluate::check_finer`), and whether it keeps 80 % of
+/// its fitness. It changes nothing written.
+fn check_best(state: &State) -> Result<(), Failure> {
+    let (Some(text), Some(lane)) = (
+        state.best_toml().map_err(Failure::Other)?,
+        state.best_lane(),
+    ) else {
+        return Ok(());
+    };
+    let Some(best) = lane.best.as_ref().map(|b| b.fitness) else {
+        return Ok(());
+    };
+    let checked = animats_scene::parse(&text, "best.toml")
+        .map_err(|e| e.to_string())
+        .and_then(animats_scene::evaluate::check_finer);
+    let (kind, dt, e) = match checked {
+        Ok(c) => c,
+        Err(e) => {
+            say!("  check: the best at a quarter of the step could not be run: {e}");
+            return Ok(());
+        }
+    };
+    let kept = if best > 0.0 {
+        let share = e.fitness / best;
+        format!(
+            " ({:.1} % of {best}){}",
+            100.0 * share,
+            if share.is_nan() || share < 0.8 {
+                ": under 80 %, not to be believed yet (docs/BODIES.md, Honest evaluation)"
+            } else {
+                ""
+            }
+        )
+    } else {
+        String::new()
+    };
+    say!(
+        "  check: the best at a quarter of the step ({dt} s) with {}: fitness {}, distance {} m{kept}",
+        kind.name(),
+        e.fitness,
+        e.distance
+    );
+    Ok(())
+}
+
 /// Writes log.csv, best.toml and the checkpoint; at the end of a run (or
 /// of this part of it) fitness.png and each lane's best, lanes/K.toml, too.
 fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
@@ -640,6 +687,7 @@ pub fn run(args: Args) -> Result<(), Failure> {
             b.ended
         );
     }
+    check_best(&state)?;
     if let Some((by, kept)) = state.refusals() {
         let total: u64 = by.values().sum();
         let reasons: Vec<String> = by.iter().map(|(r, n)| format!("{r} {n}")).collect();

@@ -55,6 +55,38 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         logged.to_bits(),
         "{json} against {logged}"
     );
+    // The check printed at the end: the best at a quarter of the step
+    // with RK4 (the scene's integrator is symplectic Euler), once, as
+    // `evaluate` scores best.toml so changed.
+    let line = stdout
+        .lines()
+        .find(|l| l.contains("check: the best at a quarter of the step (0.00025 s) with rk4"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let printed: f64 = line
+        .split("fitness ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let finer = std::fs::read_to_string(&best)
+        .unwrap()
+        .replace("dt = 0.001\n", "dt = 0.00025\n")
+        .replace("integrator = \"symplectic\"", "integrator = \"rk4\"")
+        .replace("robust = true", "robust = false");
+    let finer = write(&dir, "finer.toml", &finer);
+    let e = animats(&["evaluate", &finer, "--json"]);
+    let (json, err) = text(&e);
+    assert!(e.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(
+        v["fitness"].as_f64().unwrap().to_bits(),
+        printed.to_bits(),
+        "{json} against {line}"
+    );
+    if logged > 0.0 {
+        assert!(line.contains(&format!("% of {logged})")), "{line}");
+    }
     // The zoo: the best bodies alive, best first; the first is the run's
     // best (the body GA keeps it).
     let zoo = dir.join("zoo.gif");

@@ -212,3 +212,38 @@ fn of_several_genomes_that_fail_to_build_the_first_is_reported() {
         assert_eq!(got.unwrap_err(), "genome 1 cannot be built");
     }
 }
+
+/// The check a winner must pass (`check_finer`): a quarter of the step
+/// with another integrator, scored as `evaluate` scores the scene written
+/// that way; implicit Euler is kept.
+#[test]
+fn the_finer_check_is_the_scene_at_a_quarter_step_with_another_integrator() {
+    use animats_engine::IntegratorKind;
+    use animats_scene::evaluate::check_finer;
+    // The muscle's scene is on RK4 at 1 ms: symplectic Euler at 0.25 ms.
+    let text = muscle("energy_weight = 2.0");
+    let (kind, dt, e) = check_finer(parse(&text)).unwrap();
+    assert_eq!((kind, dt), (IntegratorKind::Symplectic, 0.00025));
+    let written = text.replace(
+        "dt = 0.001\n",
+        "dt = 0.00025\nintegrator = \"symplectic\"\n",
+    );
+    let want = evaluate(parse(&written)).unwrap();
+    assert_eq!(e.fitness.to_bits(), want.fitness.to_bits());
+    // Not the scene's own run: its work is summed at other steps.
+    assert_ne!(
+        e.fitness.to_bits(),
+        evaluate(parse(&text)).unwrap().fitness.to_bits()
+    );
+    // Symplectic Euler goes to RK4, implicit Euler stays.
+    for (from, to) in [
+        ("symplectic", IntegratorKind::Rk4),
+        ("implicit", IntegratorKind::Implicit),
+    ] {
+        let t = text.replace(
+            "dt = 0.001\n",
+            &format!("dt = 0.001\nintegrator = \"{from}\"\n"),
+        );
+        assert_eq!(check_finer(parse(&t)).unwrap().0, to);
+    }
+}
