@@ -28,6 +28,15 @@ fn evolve(scene: &str, dir: &std::path::Path, extra: &[&str]) -> std::process::O
     animats(&args)
 }
 
+/// `animats evaluate FILE --json`'s fitness, and the JSON.
+fn evaluated(file: &str) -> (f64, String) {
+    let e = animats(&["evaluate", file, "--json"]);
+    let (json, err) = text(&e);
+    assert!(e.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    (v["fitness"].as_f64().unwrap(), json)
+}
+
 #[test]
 fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     let dir = scratch("bodies-small");
@@ -46,12 +55,9 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     let particles: usize = last[8].parse().unwrap();
     assert!((2..=10).contains(&particles));
     let best = out.join("best.toml");
-    let e = animats(&["evaluate", best.to_str().unwrap(), "--json"]);
-    let (json, err) = text(&e);
-    assert!(e.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let (fitness, json) = evaluated(best.to_str().unwrap());
     assert_eq!(
-        v["fitness"].as_f64().unwrap().to_bits(),
+        fitness.to_bits(),
         logged.to_bits(),
         "{json} against {logged}"
     );
@@ -74,13 +80,9 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         .replace("dt = 0.001\n", "dt = 0.00025\n")
         .replace("integrator = \"symplectic\"", "integrator = \"rk4\"")
         .replace("robust = true", "robust = false");
-    let finer = write(&dir, "finer.toml", &finer);
-    let e = animats(&["evaluate", &finer, "--json"]);
-    let (json, err) = text(&e);
-    assert!(e.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let (fitness, json) = evaluated(&write(&dir, "finer.toml", &finer));
     assert_eq!(
-        v["fitness"].as_f64().unwrap().to_bits(),
+        fitness.to_bits(),
         printed.to_bits(),
         "{json} against {line}"
     );

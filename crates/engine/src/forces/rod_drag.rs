@@ -83,11 +83,6 @@ impl RodDrag {
             rods: ends,
         })
     }
-
-    /// The rods' ends, as particle indices.
-    pub fn rods(&self) -> &[(u32, u32)] {
-        &self.rods
-    }
 }
 
 impl Force for RodDrag {

@@ -87,16 +87,7 @@ impl Build for FluidEntry {
             targets,
         };
         cx.world.add_fluid(fluid).map_err(|e| at.model(e))?;
-        if let Some(rods) = &f.springs {
-            at.positive("springs.diameter", rods.diameter)?;
-            at.finite("springs.drag_coefficient", rods.drag_coefficient)?;
-            if rods.drag_coefficient < 0.0 {
-                return Err(at.err(
-                    "springs.drag_coefficient",
-                    format!("must be >= 0, got {}", rods.drag_coefficient),
-                ));
-            }
-        }
+
         Ok(())
     }
 }
@@ -108,6 +99,14 @@ impl FluidEntry {
         let Some(rods) = &self.springs else {
             return Ok(());
         };
+        at.positive("springs.diameter", rods.diameter)?;
+        at.finite("springs.drag_coefficient", rods.drag_coefficient)?;
+        if rods.drag_coefficient < 0.0 {
+            return Err(at.err(
+                "springs.drag_coefficient",
+                format!("must be >= 0, got {}", rods.drag_coefficient),
+            ));
+        }
         let mut immersed = vec![false; cx.world.len()];
         cx.names
             .targets(at, &self.particles)?
