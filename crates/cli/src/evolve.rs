@@ -7,6 +7,7 @@
 use crate::Failure;
 use animats_evolve::{checkpoint, Choices, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
+use animats_scene::morphology::MorphologyProblem;
 use animats_viewer::{BestBrain, Exhibition};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
@@ -63,8 +64,9 @@ pub struct Args {
     #[arg(long, default_value_t = 5.0, value_parser = crate::non_negative_f64)]
     checkpoint_every: f64,
     /// Watch it live in the browser: the scene driven by its best brain so
-    /// far (restarted with the newest best when each run ends). The view
-    /// stays open after the run until Ctrl-C.
+    /// far, or in a [morphology] scene its best body and brain (restarted
+    /// with the newest best when each run ends). The view stays open after
+    /// the run until Ctrl-C.
     #[arg(long)]
     view: bool,
     /// Record where the run's time goes (every ask, evaluation and tell:
@@ -349,14 +351,16 @@ fn watch(args: &Args, state: &State, stop: &Arc<AtomicBool>) -> Result<Option<Vi
     if !args.view {
         return Ok(None);
     }
-    if state.config.optimiser == OptimiserKind::BodyGa {
-        return Err(input(
-            "--view watches a controller evolve; a [morphology] run's best body and brain are DIR/best.toml: `animats view DIR/best.toml`",
-        ));
-    }
-    let problem = state.config.problem.parse().map_err(input)?;
+    let spec = &state.config.problem;
     let board = BestBrain::default();
-    let stage = Exhibition::new(problem, board.clone()).map_err(Failure::Other)?;
+    let stage = if spec.has_morphology().map_err(input)? {
+        let problem =
+            MorphologyProblem::parse(&spec.text, &spec.file).map_err(|e| input(e.to_string()))?;
+        Exhibition::bodies(problem, board.clone())
+    } else {
+        Exhibition::new(spec.parse().map_err(input)?, board.clone())
+    }
+    .map_err(Failure::Other)?;
     publish(&board, state);
     let server = args.serving.bind(1.0)?;
     let stop = stop.clone();

@@ -320,17 +320,4 @@ fn bad_morphology_exits_2_naming_the_field_and_writes_nothing() {
     );
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).1.contains("body-ga"), "{}", text(&o).1);
-    let o = animats(&[
-        "evolve",
-        &write(&dir, "ok2.toml", SMALL),
-        "--view",
-        "--out",
-        dir.join("v").to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        text(&o).1.contains("animats view DIR/best.toml"),
-        "{}",
-        text(&o).1
-    );
 }

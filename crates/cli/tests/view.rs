@@ -90,19 +90,27 @@ fn a_missing_scene_or_a_port_in_use_exits_2() {
 
 #[test]
 fn evolve_view_serves_during_and_after_the_run_until_ctrl_c() {
-    let dir = common::scratch("evolve-view");
+    evolve_view("evolve-view", &["--generations", "20", "--lanes", "2"]);
+}
+
+/// A `[morphology]` run is watched too: its best body and brain.
+#[test]
+fn evolve_view_of_bodies_serves_during_and_after_the_run_until_ctrl_c() {
+    let seen = evolve_view(
+        "evolve-view-bodies",
+        &["scenes/bodies_walk.toml", "--generations", "1"],
+    );
+    assert!(seen.contains("1 lanes, generation 1 of 1"), "{seen}");
+}
+
+/// Runs `animats evolve ARGS --view --port 0`, fetches the page after the
+/// run, and stops the view with Ctrl-C; what the run printed.
+fn evolve_view(name: &str, args: &[&str]) -> String {
+    let dir = common::scratch(name);
     let mut child = Command::new(env!("CARGO_BIN_EXE_animats"))
-        .args([
-            "evolve",
-            "--generations",
-            "20",
-            "--lanes",
-            "2",
-            "--view",
-            "--port",
-            "0",
-            "--out",
-        ])
+        .arg("evolve")
+        .args(args)
+        .args(["--view", "--port", "0", "--out"])
         .arg(&dir)
         .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/../.."))
         .stdout(Stdio::piped())
@@ -133,4 +141,5 @@ fn evolve_view_serves_during_and_after_the_run_until_ctrl_c() {
         "the run had finished: Ctrl-C only closes the view"
     );
     assert!(dir.join("best.toml").exists());
+    seen
 }

@@ -1,14 +1,19 @@
 //! Watching an evolution (`animats evolve [SCENE] --view`): the best
 //! brain found so far, over all lanes, drives the scene from its start, as
 //! its fitness was measured — the scene's own brain only until the first
-//! generation has a best. When the run ends (the evaluation's duration,
+//! generation has a best. In a `[morphology]` scene the best genome is a
+//! body and its brain, developed into a scene as `best.toml` is; until the
+//! first best, the starting body (the scene's `start`, or a random body
+//! that passes the checks). When the run ends (the evaluation's duration,
 //! a `fail_on_touch` particle on the floor, a blow-up) it starts again with
 //! whatever the best is by then. The overlay gives the run shown's
 //! distance and fitness so far. The evolution publishes through a
 //! [`BestBrain`].
 
 use crate::protocol::{CreatureState, Describe};
+use animats_creatures::random::Random;
 use animats_scene::evaluate::SceneProblem;
+use animats_scene::morphology::MorphologyProblem;
 use animats_view::{SceneStage, Stage};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, PoisonError};
@@ -43,9 +48,64 @@ impl BestBrain {
     }
 }
 
-/// The stage: the scene, driven by the best brain.
+/// What an evolution's genomes are.
+enum Evolved {
+    /// A scene's `[evolve]` controller: the genome drives its brain.
+    Brain(Box<SceneProblem>),
+    /// A `[morphology]` scene's bodies: the genome is a body and its brain.
+    Body(Box<MorphologyProblem>),
+}
+
+/// Random bodies drawn, at most, to find one that passes the checks to
+/// show before the first best (the last one drawn is shown if none does).
+const RANDOM_TRIES: u64 = 20;
+
+impl Evolved {
+    fn file(&self) -> &str {
+        match self {
+            Evolved::Brain(p) => p.file(),
+            Evolved::Body(p) => p.file(),
+        }
+    }
+
+    /// The genome shown before the evolution has a best.
+    fn start(&self) -> Vec<f64> {
+        match self {
+            Evolved::Brain(p) => p.start().to_vec(),
+            Evolved::Body(p) => match p.start() {
+                Some(g) => g.to_vec(),
+                None => {
+                    let mut genes = Vec::new();
+                    for k in 0..RANDOM_TRIES {
+                        genes = p.random(&mut Random::for_entry(0, k));
+                        if p.check(&genes).is_ok() {
+                            break;
+                        }
+                    }
+                    genes
+                }
+            },
+        }
+    }
+
+    /// The scene with `genome` in it, from its start.
+    fn scene(&self, genome: &[f64]) -> Result<animats_scene::Scene, String> {
+        match self {
+            Evolved::Brain(p) => p.scene(genome),
+            Evolved::Body(p) => {
+                let text = p.develop(genome, "")?;
+                animats_scene::parse(&text, p.file()).map_err(|e| e.to_string())
+            }
+        }
+    }
+}
+
+/// The stage: the scene, driven by the best brain (or built with the best
+/// body).
 pub struct Exhibition {
-    problem: SceneProblem,
+    problem: Evolved,
+    /// The genome shown until the evolution has a best.
+    start: Vec<f64>,
     board: BestBrain,
     stage: SceneStage,
     /// The fitness and lane of the brain being shown (`None`: the scene's own).
@@ -55,25 +115,39 @@ pub struct Exhibition {
 impl Exhibition {
     /// Starts with the scene's own brain until the evolution has a best.
     pub fn new(problem: SceneProblem, board: BestBrain) -> Result<Exhibition, String> {
-        let (stage, shown) = Self::best_stage(&problem, &board)?;
+        Self::of(Evolved::Brain(Box::new(problem)), board)
+    }
+
+    /// Watches a `[morphology]` scene's bodies evolve: starts with its
+    /// starting body (or a random one that passes the checks) until the
+    /// evolution has a best.
+    pub fn bodies(problem: MorphologyProblem, board: BestBrain) -> Result<Exhibition, String> {
+        Self::of(Evolved::Body(Box::new(problem)), board)
+    }
+
+    fn of(problem: Evolved, board: BestBrain) -> Result<Exhibition, String> {
+        let start = problem.start();
+        let (stage, shown) = Self::best_stage(&problem, &start, &board)?;
         Ok(Exhibition {
             problem,
+            start,
             board,
             stage,
             shown,
         })
     }
 
-    /// The scene from its start with the best brain now, and which brain
+    /// The scene from its start with the best genome now, and which genome
     /// that is.
     fn best_stage(
-        problem: &SceneProblem,
+        problem: &Evolved,
+        start: &[f64],
         board: &BestBrain,
     ) -> Result<(SceneStage, Option<(f64, usize)>), String> {
         let best = board.board().best.clone();
         let (genome, shown) = match best {
             Some((g, f, lane)) => (g, Some((f, lane))),
-            None => (problem.start().to_vec(), None),
+            None => (start.to_vec(), None),
         };
         let scene = problem.scene(&genome)?;
         let stage = SceneStage::from_scene(PathBuf::from(problem.file()), scene, None)?;
@@ -82,7 +156,7 @@ impl Exhibition {
 
     /// Starts the scene again with the best brain now.
     fn restart(&mut self) -> Result<(), String> {
-        (self.stage, self.shown) = Self::best_stage(&self.problem, &self.board)?;
+        (self.stage, self.shown) = Self::best_stage(&self.problem, &self.start, &self.board)?;
         Ok(())
     }
 
@@ -102,7 +176,11 @@ impl Exhibition {
 impl Stage for Exhibition {
     fn describe(&self) -> Describe {
         let mut d = self.stage.describe();
-        d.title = format!("evolution: the best brain for {}", self.problem.file());
+        let what = match self.problem {
+            Evolved::Brain(_) => "brain",
+            Evolved::Body(_) => "body and brain",
+        };
+        d.title = format!("evolution: the best {what} for {}", self.problem.file());
         d
     }
 
@@ -147,7 +225,11 @@ impl Stage for Exhibition {
         let b = self.board.board();
         let showing = match self.shown {
             Some((f, lane)) => format!("showing fitness {f:.2} (lane {lane})"),
-            None => "showing the scene's own brain".to_string(),
+            None => match &self.problem {
+                Evolved::Brain(_) => "showing the scene's own brain".to_string(),
+                Evolved::Body(p) if p.start().is_some() => "showing the starting body".to_string(),
+                Evolved::Body(_) => "showing a random body".to_string(),
+            },
         };
         let now = self.stage.progress_note().map_or(String::new(), |p| {
             format!(" · {p} at {:.1} s", self.stage.time())

@@ -187,6 +187,75 @@ fn a_scene_exhibition_replays_the_newest_best_brain() {
     assert!(show.focus().is_some(), "it follows the [evolve] particles");
 }
 
+/// `evolve SCENE --view` of a `[morphology]` scene: until the first best, a
+/// random body that passes the checks; then the best body and brain, built
+/// as `best.toml` is, from their start, moving as `evaluate` moves them.
+#[test]
+fn a_bodies_exhibition_shows_the_best_body_as_best_toml_builds_it() {
+    use animats_creatures::random::Random;
+    use animats_scene::evaluate::evaluate_with;
+    use animats_scene::morphology::MorphologyProblem;
+    use animats_viewer::BestBrain;
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bodies_walk.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
+    let valid = |seed: u64| {
+        (0..20)
+            .map(|k| problem.random(&mut Random::for_entry(seed, k)))
+            .find(|g| problem.check(g).is_ok())
+            .expect("a random body that passes the checks")
+    };
+    let board = BestBrain::default();
+    let mut show = Exhibition::bodies(problem.clone(), board.clone()).unwrap();
+    let note = show.note().unwrap();
+    assert!(
+        note.contains("best fitness none yet; showing a random body"),
+        "{note}"
+    );
+    let first = problem.body(&valid(0)).unwrap().nodes.len();
+    assert_eq!(show.describe().particles.len(), first);
+    assert!(show.describe().title.contains("best body and brain"));
+    let dt = show.dt();
+    for _ in 0..50 {
+        show.step(dt).unwrap();
+    }
+
+    // Another body becomes the best: shown at once, from its start.
+    let best = valid(7);
+    let n = problem.body(&best).unwrap().nodes.len();
+    board.set_best(&best, 1.5, 0);
+    show.step(dt).unwrap();
+    assert_eq!(show.time(), 0.0);
+    assert_eq!(show.describe().particles.len(), n);
+    let note = show.note().unwrap();
+    assert!(note.contains("showing fitness 1.50 (lane 0)"), "{note}");
+
+    // It moves as `evaluate` of its best.toml moves it.
+    let scene = animats_scene::parse(&problem.develop(&best, "").unwrap(), "best.toml").unwrap();
+    let mut reference = Vec::new();
+    evaluate_with(scene, |s| {
+        reference.push(s.world.position(s.particle("body.p0").unwrap()));
+    })
+    .expect("evaluate");
+    let mut p = Vec::new();
+    let mut compared = 0;
+    for (k, r) in reference.iter().enumerate().take(2001).skip(1) {
+        show.step(dt).expect("step");
+        if k % 250 == 0 {
+            show.positions(&mut p);
+            let p0 = [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])];
+            assert!(
+                (p0[0] - r.x).abs() < 1e-5
+                    && (p0[1] - r.y).abs() < 1e-5
+                    && (p0[2] - r.z).abs() < 1e-5,
+                "step {k}: {p0:?} vs {r}"
+            );
+            compared += 1;
+        }
+    }
+    assert_eq!(compared, 8);
+}
+
 /// The overlay's distance and fitness are the evaluation's, step by step:
 /// at the end of the run they are what `animats evaluate` prints.
 #[test]

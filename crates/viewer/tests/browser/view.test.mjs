@@ -4,7 +4,8 @@
 // 20 Hz or more, pause stops time and resume restarts it, the overlay shows
 // every jellyfish's FSM state, a second tab watches the same run, and a
 // click on the floor moves the food and a jellyfish heads for it; then
-// `view scenes/pile.toml` (sphere contact) and `evolve --view`.
+// `view scenes/pile.toml` (sphere contact), `evolve --view` and `evolve
+// scenes/bodies_walk.toml --view`.
 //
 //   cd crates/viewer/tests/browser && npm ci && node view.test.mjs
 //
@@ -278,6 +279,26 @@ try {
     await tab.close();
   } finally {
     evo.child.kill('SIGINT');
+  }
+
+  // `evolve --view` of a [morphology] scene: the best body so far, built
+  // as best.toml is, walks; the overlay says which and how the run stands.
+  const bodiesOut = mkdtempSync(join(tmpdir(), 'animats-evolve-bodies-view-'));
+  const bodies = await serve(['evolve', resolve(root, 'scenes/bodies_walk.toml'), '--generations', '3', '--view', '--port', '0', '--out', bodiesOut]);
+  try {
+    const tab = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    await tab.goto(bodies.url);
+    await tab.waitForFunction(() => window.__viewer && window.__viewer.frames > 30, null, { timeout: 30000 });
+    await tab.waitForFunction(() => /generation 3 of 3/.test(document.getElementById('note').textContent), null, { timeout: 60000 });
+    await tab.waitForFunction(() => /showing fitness/.test(document.getElementById('note').textContent), null, { timeout: 30000 });
+    const note = await tab.evaluate(() => document.getElementById('note').textContent);
+    check(/best fitness \d+\.\d\d \(lane 0\); showing fitness/.test(note), 'evolve bodies_walk.toml --view: the overlay names the best body shown', `note: ${JSON.stringify(note)}`);
+    const drawn = await canvasStats(tab);
+    check(drawn.variance > 50, 'evolve bodies_walk.toml --view: the body is drawn', `luminance variance ${drawn.variance.toFixed(0)}`);
+    await tab.screenshot({ path: join(dirname(screenshot), 'bodies.png') });
+    await tab.close();
+  } finally {
+    bodies.child.kill('SIGINT');
   }
 } finally {
   await browser.close();
