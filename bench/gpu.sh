@@ -98,7 +98,7 @@ for device in cpu cuda; do
   [ $rc -gt $status ] && status=$rc
 done
 # Same seed, same log and best on the GPU as on the CPU (strict mode).
-for run in "scenes/walker.toml --optimiser cma-es --generations 20" "scenes/bodies_walk.toml --generations 4 --population 256"; do
+for run in "scenes/walker.toml --optimiser cma-es --generations 20" "scenes/bodies_walk.toml --generations 4 --population 256" "scenes/bodies_swim_rods.toml --generations 2 --population 128"; do
   echo "== evolve $run --seed 2: GPU against CPU"
   for device in cuda cpu; do
     # shellcheck disable=SC2086

@@ -14,7 +14,8 @@
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
- * constant forces, still fluids on every particle, soft (penalty) contact between spheres, the
+ * constant forces, still fluids on every particle and their drag across springs ([fluid]
+ * springs), soft (penalty) contact between spheres, the
  * flat floor (its located collisions with backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
@@ -164,6 +165,10 @@ typedef struct {
     const int *muscle_push;    /* 2 per muscle: a force's first push in the creature, pushes */
     const double *muscle_gate; /* 3 per muscle: its gate's sensor (-1: none), threshold,
                                   1 if open above it */
+    const long long *first_rod; /* per creature: its springs dragged across ([fluid] springs) */
+    const int *rod_a;           /* a rod's ends, within the creature */
+    const int *rod_b;
+    const double *rod_drag;     /* per rod: -0.5 C rho D, as forces/rod_drag.rs forms it */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -334,6 +339,56 @@ AN_FN void an_soft_contact(const an_batch *b, an_state st, long long q0, long lo
     }
 }
 
+/* The two Gauss points along a rod (forces/rod_drag.rs, GAUSS). */
+#define AN_GAUSS_0 0.21132486540518708
+#define AN_GAUSS_1 0.7886751345948129
+
+/* Drag across the rods q0 .. q0 + nq - 1 in still water (forces/rod_drag.rs,
+ * `apply`): -0.5 C rho D |v_n| v_n per length, v_n the velocity across the
+ * rod, integrated by two-point Gauss quadrature, each point's force split
+ * between the ends as a lever splits it. */
+AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const double *x,
+                       const double *v, double *f) {
+    const double gauss[2] = {AN_GAUSS_0, AN_GAUSS_1};
+    for (long long q = q0; q < q0 + nq; q++) {
+        long long a = b->rod_a[q], e = b->rod_b[q];
+        double drag = b->rod_drag[q];
+        double d[3], u[3], dv[3], fa[3] = {0.0, 0.0, 0.0}, fe[3] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < 3; k++) {
+            d[k] = x[3 * e + k] - x[3 * a + k];
+        }
+        double length = sqrt(an_dot(d, d));
+        if (length == 0.0) {
+            continue; /* no direction: a rod of no length has no drag */
+        }
+        for (int k = 0; k < 3; k++) {
+            u[k] = d[k] / length;
+            dv[k] = v[3 * e + k] - v[3 * a + k];
+        }
+        for (int g = 0; g < 2; g++) {
+            double xi = gauss[g], w[3], vn[3];
+            for (int k = 0; k < 3; k++) {
+                w[k] = v[3 * a + k] + dv[k] * xi;
+            }
+            double along = an_dot(w, u);
+            for (int k = 0; k < 3; k++) {
+                vn[k] = w[k] - u[k] * along;
+            }
+            double s = drag * 0.5 * length * sqrt(an_dot(vn, vn));
+            double lever = 1.0 - xi;
+            for (int k = 0; k < 3; k++) {
+                double fk = vn[k] * s;
+                fa[k] += fk * lever;
+                fe[k] += fk * xi;
+            }
+        }
+        for (int k = 0; k < 3; k++) {
+            f[3 * a + k] += fa[k];
+            f[3 * e + k] += fe[k];
+        }
+    }
+}
+
 /* The flat floor's contact force on particle i (forces/floor_contact.rs,
  * `contact` and `friction`): a sphere resting on the plane and pressed
  * into it is held up, and rubs. h is the trial's step. */
@@ -385,8 +440,8 @@ AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long lo
 
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints, constant forces, fluids, soft contact (a user
- * force of the body stage), the floor's contact force. h: the step
+ * joints, torque joints, constant forces, fluids, soft contact and then
+ * rod drag (user forces of the body stage), the floor's contact force. h: the step
  * of the trial. */
 AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, long long n,
                      long long s0, long long ns, const double *x, const double *v, double *f,
@@ -437,6 +492,8 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
     long long c0 = b->first_pair[c];
     an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
+    long long r0 = b->first_rod[c];
+    an_rod_drag(b, r0, b->first_rod[c + 1] - r0, x, v, f);
     if (b->floor && b->floor_contact) {
         for (long long i = 0; i < n; i++) {
             an_floor_contact(b, st, i, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);

@@ -2,7 +2,7 @@
 //! each creature's particles and springs a contiguous run found through
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
-use animats_engine::{DVec3, FloorCollision, IntegratorKind, SoftContact, World};
+use animats_engine::{DVec3, FloorCollision, IntegratorKind, RodDrag, SoftContact, World};
 use std::os::raw::{c_double, c_int, c_longlong};
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
@@ -122,6 +122,10 @@ pub(crate) struct Raw {
     muscle_base: *const c_double,
     muscle_push: *const c_int,
     muscle_gate: *const c_double,
+    first_rod: *const c_longlong,
+    rod_a: *const c_int,
+    rod_b: *const c_int,
+    rod_drag: *const c_double,
 }
 
 extern "C" {
@@ -233,6 +237,12 @@ pub struct Batch {
     pair_b: Vec<i32>,
     pair_stiffness: Vec<f64>,
     pair_damping: Vec<f64>,
+    /// Drag across springs (`[fluid] springs`): per creature its rods, each
+    /// rod's ends and `-½ C ρ D`.
+    first_rod: Vec<i64>,
+    rod_a: Vec<i32>,
+    rod_b: Vec<i32>,
+    rod_drag: Vec<f64>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -308,6 +318,10 @@ impl Batch {
             pair_b: Vec::new(),
             pair_stiffness: Vec::new(),
             pair_damping: Vec::new(),
+            first_rod: vec![0],
+            rod_a: Vec::new(),
+            rod_b: Vec::new(),
+            rod_drag: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         for (k, w) in worlds.iter().enumerate() {
@@ -391,6 +405,19 @@ impl Batch {
                     b.pair_damping.push(sc.damping);
                 }
             }
+            for rd in w
+                .forces()
+                .user()
+                .filter_map(|u| u.as_any()?.downcast_ref::<RodDrag>())
+            {
+                // As RodDrag::apply forms it.
+                let drag = -0.5 * rd.drag_coefficient * rd.density * rd.diameter;
+                for &(a, e) in rd.rods() {
+                    b.rod_a.push(a as i32);
+                    b.rod_b.push(e as i32);
+                    b.rod_drag.push(drag);
+                }
+            }
             b.radius.extend_from_slice(&props.radius);
             b.volume.extend_from_slice(&props.volume);
             b.restitution.extend_from_slice(&props.restitution);
@@ -403,6 +430,7 @@ impl Batch {
             b.first_fluid.push(b.fluid_drag.len() as i64);
             b.first_push.push(b.push_particle.len() as i64);
             b.first_pair.push(b.pair_a.len() as i64);
+            b.first_rod.push(b.rod_a.len() as i64);
             b.ev.fixed.extend(props.fixed.iter().map(|&f| i32::from(f)));
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
@@ -609,6 +637,10 @@ impl Batch {
             Array::MuscleBase => F64(&self.ev.muscle_base),
             Array::MusclePush => I32(&self.ev.muscle_push),
             Array::MuscleGate => F64(&self.ev.muscle_gate),
+            Array::FirstRod => I64(&self.first_rod),
+            Array::RodA => I32(&self.rod_a),
+            Array::RodB => I32(&self.rod_b),
+            Array::RodDrag => F64(&self.rod_drag),
         }
     }
 
@@ -760,6 +792,10 @@ impl Batch {
             muscle_base: c(Array::MuscleBase),
             muscle_push: i(Array::MusclePush),
             muscle_gate: c(Array::MuscleGate),
+            first_rod: l(Array::FirstRod),
+            rod_a: i(Array::RodA),
+            rod_b: i(Array::RodB),
+            rod_drag: c(Array::RodDrag),
         }
     }
 }
@@ -796,13 +832,20 @@ fn supported(w: &World) -> Result<(), String> {
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");
     }
-    // Soft contact is the one user force the C steps (a body-stage force,
-    // after the fluids, as the engine orders it).
+    // Soft contact and drag across springs in still water are the user
+    // forces the C steps (body-stage forces, after the fluids, as the
+    // engine orders them): every soft contact, then every rod drag.
+    let mut rods_seen = false;
     for u in f.user() {
-        let soft = u.as_any().is_some_and(|a| a.is::<SoftContact>());
-        if !soft || u.stage() != animats_engine::Stage::Body {
+        let any = u.as_any();
+        let soft = any.is_some_and(|a| a.is::<SoftContact>());
+        let rods = any
+            .and_then(|a| a.downcast_ref::<RodDrag>())
+            .is_some_and(|r| matches!(r.current, animats_engine::Current::Still));
+        if !(soft || rods) || u.stage() != animats_engine::Stage::Body || (soft && rods_seen) {
             return refuse(&format!("the user force `{}`", u.name()));
         }
+        rods_seen |= rods;
     }
     Ok(())
 }
@@ -916,11 +959,15 @@ pub(crate) enum Array {
     MuscleBase,
     MusclePush,
     MuscleGate,
+    FirstRod,
+    RodA,
+    RodB,
+    RodDrag,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 99] = [
+    pub(crate) const ALL: [Array; 103] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1020,6 +1067,10 @@ impl Array {
         Array::MuscleBase,
         Array::MusclePush,
         Array::MuscleGate,
+        Array::FirstRod,
+        Array::RodA,
+        Array::RodB,
+        Array::RodDrag,
     ];
 }
 

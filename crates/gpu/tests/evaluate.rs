@@ -243,6 +243,34 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn swimmers_in_water_that_drags_across_limbs_are_the_engine_s_to_the_bit() {
+    // The rods swim task's random starts, 2 s each, and its shipped best
+    // (seed 2 of docs/BODIES.md), 2 s: drag across springs, still water,
+    // self-contact, no floor.
+    let text = include_str!("../../../scenes/bodies_swim_rods.toml")
+        .replace("duration = 20.0", "duration = 2.0");
+    let problem = MorphologyProblem::parse(&text, "bodies_swim_rods.toml").unwrap();
+    let mut rng = Random::for_entry(5, 0);
+    let mut scenes = Vec::new();
+    while scenes.len() < 12 {
+        let genes = problem.random(&mut rng);
+        let body = problem.develop(&genes, "").unwrap();
+        scenes.push(animats_scene::parse(&body, "body.toml").unwrap());
+    }
+    let best = include_str!("../../../scenes/bodies_swim_rods_evolved.toml")
+        .replace("duration = 20.0", "duration = 2.0");
+    scenes.push(animats_scene::parse(&best, "bodies_swim_rods_evolved.toml").unwrap());
+    let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
+    let got = assert_same(scenes, &format!("swimmers with rods {sizes:?}"));
+    assert!(distinct_distances(&got) > 8, "{got:?}");
+    assert!(
+        got[12].distance > 0.3,
+        "the shipped swimmer swims: {:?}",
+        got[12]
+    );
+}
+
+#[test]
 fn lattice_bodies_too_big_for_a_thread_s_own_arrays_are_the_engine_s_to_the_bit() {
     // The EvoGym walker of scenes/bodies_lattice.toml (more than the 32
     // particles a thread holds in arrays of its own: kept in the batch's

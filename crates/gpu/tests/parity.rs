@@ -278,6 +278,71 @@ fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Bodies in water dragged across their springs (`[fluid] springs`,
+/// forces/rod_drag.rs), their spheres touching each other too (the C
+/// applies soft contact, then rod drag, as the engine's list of user forces
+/// orders them).
+#[test]
+fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
+    let mut rng = Random::for_entry(23, 0);
+    for kind in INTEGRATORS {
+        let make = |rng: &mut Random, rods: bool| -> Vec<World> {
+            (0..16)
+                .map(|k| {
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
+                    let mut w = random_body(rng, n, true, k % 2 == 0, kind).unwrap();
+                    let water = FluidMedium::water();
+                    let (density, c) = (water.density, 0.8 + 0.1 * (k % 5) as f64);
+                    w.add_fluid(water).unwrap();
+                    let ids: Vec<_> = w.particle_ids().collect();
+                    let soft =
+                        animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs())
+                            .unwrap();
+                    w.add_force(Box::new(soft));
+                    if rods {
+                        let ends: Vec<_> = w.forces().springs.iter().map(|s| s.ends()).collect();
+                        let drag = animats_engine::RodDrag::new(
+                            density,
+                            c,
+                            0.02,
+                            animats_engine::Current::Still,
+                            &ends,
+                        )
+                        .unwrap();
+                        w.add_force(Box::new(drag));
+                    }
+                    w
+                })
+                .collect()
+        };
+        let mut again = rng.clone();
+        let mut worlds = make(&mut rng, true);
+        let mut plain = make(&mut again, false);
+        let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
+        assert_same(
+            &mut worlds,
+            5e-4,
+            400,
+            3,
+            &format!("bodies dragged across their springs {sizes:?}, {kind:?}"),
+        );
+        // The rods matter: without them every body ends elsewhere.
+        for w in &mut plain {
+            for _ in 0..1200 {
+                if w.step(5e-4).is_err() {
+                    break;
+                }
+            }
+        }
+        let moved = worlds
+            .iter()
+            .zip(&plain)
+            .filter(|(a, b)| a.state().pos != b.state().pos)
+            .count();
+        assert_eq!(moved, 16, "{kind:?}: the rods changed only {moved} bodies");
+    }
+}
+
 #[test]
 fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let plain = || {
@@ -336,6 +401,41 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         err,
         "world 0: the user force `breeze` is not in the GPU step yet"
     );
+
+    // Drag across springs is stepped in still water only, and after every
+    // soft contact (the C's order).
+    let rods = |current| {
+        let ends = [(
+            animats_engine::ParticleId::from_index(0),
+            animats_engine::ParticleId::from_index(1),
+        )];
+        Box::new(animats_engine::RodDrag::new(1000.0, 1.2, 0.02, current, &ends).unwrap())
+    };
+    let soft = |w: &World| {
+        let ids: Vec<_> = w.particle_ids().collect();
+        Box::new(animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs()).unwrap())
+    };
+    let mut flowing = plain();
+    flowing.add_force(rods(animats_engine::Current::Uniform(DVec3::X)));
+    let err = Batch::pack(&[&flowing], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: the user force `rod drag` is not in the GPU step yet"
+    );
+    let mut first = plain();
+    first.add_force(rods(animats_engine::Current::Still));
+    let s = soft(&first);
+    first.add_force(s);
+    let err = Batch::pack(&[&first], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: the user force `soft contact` is not in the GPU step yet"
+    );
+    let mut still = plain();
+    let s = soft(&still);
+    still.add_force(s);
+    still.add_force(rods(animats_engine::Current::Still));
+    assert!(Batch::pack(&[&still], 1e-3).is_ok());
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);

@@ -83,6 +83,12 @@ impl RodDrag {
             rods: ends,
         })
     }
+
+    /// The rods' ends, as particle indices, in the order they are dragged
+    /// (the GPU's packer reads them).
+    pub fn rods(&self) -> &[(u32, u32)] {
+        &self.rods
+    }
 }
 
 impl Force for RodDrag {
