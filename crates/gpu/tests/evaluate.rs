@@ -271,6 +271,32 @@ fn swimmers_in_water_that_drags_across_limbs_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn neural_lattice_bodies_are_the_engine_s_to_the_bit() {
+    // The lattice task with `controller = "neural"`: random lattices of
+    // its 5 × 5 × 2 cells that pass the checks, 1 s each, every corner a
+    // touch sensor feeding one layer to every muscle.
+    let text = include_str!("../../../scenes/bodies_lattice.toml")
+        .replace("controller = \"oscillator\"", "controller = \"neural\"")
+        .replace("duration = 10.0", "duration = 1.0");
+    let base = MorphologyProblem::parse(&text, "bodies_lattice.toml").unwrap();
+    assert!(base.morphology().neural);
+    let mut rng = Random::for_entry(3, 0);
+    let mut scenes = Vec::new();
+    while scenes.len() < 8 {
+        let genes = base.random(&mut rng);
+        if base.check(&genes).is_err() {
+            continue;
+        }
+        let body = base.develop(&genes, "").unwrap();
+        assert!(body.contains("kind = \"neural\""));
+        scenes.push(animats_scene::parse(&body, "body.toml").unwrap());
+    }
+    let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
+    let got = assert_same(scenes, &format!("neural lattices {sizes:?}"));
+    assert!(distinct_distances(&got) > 4, "{got:?}");
+}
+
+#[test]
 fn lattice_bodies_too_big_for_a_thread_s_own_arrays_are_the_engine_s_to_the_bit() {
     // The EvoGym walker of scenes/bodies_lattice.toml (more than the 32
     // particles a thread holds in arrays of its own: kept in the batch's

@@ -204,6 +204,7 @@ fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
             2
         ],
         frequency: 1.0,
+        neural: false,
     };
     let b = one.develop(&shape, p.morphology());
     // A cube: 8 corners, 12 edges and 12 face diagonals; its 4 x edges are
@@ -227,6 +228,95 @@ fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
         "{:?}",
         p.check(&one.to_genes(&shape))
     );
+}
+
+/// One muscle cell of a `neural` lattice (its four x edges muscles, touch
+/// weights `touch`, no oscillation), its lowest points at `height`: the
+/// bottom muscles' mean length over their built length after 1 s.
+fn lattice_reflex(touch: [f64; 2], height: f64) -> f64 {
+    let text = with(&format!(
+        "encoding = \"lattice\"\ncells = [1, 1, 1]\ncell = 0.1\nmax_particles = 8\nmax_springs = 24\nmass = [0.001, 0.3]\ncontroller = \"neural\"\norigin = [0.0, {height}, 0.0]"
+    ));
+    let p = MorphologyProblem::parse(&text, "nl.toml").unwrap();
+    let shape = p.morphology().lattice.clone().unwrap();
+    let cell = Lattice {
+        materials: vec![Material::MuscleX],
+        muscles: vec![Muscle {
+            amplitude: 0.0,
+            phase: 0.0,
+            offset: 0.5,
+            touch,
+        }],
+        frequency: 1.0,
+        neural: true,
+    };
+    let genes = cell.to_genes(&shape);
+    // [4, nx, ny, nz, f], a material, then five genes a cell.
+    assert_eq!(genes.len(), 5 + 1 + 5);
+    assert_eq!(genes[0], 4.0);
+    assert_eq!(Lattice::from_genes(&genes, &shape).unwrap(), cell);
+    let body = p.body(&genes).unwrap();
+    assert!(body.neural);
+    assert!(body
+        .edges
+        .iter()
+        .filter_map(|e| e.muscle)
+        .all(|m| m.touch == touch));
+    assert_eq!(p.check(&genes), Ok(()), "a valid neural lattice");
+    let developed = p.develop(&genes, "").unwrap();
+    assert!(developed.contains("kind = \"touch\"") && developed.contains("kind = \"neural\""));
+    let mut scene = animats_scene::parse(&developed, "nl.toml").unwrap();
+    let bottom: Vec<_> = body
+        .edges
+        .iter()
+        .filter(|e| e.muscle.is_some())
+        .filter(|e| body.nodes[e.a].position.y == 0.0 && body.nodes[e.b].position.y == 0.0)
+        .map(|e| {
+            let (a, b) = (
+                scene.particle(&format!("body.p{}", e.a)).unwrap(),
+                scene.particle(&format!("body.p{}", e.b)).unwrap(),
+            );
+            (a, b)
+        })
+        .collect();
+    assert_eq!(bottom.len(), 2, "two x muscles on the bottom face");
+    let length = |s: &animats_scene::Scene| -> f64 {
+        bottom
+            .iter()
+            .map(|&(a, b)| (s.world.position(a) - s.world.position(b)).length())
+            .sum::<f64>()
+            / 2.0
+    };
+    let built = length(&scene);
+    scene.steps(1000, 0.001).unwrap();
+    length(&scene) / built
+}
+
+/// A `neural` lattice's muscles feel the floor as a graph body's do: with
+/// touch weights 1 the bottom muscles, their ends on the floor, are driven
+/// towards σ(4) = 0.982 of their range and lengthen (the cube's other
+/// springs resist, so by less than the bare muscle's 29 %); with weights
+/// 0, or falling through the air, the network's inputs are zero and the
+/// muscles hold level ½, to the bit the same either way.
+#[test]
+fn a_neural_lattice_feels_the_floor() {
+    let on_floor = lattice_reflex([1.0, 1.0], 0.0);
+    let numb = lattice_reflex([0.0, 0.0], 0.0);
+    let in_air = lattice_reflex([1.0, 1.0], 10.0);
+    let numb_in_air = lattice_reflex([0.0, 0.0], 10.0);
+    println!(
+        "on the floor {on_floor}, numb {numb}, in the air {in_air}, numb in the air {numb_in_air}"
+    );
+    assert!(on_floor > numb + 0.05, "{on_floor} vs {numb}");
+    assert!((numb - 1.0).abs() < 0.01, "{numb}");
+    assert_eq!(in_air.to_bits(), numb_in_air.to_bits());
+    // A neural lattice genome is not an oscillator lattice's.
+    let text = std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml")).unwrap();
+    let p = MorphologyProblem::parse(&text, "bodies_lattice.toml").unwrap();
+    let shape = p.morphology().lattice.clone().unwrap();
+    let mut l = Lattice::from_genes(p.start().unwrap(), &shape).unwrap();
+    l.neural = true;
+    assert_eq!(p.check(&l.to_genes(&shape)), Err(Refusal::Malformed));
 }
 
 #[test]
@@ -309,10 +399,6 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
         ("stiffness = [800.0, 50.0]", "morphology.stiffness"),
         ("encoding = \"voxels\"", "voxels"),
         (
-            "encoding = \"lattice\"\ncontroller = \"neural\"",
-            "morphology.controller",
-        ),
-        (
             "encoding = \"lattice\"\ncells = [101, 100, 1]",
             "morphology.cells",
         ),
@@ -390,7 +476,8 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
 
 /// 100,000 variations (mutants and crossovers, chained as evolution chains
 /// them) from each shipped start (random graph bodies, with either
-/// controller; the soft walker; the EvoGym lattice): every one is a body that passes the
+/// controller; the soft walker; the EvoGym lattice, with either controller):
+/// every one is a body that passes the
 /// checks that need no simulation or is refused with a reason, none
 /// panics; every 100th also runs the settle.
 #[test]
@@ -406,6 +493,12 @@ fn a_hundred_thousand_random_variations_are_valid_or_refused_with_a_reason() {
         (
             std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml")).unwrap(),
             "bodies_lattice.toml".to_string(),
+        ),
+        (
+            std::fs::read_to_string(format!("{ROOT}/scenes/bodies_lattice.toml"))
+                .unwrap()
+                .replace("controller = \"oscillator\"", "controller = \"neural\""),
+            "bodies_lattice.toml, neural".to_string(),
         ),
     ];
     let per = 100_000 / scenes.len() + 1;

@@ -6,8 +6,11 @@
 //!
 //! Genome: `[2, nx, ny, nz, frequency]`, a material code per cell (x
 //! fastest, then y, then z), then each cell's `amplitude, phase, offset`
-//! (used while it is a muscle). It develops into a [`Body`]: every check
-//! and the rest of development are the graph's.
+//! (used while it is a muscle). A `neural` lattice's genome starts with 4
+//! instead and each cell carries two more genes, the touch weights of its
+//! muscles (each muscle feels the touch sensors at its own two ends, as a
+//! graph body's muscle does). It develops into a [`Body`]: every check and
+//! the rest of development are the graph's.
 
 use super::genome::{Body, Edge, Muscle, Node};
 use super::{Morphology, MorphologyEntry, MAX_CELLS};
@@ -18,6 +21,8 @@ use std::collections::BTreeMap;
 
 /// The first gene of a lattice genome.
 pub const LATTICE_TAG: f64 = 2.0;
+/// The first gene of a `neural` lattice's genome.
+pub const NEURAL_LATTICE_TAG: f64 = 4.0;
 
 /// A cell's material.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -166,13 +171,20 @@ pub struct Lattice {
     pub muscles: Vec<Muscle>,
     /// Hz.
     pub frequency: f64,
+    /// Its muscles feel touch (`controller = "neural"`): each cell's genes
+    /// carry two touch weights.
+    pub neural: bool,
 }
 
 impl Lattice {
     /// The genes (see the module).
     pub fn to_genes(&self, shape: &Shape) -> Vec<f64> {
         let mut g = vec![
-            LATTICE_TAG,
+            if self.neural {
+                NEURAL_LATTICE_TAG
+            } else {
+                LATTICE_TAG
+            },
             shape.cells[0] as f64,
             shape.cells[1] as f64,
             shape.cells[2] as f64,
@@ -181,6 +193,9 @@ impl Lattice {
         g.extend(self.materials.iter().map(|m| m.code()));
         for m in &self.muscles {
             g.extend([m.amplitude, m.phase, m.offset]);
+            if self.neural {
+                g.extend(m.touch);
+            }
         }
         g
     }
@@ -191,17 +206,23 @@ impl Lattice {
             return Err(format!("gene {i} is not finite: {}", g[i]));
         }
         let n = shape.len();
+        let neural = g.first() == Some(&NEURAL_LATTICE_TAG);
+        let per_cell = if neural { 5 } else { 3 };
         let head = [
-            LATTICE_TAG,
+            if neural {
+                NEURAL_LATTICE_TAG
+            } else {
+                LATTICE_TAG
+            },
             shape.cells[0] as f64,
             shape.cells[1] as f64,
             shape.cells[2] as f64,
         ];
-        if g.len() != 5 + 4 * n || g[..4] != head {
+        if g.len() != 5 + (1 + per_cell) * n || g[..4.min(g.len())] != head {
             return Err(format!(
                 "not a lattice genome of {:?} cells: it must start {head:?} and hold {} genes",
                 shape.cells,
-                5 + 4 * n
+                5 + (1 + per_cell) * n
             ));
         }
         let materials = g[5..5 + n]
@@ -210,18 +231,19 @@ impl Lattice {
             .map(|(i, &x)| Material::from_code(x).ok_or(format!("cell {i}: {x} is not a material")))
             .collect::<Result<_, _>>()?;
         let muscles = g[5 + n..]
-            .chunks_exact(3)
+            .chunks_exact(per_cell)
             .map(|c| Muscle {
                 amplitude: c[0],
                 phase: c[1],
                 offset: c[2],
-                touch: [0.0; 2],
+                touch: if neural { [c[3], c[4]] } else { [0.0; 2] },
             })
             .collect();
         Ok(Lattice {
             materials,
             muscles,
             frequency: g[4],
+            neural,
         })
     }
 
@@ -268,7 +290,7 @@ impl Lattice {
             nodes,
             edges: edges.into_values().collect(),
             frequency: self.frequency,
-            neural: false,
+            neural: self.neural,
         }
     }
 }

@@ -235,12 +235,6 @@ impl Morphology {
     /// Checks every key, naming the field.
     pub(crate) fn from_entry(at: &At, e: &MorphologyEntry) -> Result<Morphology, SceneError> {
         let neural = e.controller == BrainName::Neural;
-        if neural && e.encoding == EncodingName::Lattice {
-            return Err(at.err(
-                "controller",
-                "`neural` is for graph bodies (a lattice's muscles carry oscillator genes only): use `oscillator`, or encoding = \"graph\"",
-            ));
-        }
         let range = |field: &str, r: [f64; 2], least: f64| -> Result<(f64, f64), SceneError> {
             let (lo, hi) = (at.finite(field, r[0])?, at.finite(field, r[1])?);
             if lo < least || lo > hi {

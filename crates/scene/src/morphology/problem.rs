@@ -98,6 +98,7 @@ impl MorphologyProblem {
                             s.len()
                         ],
                         frequency: 1.0,
+                        neural: morphology.neural,
                     }
                     .to_genes(s)
                 })
@@ -263,7 +264,7 @@ impl MorphologyProblem {
     pub fn random(&self, rng: &mut Random) -> Vec<f64> {
         match &self.morphology.lattice {
             None => vary::random_body(&self.morphology, rng).to_genes(),
-            Some(shape) => vary::random_lattice(shape, rng).to_genes(shape),
+            Some(shape) => vary::random_lattice(shape, self.morphology.neural, rng).to_genes(shape),
         }
     }
 

@@ -15,8 +15,9 @@
 //! cut severed is rejoined to the nearest particle across it.
 //!
 //! Lattice mutation repaints each cell with probability 0.1 (at least one
-//! cell; EvoGym's rate) and nudges muscle genes; lattice crossover copies a
-//! random box of cells from the second parent into the first.
+//! cell; EvoGym's rate) and nudges muscle genes (a `neural` lattice's
+//! touch weights with them); lattice crossover copies a random box of
+//! cells from the second parent into the first.
 
 use super::genome::{Body, Edge, Muscle, Node};
 use super::lattice::{Lattice, Material, Shape};
@@ -390,8 +391,9 @@ pub fn cross_bodies(a: &Body, b: &Body, rng: &mut Random) -> Body {
 }
 
 /// A random lattice: each cell empty with probability 0.3, else a random
-/// material; random muscle genes in every cell.
-pub fn random_lattice(shape: &Shape, rng: &mut Random) -> Lattice {
+/// material; random muscle genes in every cell (and, if `neural`, touch
+/// weights).
+pub fn random_lattice(shape: &Shape, neural: bool, rng: &mut Random) -> Lattice {
     let materials = (0..shape.len())
         .map(|_| {
             if rng.uniform() < 0.3 {
@@ -402,12 +404,13 @@ pub fn random_lattice(shape: &Shape, rng: &mut Random) -> Lattice {
         })
         .collect();
     let muscles = (0..shape.len())
-        .map(|_| random_muscle(rng, false))
+        .map(|_| random_muscle(rng, neural))
         .collect();
     Lattice {
         materials,
         muscles,
         frequency: rng.between(0.5, 3.0),
+        neural,
     }
 }
 
@@ -428,7 +431,7 @@ pub fn mutate_lattice(parent: &Lattice, rng: &mut Random) -> Lattice {
     }
     for _ in 0..int(rng, 0, 2) {
         let mu = &mut l.muscles[int(rng, 0, n - 1)];
-        nudge_muscle(rng, mu, 0.1, 0.2 * PI, false);
+        nudge_muscle(rng, mu, 0.1, 0.2 * PI, parent.neural);
     }
     if rng.uniform() < 0.2 {
         l.frequency = nudge(rng, l.frequency, FREQUENCY, 0.05);
