@@ -89,6 +89,30 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     if logged > 0.0 {
         assert!(line.contains(&format!("% of {logged})")), "{line}");
     }
+    // And before it, with its own integrator at a quarter of the step.
+    let own = stdout
+        .lines()
+        .find(|l| {
+            l.contains("check: the best at a quarter of the step (0.00025 s) with symplectic")
+        })
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(
+        stdout.find(own) < stdout.find(line),
+        "own integrator first: {stdout}"
+    );
+    let printed: f64 = own
+        .split("fitness ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let finer = std::fs::read_to_string(&best)
+        .unwrap()
+        .replace("dt = 0.001\n", "dt = 0.00025\n")
+        .replace("robust = true", "robust = false");
+    let (fitness, json) = evaluated(&write(&dir, "finer_own.toml", &finer));
+    assert_eq!(fitness.to_bits(), printed.to_bits(), "{json} against {own}");
     // The zoo: the best bodies alive, best first; the first is the run's
     // best (the body GA keeps it).
     let zoo = dir.join("zoo.gif");

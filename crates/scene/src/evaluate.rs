@@ -552,7 +552,7 @@ pub fn evaluate(scene: Scene) -> Result<Evaluation, String> {
 /// RK4; implicit Euler is kept (an explicit step may not hold its stiff
 /// springs). Returns the integrator, the step and the evaluation.
 pub fn check_finer(
-    mut scene: Scene,
+    scene: Scene,
 ) -> Result<(animats_engine::IntegratorKind, f64, Evaluation), String> {
     use animats_engine::IntegratorKind as K;
     let kind = match scene.world.integrator() {
@@ -560,6 +560,32 @@ pub fn check_finer(
         K::Implicit => K::Implicit,
         _ => K::Rk4,
     };
+    check_with(scene, kind)
+}
+
+/// Both checks a winner must pass before it is believed, each `scene`'s
+/// `[evolve]` evaluation once (no trials, not robust) at a quarter of its
+/// step: with its own integrator (a gait tuned to where in a step its feet
+/// land fails it), then with another ([`check_finer`]); one run when the
+/// two are the same (implicit Euler); `make` builds the scene afresh for
+/// each. Returns each run's integrator, step and evaluation.
+pub fn checks_finer(
+    make: impl Fn() -> Result<Scene, String>,
+) -> Result<Vec<(animats_engine::IntegratorKind, f64, Evaluation)>, String> {
+    let scene = make()?;
+    let own = scene.world.integrator();
+    let other = check_finer(scene)?;
+    if other.0 == own {
+        return Ok(vec![other]);
+    }
+    Ok(vec![check_with(make()?, own)?, other])
+}
+
+/// `scene` evaluated once at a quarter of its step with `kind`.
+fn check_with(
+    mut scene: Scene,
+    kind: animats_engine::IntegratorKind,
+) -> Result<(animats_engine::IntegratorKind, f64, Evaluation), String> {
     scene.world.set_integrator(kind);
     scene.dt *= 0.25;
     let dt = scene.dt;

@@ -247,3 +247,35 @@ fn the_finer_check_is_the_scene_at_a_quarter_step_with_another_integrator() {
         assert_eq!(check_finer(parse(&t)).unwrap().0, to);
     }
 }
+
+/// Both checks (`checks_finer`): a quarter of the step with the scene's
+/// own integrator, then with another, each as `evaluate` scores the scene
+/// written that way; one run for implicit Euler.
+#[test]
+fn both_finer_checks_are_the_scene_at_a_quarter_step_with_its_own_integrator_and_another() {
+    use animats_engine::IntegratorKind;
+    use animats_scene::evaluate::checks_finer;
+    let text = muscle("energy_weight = 2.0");
+    let runs = checks_finer(|| Ok(parse(&text))).unwrap();
+    let kinds: Vec<_> = runs.iter().map(|r| (r.0, r.1)).collect();
+    assert_eq!(
+        kinds,
+        [
+            (IntegratorKind::Rk4, 0.00025),
+            (IntegratorKind::Symplectic, 0.00025)
+        ]
+    );
+    let own = evaluate(parse(&text.replace("dt = 0.001\n", "dt = 0.00025\n"))).unwrap();
+    assert_eq!(runs[0].2.fitness.to_bits(), own.fitness.to_bits());
+    let (_, _, other) = animats_scene::evaluate::check_finer(parse(&text)).unwrap();
+    assert_eq!(runs[1].2.fitness.to_bits(), other.fitness.to_bits());
+    // Not the scene's own run: its work is summed at other steps.
+    assert_ne!(
+        runs[0].2.fitness.to_bits(),
+        evaluate(parse(&text)).unwrap().fitness.to_bits()
+    );
+    let implicit = text.replace("dt = 0.001\n", "dt = 0.001\nintegrator = \"implicit\"\n");
+    let runs = checks_finer(|| Ok(parse(&implicit))).unwrap();
+    assert_eq!(runs.len(), 1);
+    assert_eq!(runs[0].0, IntegratorKind::Implicit);
+}
