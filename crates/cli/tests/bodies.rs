@@ -113,6 +113,18 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         .replace("robust = true", "robust = false");
     let (fitness, json) = evaluated(&write(&dir, "finer_own.toml", &finer));
     assert_eq!(fitness.to_bits(), printed.to_bits(), "{json} against {own}");
+    // --no-check skips them; the run is the same.
+    let o = evolve(
+        &write(&dir, "small2.toml", SMALL),
+        &dir.join("unchecked"),
+        &["--generations", "4", "--no-check"],
+    );
+    assert!(o.status.success(), "{}", text(&o).1);
+    assert!(!text(&o).0.contains("check:"), "{}", text(&o).0);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("unchecked/log.csv")).unwrap(),
+        std::fs::read_to_string(out.join("log.csv")).unwrap()
+    );
     // The zoo: the best bodies alive, best first; the first is the run's
     // best (the body GA keeps it).
     let zoo = dir.join("zoo.gif");
