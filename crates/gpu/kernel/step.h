@@ -14,7 +14,7 @@
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
- * constant forces, still fluids on every particle and their drag across springs ([fluid]
+ * constant forces, fluids (still or in a uniform current) on every particle and their drag across springs ([fluid]
  * springs), soft (penalty) contact between spheres, the
  * flat floor (its located collisions with backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
@@ -42,7 +42,7 @@ enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
  * Angle joints (first_joint, ends a and b, joint j), torque joints
  * (first_motor, end and joint, unit axis, torque), constant forces (as
  * pushes: first_push, a particle and a vector each, in the engine's order)
- * and still fluids on every particle (first_fluid) likewise. Vectors are
+ * and fluids on every particle (first_fluid) likewise. Vectors are
  * stored x, y, z per particle. `scratch` holds 15 doubles per particle
  * (force, and RK4's start and sums).
  */
@@ -169,6 +169,8 @@ typedef struct {
     const int *rod_a;           /* a rod's ends, within the creature */
     const int *rod_b;
     const double *rod_drag;     /* per rod: -0.5 C rho D, as forces/rod_drag.rs forms it */
+    const double *fluid_current; /* 3 per fluid: its uniform current (0 in still water) */
+    const double *rod_current;   /* 3 per rod: its fluid's uniform current (0 in still water) */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -282,8 +284,10 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
     }
 }
 
-/* Still fluids q0 .. q0 + nq - 1 on every particle of the creature
- * (forces/fluid.rs, `force_on`): quadratic drag and buoyancy. */
+/* Fluids q0 .. q0 + nq - 1 on every particle of the creature, still or
+ * in a uniform current (forces/fluid.rs, `force_on`): quadratic drag
+ * against the velocity relative to the water, and buoyancy. In still
+ * water the current is 0, and v - 0 is v to the bit (-0 included). */
 AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, long long q0,
                      long long nq, const double *v, double *f) {
     double g[3] = {b->gx, b->gy, b->gz};
@@ -294,9 +298,10 @@ AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, 
     }
     for (long long q = q0; q < q0 + nq; q++) {
         double drag = b->fluid_drag[q], density = b->fluid_density[q];
+        const double *cur = b->fluid_current + 3 * q;
         for (long long i = 0; i < n; i++) {
             double r = st.r[i];
-            const double *vr = v + 3 * i;
+            double vr[3] = {v[3 * i] - cur[0], v[3 * i + 1] - cur[1], v[3 * i + 2] - cur[2]};
             double speed = sqrt(an_dot(vr, vr));
             double s = drag * r * r * speed;
             double lift = -b->volume[p0 + i] * density;
@@ -343,9 +348,10 @@ AN_FN void an_soft_contact(const an_batch *b, an_state st, long long q0, long lo
 #define AN_GAUSS_0 0.21132486540518708
 #define AN_GAUSS_1 0.7886751345948129
 
-/* Drag across the rods q0 .. q0 + nq - 1 in still water (forces/rod_drag.rs,
- * `apply`): -0.5 C rho D |v_n| v_n per length, v_n the velocity across the
- * rod, integrated by two-point Gauss quadrature, each point's force split
+/* Drag across the rods q0 .. q0 + nq - 1, in still water or a uniform
+ * current (forces/rod_drag.rs, `apply`): -0.5 C rho D |v_n| v_n per
+ * length, v_n the velocity relative to the water across the rod,
+ * integrated by two-point Gauss quadrature, each point's force split
  * between the ends as a lever splits it. */
 AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const double *x,
                        const double *v, double *f) {
@@ -353,6 +359,7 @@ AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const doub
     for (long long q = q0; q < q0 + nq; q++) {
         long long a = b->rod_a[q], e = b->rod_b[q];
         double drag = b->rod_drag[q];
+        const double *cur = b->rod_current + 3 * q;
         double d[3], u[3], dv[3], fa[3] = {0.0, 0.0, 0.0}, fe[3] = {0.0, 0.0, 0.0};
         for (int k = 0; k < 3; k++) {
             d[k] = x[3 * e + k] - x[3 * a + k];
@@ -368,7 +375,7 @@ AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const doub
         for (int g = 0; g < 2; g++) {
             double xi = gauss[g], w[3], vn[3];
             for (int k = 0; k < 3; k++) {
-                w[k] = v[3 * a + k] + dv[k] * xi;
+                w[k] = (v[3 * a + k] + dv[k] * xi) - cur[k];
             }
             double along = an_dot(w, u);
             for (int k = 0; k < 3; k++) {

@@ -126,6 +126,8 @@ pub(crate) struct Raw {
     rod_a: *const c_int,
     rod_b: *const c_int,
     rod_drag: *const c_double,
+    fluid_current: *const c_double,
+    rod_current: *const c_double,
 }
 
 extern "C" {
@@ -243,6 +245,10 @@ pub struct Batch {
     rod_a: Vec<i32>,
     rod_b: Vec<i32>,
     rod_drag: Vec<f64>,
+    /// Each fluid's and each rod's uniform current, 3 numbers each (0 in
+    /// still water).
+    fluid_current: Vec<f64>,
+    rod_current: Vec<f64>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -252,7 +258,7 @@ impl Batch {
     /// world must share the first one's gravity, floor and integrator, and
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
-    /// torques, constant forces, still fluids about every particle, soft
+    /// torques, constant forces, fluids about every particle (still or in a uniform current), soft
     /// contact, the flat floor under every particle): anything else is refused with a message naming the
     /// world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
@@ -322,6 +328,8 @@ impl Batch {
             rod_a: Vec::new(),
             rod_b: Vec::new(),
             rod_drag: Vec::new(),
+            fluid_current: Vec::new(),
+            rod_current: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         for (k, w) in worlds.iter().enumerate() {
@@ -392,6 +400,7 @@ impl Batch {
                 b.fluid_drag
                     .push(-0.5 * fl.drag_coefficient * fl.density * std::f64::consts::PI);
                 b.fluid_density.push(fl.density);
+                b.fluid_current.extend(uniform(&fl.current).to_array());
             }
             for sc in w
                 .forces()
@@ -416,6 +425,7 @@ impl Batch {
                     b.rod_a.push(a as i32);
                     b.rod_b.push(e as i32);
                     b.rod_drag.push(drag);
+                    b.rod_current.extend(uniform(&rd.current).to_array());
                 }
             }
             b.radius.extend_from_slice(&props.radius);
@@ -641,6 +651,8 @@ impl Batch {
             Array::RodA => I32(&self.rod_a),
             Array::RodB => I32(&self.rod_b),
             Array::RodDrag => F64(&self.rod_drag),
+            Array::FluidCurrent => F64(&self.fluid_current),
+            Array::RodCurrent => F64(&self.rod_current),
         }
     }
 
@@ -796,6 +808,8 @@ impl Batch {
             rod_a: i(Array::RodA),
             rod_b: i(Array::RodB),
             rod_drag: c(Array::RodDrag),
+            fluid_current: c(Array::FluidCurrent),
+            rod_current: c(Array::RodCurrent),
         }
     }
 }
@@ -825,15 +839,15 @@ fn supported(w: &World) -> Result<(), String> {
         if fl.targets != Targets::All {
             return refuse("a fluid about some particles only");
         }
-        if !matches!(fl.current, animats_engine::Current::Still) {
-            return refuse("a fluid's current");
+        if uniform_or_still(&fl.current).is_none() {
+            return refuse("a fluid's current other than a uniform one");
         }
     }
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");
     }
-    // Soft contact and drag across springs in still water are the user
-    // forces the C steps (body-stage forces, after the fluids, as the
+    // Soft contact and drag across springs (in still water or a uniform
+    // current) are the user forces the C steps (body-stage forces, after the fluids, as the
     // engine orders them): every soft contact, then every rod drag.
     let mut rods_seen = false;
     for u in f.user() {
@@ -841,13 +855,28 @@ fn supported(w: &World) -> Result<(), String> {
         let soft = any.is_some_and(|a| a.is::<SoftContact>());
         let rods = any
             .and_then(|a| a.downcast_ref::<RodDrag>())
-            .is_some_and(|r| matches!(r.current, animats_engine::Current::Still));
+            .is_some_and(|r| uniform_or_still(&r.current).is_some());
         if !(soft || rods) || u.stage() != animats_engine::Stage::Body || (soft && rods_seen) {
             return refuse(&format!("the user force `{}`", u.name()));
         }
         rods_seen |= rods;
     }
     Ok(())
+}
+
+/// A current's velocity where the C steps it: still water (0) or a
+/// uniform current; `None` for one that varies (a reef's waves).
+fn uniform_or_still(c: &animats_engine::Current) -> Option<DVec3> {
+    match c {
+        animats_engine::Current::Still => Some(DVec3::ZERO),
+        animats_engine::Current::Uniform(v) => Some(*v),
+        _ => None,
+    }
+}
+
+/// The velocity of a current [`supported`] let through.
+fn uniform(c: &animats_engine::Current) -> DVec3 {
+    uniform_or_still(c).unwrap_or(DVec3::ZERO)
 }
 
 /// One of a batch's arrays, borrowed.
@@ -963,11 +992,13 @@ pub(crate) enum Array {
     RodA,
     RodB,
     RodDrag,
+    FluidCurrent,
+    RodCurrent,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 103] = [
+    pub(crate) const ALL: [Array; 105] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1071,6 +1102,8 @@ impl Array {
         Array::RodA,
         Array::RodB,
         Array::RodDrag,
+        Array::FluidCurrent,
+        Array::RodCurrent,
     ];
 }
 

@@ -281,7 +281,8 @@ fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
 /// Bodies in water dragged across their springs (`[fluid] springs`,
 /// forces/rod_drag.rs), their spheres touching each other too (the C
 /// applies soft contact, then rod drag, as the engine's list of user forces
-/// orders them).
+/// orders them); every other body in a uniform current, which the water
+/// and the rods both feel.
 #[test]
 fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
     let mut rng = Random::for_entry(23, 0);
@@ -291,7 +292,15 @@ fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
                 .map(|k| {
                     let n = 2 + (rng.uniform() * 39.0) as usize;
                     let mut w = random_body(rng, n, true, k % 2 == 0, kind).unwrap();
-                    let water = FluidMedium::water();
+                    let current = if k % 2 == 1 {
+                        animats_engine::Current::Uniform(random_vec(rng, 0.5))
+                    } else {
+                        animats_engine::Current::Still
+                    };
+                    let water = FluidMedium {
+                        current: current.clone(),
+                        ..FluidMedium::water()
+                    };
                     let (density, c) = (water.density, 0.8 + 0.1 * (k % 5) as f64);
                     w.add_fluid(water).unwrap();
                     let ids: Vec<_> = w.particle_ids().collect();
@@ -301,14 +310,8 @@ fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
                     w.add_force(Box::new(soft));
                     if rods {
                         let ends: Vec<_> = w.forces().springs.iter().map(|s| s.ends()).collect();
-                        let drag = animats_engine::RodDrag::new(
-                            density,
-                            c,
-                            0.02,
-                            animats_engine::Current::Still,
-                            &ends,
-                        )
-                        .unwrap();
+                        let drag =
+                            animats_engine::RodDrag::new(density, c, 0.02, current, &ends).unwrap();
                         w.add_force(Box::new(drag));
                     }
                     w
@@ -402,8 +405,8 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "world 0: the user force `breeze` is not in the GPU step yet"
     );
 
-    // Drag across springs is stepped in still water only, and after every
-    // soft contact (the C's order).
+    // Drag across springs is stepped in still water or a uniform current
+    // only, and after every soft contact (the C's order); so is a fluid.
     let rods = |current| {
         let ends = [(
             animats_engine::ParticleId::from_index(0),
@@ -416,7 +419,9 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         Box::new(animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs()).unwrap())
     };
     let mut flowing = plain();
-    flowing.add_force(rods(animats_engine::Current::Uniform(DVec3::X)));
+    flowing.add_force(rods(animats_engine::Current::Reef(
+        animats_engine::ReefWater::default(),
+    )));
     let err = Batch::pack(&[&flowing], 1e-3).unwrap_err();
     assert_eq!(
         err,
@@ -435,7 +440,19 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let s = soft(&still);
     still.add_force(s);
     still.add_force(rods(animats_engine::Current::Still));
+    still.add_force(rods(animats_engine::Current::Uniform(DVec3::X)));
     assert!(Batch::pack(&[&still], 1e-3).is_ok());
+    let mut reef = plain();
+    reef.add_fluid(FluidMedium {
+        current: animats_engine::Current::Reef(animats_engine::ReefWater::default()),
+        ..FluidMedium::water()
+    })
+    .unwrap();
+    let err = Batch::pack(&[&reef], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: a fluid's current other than a uniform one is not in the GPU step yet"
+    );
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);
