@@ -37,6 +37,27 @@ fn evaluated(file: &str) -> (f64, String) {
     (v["fitness"].as_f64().unwrap(), json)
 }
 
+/// The `check:` line `evolve` printed for a quarter of the step (0.00025 s)
+/// with `integrator`, and the fitness it gives.
+fn check_line<'a>(stdout: &'a str, integrator: &str) -> (&'a str, f64) {
+    let line = stdout
+        .lines()
+        .find(|l| {
+            l.contains(&format!(
+                "check: the best at a quarter of the step (0.00025 s) with {integrator}:"
+            ))
+        })
+        .unwrap_or_else(|| panic!("{stdout}"));
+    let fitness = line
+        .split("fitness ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    (line, fitness)
+}
+
 #[test]
 fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     let dir = scratch("bodies-small");
@@ -64,17 +85,7 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
     // The check printed at the end: the best at a quarter of the step
     // with RK4 (the scene's integrator is symplectic Euler), once, as
     // `evaluate` scores best.toml so changed.
-    let line = stdout
-        .lines()
-        .find(|l| l.contains("check: the best at a quarter of the step (0.00025 s) with rk4"))
-        .unwrap_or_else(|| panic!("{stdout}"));
-    let printed: f64 = line
-        .split("fitness ")
-        .nth(1)
-        .and_then(|r| r.split(',').next())
-        .unwrap()
-        .parse()
-        .unwrap();
+    let (line, printed) = check_line(&stdout, "rk4");
     let finer = std::fs::read_to_string(&best)
         .unwrap()
         .replace("dt = 0.001\n", "dt = 0.00025\n")
@@ -90,23 +101,11 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         assert!(line.contains(&format!("% of {logged})")), "{line}");
     }
     // And before it, with its own integrator at a quarter of the step.
-    let own = stdout
-        .lines()
-        .find(|l| {
-            l.contains("check: the best at a quarter of the step (0.00025 s) with symplectic")
-        })
-        .unwrap_or_else(|| panic!("{stdout}"));
+    let (own, printed) = check_line(&stdout, "symplectic");
     assert!(
         stdout.find(own) < stdout.find(line),
         "own integrator first: {stdout}"
     );
-    let printed: f64 = own
-        .split("fitness ")
-        .nth(1)
-        .and_then(|r| r.split(',').next())
-        .unwrap()
-        .parse()
-        .unwrap();
     let finer = std::fs::read_to_string(&best)
         .unwrap()
         .replace("dt = 0.001\n", "dt = 0.00025\n")

@@ -223,6 +223,19 @@ ranges = [[0.0, 1.0], [0.0, 6.0], [-1.0, 1.0], [-1.0, 1.0], [0.0, 0.3], [-1.0, 1
     }
 }
 
+/// `n` scenes of `problem`'s random bodies (unchecked), drawn from
+/// `seed`'s stream.
+fn random_bodies(problem: &MorphologyProblem, seed: u64, n: usize) -> Vec<Scene> {
+    let mut rng = Random::for_entry(seed, 0);
+    (0..n)
+        .map(|_| {
+            let genes = problem.random(&mut rng);
+            let body = problem.develop(&genes, "").unwrap();
+            animats_scene::parse(&body, "body.toml").unwrap()
+        })
+        .collect()
+}
+
 #[test]
 fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     // The land task's random starts, 2 s each: spring muscles driven by
@@ -230,13 +243,7 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
     // (feet on the floor, size).
     let text = BODIES_WALK.replace("duration = 10.0", "duration = 2.0");
     let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
-    let mut rng = Random::for_entry(11, 0);
-    let mut scenes = Vec::new();
-    while scenes.len() < 16 {
-        let genes = problem.random(&mut rng);
-        let body = problem.develop(&genes, "").unwrap();
-        scenes.push(animats_scene::parse(&body, "body.toml").unwrap());
-    }
+    let scenes = random_bodies(&problem, 11, 16);
     let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
     let got = assert_same(scenes, &format!("random bodies {sizes:?}"));
     assert!(distinct_distances(&got) > 8, "{got:?}");
@@ -250,13 +257,7 @@ fn swimmers_in_water_that_drags_across_limbs_are_the_engine_s_to_the_bit() {
     let text = include_str!("../../../scenes/bodies_swim_rods.toml")
         .replace("duration = 20.0", "duration = 2.0");
     let problem = MorphologyProblem::parse(&text, "bodies_swim_rods.toml").unwrap();
-    let mut rng = Random::for_entry(5, 0);
-    let mut scenes = Vec::new();
-    while scenes.len() < 12 {
-        let genes = problem.random(&mut rng);
-        let body = problem.develop(&genes, "").unwrap();
-        scenes.push(animats_scene::parse(&body, "body.toml").unwrap());
-    }
+    let mut scenes = random_bodies(&problem, 5, 12);
     let best = include_str!("../../../scenes/bodies_swim_rods_evolved.toml")
         .replace("duration = 20.0", "duration = 2.0");
     scenes.push(animats_scene::parse(&best, "bodies_swim_rods_evolved.toml").unwrap());

@@ -82,6 +82,31 @@ fn assert_same(worlds: &mut [World], dt: f64, steps: u64, rounds: usize, what: &
     }
 }
 
+/// Penalty contact between every pair of `w`'s spheres that no spring
+/// joins (k = 5000 N/m, c = 2 N s/m).
+fn soft_contact(w: &World) -> Box<animats_engine::SoftContact> {
+    let ids: Vec<_> = w.particle_ids().collect();
+    Box::new(animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs()).unwrap())
+}
+
+/// Steps each of `plain` (the same bodies as `worlds` without a force)
+/// 1200 steps of 0.5 ms, as far as it stays finite, and counts the bodies
+/// that end elsewhere than their twins in `worlds`.
+fn ending_elsewhere(worlds: &[World], plain: &mut [World]) -> usize {
+    for w in plain.iter_mut() {
+        for _ in 0..1200 {
+            if w.step(5e-4).is_err() {
+                break;
+            }
+        }
+    }
+    worlds
+        .iter()
+        .zip(plain.iter())
+        .filter(|(a, b)| a.state().pos != b.state().pos)
+        .count()
+}
+
 #[test]
 fn a_hanging_chain_is_the_engine_s_to_the_bit_under_every_integrator() {
     for kind in INTEGRATORS {
@@ -236,11 +261,8 @@ fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
                     let mut w = random_body(rng, n, true, k % 2 == 0, kind).unwrap();
                     w.add_floor(FloorDef::default()).unwrap();
                     if contact {
-                        let ids: Vec<_> = w.particle_ids().collect();
-                        let soft =
-                            animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs())
-                                .unwrap();
-                        w.add_force(Box::new(soft));
+                        let soft = soft_contact(&w);
+                        w.add_force(soft);
                     }
                     w
                 })
@@ -258,18 +280,7 @@ fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
             3,
             &format!("touching bodies {before:?}, {kind:?}"),
         );
-        for w in &mut plain {
-            for _ in 0..1200 {
-                if w.step(5e-4).is_err() {
-                    break;
-                }
-            }
-        }
-        let moved = worlds
-            .iter()
-            .zip(&plain)
-            .filter(|(a, b)| a.state().pos != b.state().pos)
-            .count();
+        let moved = ending_elsewhere(&worlds, &mut plain);
         eprintln!("{kind:?}: {moved} of 16 bodies end elsewhere without their contacts");
         assert!(
             moved >= 8,
@@ -303,11 +314,8 @@ fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
                     };
                     let (density, c) = (water.density, 0.8 + 0.1 * (k % 5) as f64);
                     w.add_fluid(water).unwrap();
-                    let ids: Vec<_> = w.particle_ids().collect();
-                    let soft =
-                        animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs())
-                            .unwrap();
-                    w.add_force(Box::new(soft));
+                    let soft = soft_contact(&w);
+                    w.add_force(soft);
                     if rods {
                         let ends: Vec<_> = w.forces().springs.iter().map(|s| s.ends()).collect();
                         let drag =
@@ -330,18 +338,7 @@ fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
             &format!("bodies dragged across their springs {sizes:?}, {kind:?}"),
         );
         // The rods matter: without them every body ends elsewhere.
-        for w in &mut plain {
-            for _ in 0..1200 {
-                if w.step(5e-4).is_err() {
-                    break;
-                }
-            }
-        }
-        let moved = worlds
-            .iter()
-            .zip(&plain)
-            .filter(|(a, b)| a.state().pos != b.state().pos)
-            .count();
+        let moved = ending_elsewhere(&worlds, &mut plain);
         assert_eq!(moved, 16, "{kind:?}: the rods changed only {moved} bodies");
     }
 }
@@ -414,10 +411,6 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         )];
         Box::new(animats_engine::RodDrag::new(1000.0, 1.2, 0.02, current, &ends).unwrap())
     };
-    let soft = |w: &World| {
-        let ids: Vec<_> = w.particle_ids().collect();
-        Box::new(animats_engine::SoftContact::new(5000.0, 2.0, &ids, &w.joined_pairs()).unwrap())
-    };
     let mut flowing = plain();
     flowing.add_force(rods(animats_engine::Current::Reef(
         animats_engine::ReefWater::default(),
@@ -429,7 +422,7 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     );
     let mut first = plain();
     first.add_force(rods(animats_engine::Current::Still));
-    let s = soft(&first);
+    let s = soft_contact(&first);
     first.add_force(s);
     let err = Batch::pack(&[&first], 1e-3).unwrap_err();
     assert_eq!(
@@ -437,7 +430,7 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "world 0: the user force `soft contact` is not in the GPU step yet"
     );
     let mut still = plain();
-    let s = soft(&still);
+    let s = soft_contact(&still);
     still.add_force(s);
     still.add_force(rods(animats_engine::Current::Still));
     still.add_force(rods(animats_engine::Current::Uniform(DVec3::X)));
