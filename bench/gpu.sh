@@ -4,8 +4,9 @@
 # 2 to 40), stepped by the engine on every core, by the C on every core
 # and by the GPU, every coordinate compared as bits; then whole
 # evaluations: 65,536 soft walkers (random oscillator genomes), 16,384
-# random evolved bodies (self-contact, spring muscles) and 16,384 with
-# neural brains reading touch sensors,
+# random evolved bodies (self-contact, spring muscles), 16,384 with
+# neural brains reading touch sensors and 8,192 gaits of the thesis's
+# quadruped (model 3) around its evolved walk,
 # each evaluated for 10 s by the engine on every core, by the C and by the
 # GPU, every fitness compared as bits; the throughput of each; last the
 # soft walker evolved on the GPU, 16,384 candidates a generation, against
@@ -57,7 +58,7 @@ for run in "65536 1000 20" "16384 1000 0"; do
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
-for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10"; do
+for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10" "quadruped 8192 10"; do
   echo "== gpu_evaluate $run"
   # shellcheck disable=SC2086
   "$E" $run

@@ -138,25 +138,27 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
 /// bits. Exit 2 for every refusal.
 #[test]
 fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
-    let o = animats(&[
-        "evaluate",
-        "scenes/quadruped3_gait.toml",
-        "--device",
-        "cuda",
-    ]);
+    // The quadruped with its scripted step (the thesis's experiment) acts
+    // by itself: refused by name.
+    let dir = scratch("device-bodies");
+    let dog = dir.join("dog.toml");
+    let gait = include_str!("../../../scenes/quadruped3_gait.toml");
+    assert!(gait.contains("demo_at = -1.0"));
+    std::fs::write(&dog, gait.replace("demo_at = -1.0", "demo_at = 2.0")).unwrap();
+    let dog = dog.to_str().unwrap();
+    let o = animats(&["evaluate", dog, "--device", "cuda"]);
     assert_eq!(o.status.code(), Some(2));
     let err = text(&o).1;
     assert!(
-        err.contains("scenes/quadruped3_gait.toml: --device cuda:")
+        err.contains(&format!("{dog}: --device cuda:"))
             && err.contains("the creature `dog`")
             && err.contains("not in the GPU evaluation yet"),
         "{err}"
     );
-    let dir = scratch("device-bodies");
     let out = dir.join("x");
     let o = animats(&[
         "evolve",
-        "scenes/quadruped3_gait.toml",
+        dog,
         "--device",
         "cuda",
         "--generations",

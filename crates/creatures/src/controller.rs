@@ -32,4 +32,10 @@ pub trait Actor: Send {
     fn status(&self) -> Option<Status> {
         None
     }
+    /// Whether `act` may ever change the world: `false` for a creature
+    /// whose body is driven only by the scene's controllers (a quadruped
+    /// with no demo), which the GPU evaluation can then step.
+    fn acts(&self) -> bool {
+        true
+    }
 }

@@ -8,8 +8,12 @@
 //! evaluations and creature-steps per second of each.
 //!
 //! `neural`: the same bodies with neural brains reading touch sensors.
+//! `quadruped`: the thesis's model 3 (`scenes/quadruped3_walk.toml`, 12
+//! oscillating leg springs, in air, its steps at 0.5 ms), its evolved gait
+//! and gaits around it, each gene moved by up to 5 % of its range (a late
+//! population of `animats evolve`: most walk, some fall).
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural] [COUNT] [SECONDS]
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped] [COUNT] [SECONDS]
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -24,6 +28,7 @@ use std::time::Instant;
 
 const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
+const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml");
 
 fn fail(e: impl std::fmt::Display) -> ! {
     eprintln!("gpu_evaluate: {e}");
@@ -44,6 +49,24 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
             .bounds()
             .iter()
             .map(|&(lo, hi)| rng.between(lo, hi))
+            .collect();
+        problem.scene(&g)
+    } else if kind == "quadruped" {
+        let text = QUADRUPED_WALK.replace("duration = 20.0", &format!("duration = {seconds}"));
+        let problem =
+            SceneProblem::parse(&text, "scenes/quadruped3_walk.toml").map_err(|e| e.to_string())?;
+        let g: Vec<f64> = problem
+            .start()
+            .iter()
+            .zip(problem.bounds())
+            .map(|(&x, &(lo, hi))| {
+                let moved = x + (hi - lo) * rng.between(-0.05, 0.05);
+                if k == 0 {
+                    x
+                } else {
+                    moved.clamp(lo, hi)
+                }
+            })
             .collect();
         problem.scene(&g)
     } else {
@@ -70,8 +93,10 @@ fn main() {
         .get(3)
         .map_or(Ok(10.0), |a| a.parse())
         .unwrap_or_else(|_| fail("SECONDS: a number"));
-    if !matches!(kind, "walker" | "bodies" | "neural") || !(1..=10_000_000).contains(&count) {
-        fail("usage: gpu_evaluate [walker|bodies|neural] [COUNT 1 to 10,000,000] [SECONDS]");
+    if !matches!(kind, "walker" | "bodies" | "neural" | "quadruped")
+        || !(1..=10_000_000).contains(&count)
+    {
+        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");

@@ -171,7 +171,7 @@ impl Rules {
             .evolve
             .as_ref()
             .ok_or("it has no [evolve] table: nothing to evaluate")?;
-        if let Some(a) = scene.actors.first() {
+        if let Some(a) = scene.actors.iter().find(|a| a.acts()) {
             let who = a
                 .status()
                 .map_or("a creature that acts by itself".into(), |s| {

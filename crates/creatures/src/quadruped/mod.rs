@@ -400,4 +400,8 @@ impl Actor for Quadruped {
             phase: None,
         })
     }
+
+    fn acts(&self) -> bool {
+        self.demo.is_some()
+    }
 }
