@@ -171,6 +171,10 @@ typedef struct {
     const double *rod_drag;     /* per rod: -0.5 C rho D, as forces/rod_drag.rs forms it */
     const double *fluid_current; /* 3 per fluid: its uniform current (0 in still water) */
     const double *rod_current;   /* 3 per rod: its fluid's uniform current (0 in still water) */
+    const long long *first_plane; /* per creature: its plane constraints, in the world's order */
+    const double *plane_param;    /* 7 per plane: point, unit normal, 1 if handled before the floor */
+    const long long *plane_first_particle; /* per plane, over the batch: its particles */
+    const int *plane_particle;    /* a particle, within the creature */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -602,19 +606,44 @@ AN_FN int an_floor_check(const an_batch *b, an_state st, long long n, const doub
     return deepest < -b->envelope ? AN_MISSED : AN_OCCURRING;
 }
 
+/* The flat floor's check's records of a trial of step h (`Hit`): for
+ * each sphere below the plane its mean normal acceleration over the
+ * trial, NaN for the others, in rec[3 i]. An event handled before the
+ * floor (a plane constraint) may move the trial after the check: the
+ * floor then handles the spheres its check found, with their
+ * accelerations as found. */
+AN_FN void an_floor_note(an_state st, long long n, double h, const double *v0, const double *x1,
+                         const double *v1, double *rec) {
+    for (long long i = 0; i < n; i++) {
+        double gap = x1[3 * i + 1] - st.r[i];
+        int hit = gap < 0.0 && st.w[i] != 0.0;
+        rec[3 * i] = hit ? (v1[3 * i + 1] - v0[3 * i + 1]) / h : an_from_bits(0x7ff8000000000000ULL);
+    }
+}
+
 /* The flat floor's handling of a trial of step h (part of the step
  * `step`): each sphere below the plane moved up onto it and its impact
- * resolved (`resolve` and `normal_speed`). */
+ * resolved (`resolve` and `normal_speed`); the spheres and accelerations
+ * of `rec` (an_floor_note) where it is not NULL. */
 AN_FN void an_floor_handle(const an_batch *b, an_state st, long long p0, long long n, double h,
-                           double step, const double *v0, double *x1, double *v1) {
+                           double step, const double *v0, double *x1, double *v1,
+                           const double *rec) {
     for (long long i = 0; i < n; i++) {
         long long p = p0 + i;
         double r = st.r[i];
-        double gap = x1[3 * i + 1] - r;
-        if (!(gap < 0.0) || st.w[i] == 0.0) {
-            continue;
+        double accel;
+        if (rec) {
+            accel = rec[3 * i];
+            if (accel != accel) {
+                continue;
+            }
+        } else {
+            double gap = x1[3 * i + 1] - r;
+            if (!(gap < 0.0) || st.w[i] == 0.0) {
+                continue;
+            }
+            accel = (v1[3 * i + 1] - v0[3 * i + 1]) / h;
         }
-        double accel = (v1[3 * i + 1] - v0[3 * i + 1]) / h;
         double shift = b->flight_shift * accel * step;
         double e = b->restitution[p];
         double depth = r - x1[3 * i + 1];
@@ -634,6 +663,71 @@ AN_FN void an_floor_handle(const an_batch *b, an_state st, long long p0, long lo
         /* (+inf as bits: NVRTC has no math.h, hence no INFINITY) */
         double flight = accel < 0.0 ? 2.0 * rebound / -accel : an_from_bits(0x7ff0000000000000ULL);
         v1[3 * i + 1] = (at_plane < b->rest_speed || flight <= step) ? 0.0 : rebound;
+    }
+}
+
+/* Which of creature c's planes a trial leaves (events/plane_constraint.rs
+ * `check`: a particle whose offset from the plane, or whose velocity,
+ * along its normal is not 0), bit k for its k-th plane. */
+AN_FN unsigned long long an_planes_check(const an_batch *b, long long c, const double *x1,
+                                         const double *v1) {
+    unsigned long long off = 0;
+    long long k0 = b->first_plane[c];
+    for (long long k = k0; k < b->first_plane[c + 1]; k++) {
+        const double *pt = b->plane_param + 7 * k, *nrm = pt + 3;
+        for (long long j = b->plane_first_particle[k]; j < b->plane_first_particle[k + 1]; j++) {
+            long long i = b->plane_particle[j];
+            double d[3];
+            for (int e = 0; e < 3; e++) {
+                d[e] = x1[3 * i + e] - pt[e];
+            }
+            if (an_dot(d, nrm) != 0.0 || an_dot(v1 + 3 * i, nrm) != 0.0) {
+                off |= 1ULL << (k - k0);
+                break;
+            }
+        }
+    }
+    return off;
+}
+
+/* Whether any of creature c's planes in `off` comes before the floor's
+ * collisions. */
+AN_FN int an_planes_before(const an_batch *b, long long c, unsigned long long off) {
+    long long k0 = b->first_plane[c];
+    for (long long k = k0; off != 0 && k < b->first_plane[c + 1]; k++) {
+        if (((off >> (k - k0)) & 1ULL) && b->plane_param[7 * k + 6] != 0.0) {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* `handle` of creature c's planes in `off` that come before the floor's
+ * collisions (before = 1) or after them (0): each particle's position and
+ * velocity projected onto the plane, x -= n ((x - point) . n), v -= n (v . n). */
+AN_FN void an_planes_handle(const an_batch *b, long long c, unsigned long long off, int before,
+                            double *x1, double *v1) {
+    long long k0 = b->first_plane[c];
+    for (long long k = k0; k < b->first_plane[c + 1]; k++) {
+        const double *pt = b->plane_param + 7 * k, *nrm = pt + 3;
+        if (!((off >> (k - k0)) & 1ULL) || (pt[6] != 0.0) != (before != 0)) {
+            continue;
+        }
+        for (long long j = b->plane_first_particle[k]; j < b->plane_first_particle[k + 1]; j++) {
+            long long i = b->plane_particle[j];
+            double *x = x1 + 3 * i, *v = v1 + 3 * i, d[3];
+            for (int e = 0; e < 3; e++) {
+                d[e] = x[e] - pt[e];
+            }
+            double along = an_dot(d, nrm);
+            for (int e = 0; e < 3; e++) {
+                x[e] = x[e] - nrm[e] * along;
+            }
+            double speed = an_dot(v, nrm);
+            for (int e = 0; e < 3; e++) {
+                v[e] = v[e] - nrm[e] * speed;
+            }
+        }
     }
 }
 
@@ -677,9 +771,21 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
             }
             state = AN_OCCURRING; /* cannot split further */
         }
-        if (state != AN_NONE) {
-            an_floor_handle(b, st, p0, n, h, dt, v, x1, v1);
+        /* Every event checks the trial before any handles it, then each
+         * handles it in the world's order. */
+        unsigned long long off = an_planes_check(b, c, x1, v1);
+        const double *rec = 0;
+        if (an_planes_before(b, c, off)) {
+            if (state != AN_NONE) {
+                an_floor_note(st, n, h, v, x1, v1, f);
+                rec = f; /* (the forces are spent) */
+            }
+            an_planes_handle(b, c, off, 1, x1, v1);
         }
+        if (state != AN_NONE) {
+            an_floor_handle(b, st, p0, n, h, dt, v, x1, v1, rec);
+        }
+        an_planes_handle(b, c, off, 0, x1, v1);
         if (!an_finite(x1, m3) || !an_finite(v1, m3)) {
             return 0;
         }

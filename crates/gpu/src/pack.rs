@@ -2,7 +2,9 @@
 //! each creature's particles and springs a contiguous run found through
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
-use animats_engine::{DVec3, FloorCollision, IntegratorKind, RodDrag, SoftContact, World};
+use animats_engine::{
+    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, World,
+};
 use std::os::raw::{c_double, c_int, c_longlong};
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
@@ -128,6 +130,10 @@ pub(crate) struct Raw {
     rod_drag: *const c_double,
     fluid_current: *const c_double,
     rod_current: *const c_double,
+    first_plane: *const c_longlong,
+    plane_param: *const c_double,
+    plane_first_particle: *const c_longlong,
+    plane_particle: *const c_int,
 }
 
 extern "C" {
@@ -249,6 +255,14 @@ pub struct Batch {
     /// still water).
     fluid_current: Vec<f64>,
     rod_current: Vec<f64>,
+    /// Plane constraints (events/plane_constraint.rs): per creature its
+    /// planes, each one's point, unit normal and 1 if it comes before the
+    /// floor's collisions among the world's events (7 numbers), and its
+    /// particles.
+    first_plane: Vec<i64>,
+    plane_param: Vec<f64>,
+    plane_first_particle: Vec<i64>,
+    plane_particle: Vec<i32>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -330,6 +344,10 @@ impl Batch {
             rod_drag: Vec::new(),
             fluid_current: Vec::new(),
             rod_current: Vec::new(),
+            first_plane: vec![0],
+            plane_param: Vec::new(),
+            plane_first_particle: vec![0],
+            plane_particle: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         for (k, w) in worlds.iter().enumerate() {
@@ -428,6 +446,20 @@ impl Batch {
                     b.rod_current.extend(uniform(&rd.current).to_array());
                 }
             }
+            // Planes, in the order of the world's events, each marked
+            // where it is handled before the floor's collisions.
+            let mut floor_seen = false;
+            for e in w.events() {
+                floor_seen |= e.as_any().is::<FloorCollision>();
+                if let Some(pc) = e.as_any().downcast_ref::<PlaneConstraint>() {
+                    b.plane_param.extend(pc.point().to_array());
+                    b.plane_param.extend(pc.normal().to_array());
+                    b.plane_param.push(if floor_seen { 0.0 } else { 1.0 });
+                    b.plane_particle
+                        .extend(pc.particles().iter().map(|p| p.index() as i32));
+                    b.plane_first_particle.push(b.plane_particle.len() as i64);
+                }
+            }
             b.radius.extend_from_slice(&props.radius);
             b.volume.extend_from_slice(&props.volume);
             b.restitution.extend_from_slice(&props.restitution);
@@ -441,6 +473,7 @@ impl Batch {
             b.first_push.push(b.push_particle.len() as i64);
             b.first_pair.push(b.pair_a.len() as i64);
             b.first_rod.push(b.rod_a.len() as i64);
+            b.first_plane.push(b.plane_first_particle.len() as i64 - 1);
             b.ev.fixed.extend(props.fixed.iter().map(|&f| i32::from(f)));
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
@@ -653,6 +686,10 @@ impl Batch {
             Array::RodDrag => F64(&self.rod_drag),
             Array::FluidCurrent => F64(&self.fluid_current),
             Array::RodCurrent => F64(&self.rod_current),
+            Array::FirstPlane => I64(&self.first_plane),
+            Array::PlaneParam => F64(&self.plane_param),
+            Array::PlaneFirstParticle => I64(&self.plane_first_particle),
+            Array::PlaneParticle => I32(&self.plane_particle),
         }
     }
 
@@ -810,9 +847,17 @@ impl Batch {
             rod_drag: c(Array::RodDrag),
             fluid_current: c(Array::FluidCurrent),
             rod_current: c(Array::RodCurrent),
+            first_plane: l(Array::FirstPlane),
+            plane_param: c(Array::PlaneParam),
+            plane_first_particle: l(Array::PlaneFirstParticle),
+            plane_particle: i(Array::PlaneParticle),
         }
     }
 }
+
+/// The most plane constraints a world may hold for the C (it notes which
+/// of them a trial leaves, before handling any event, in one 64-bit word).
+const MAX_PLANES: usize = 64;
 
 /// Whether the C steps world `w` as the engine does: `Err` names the first
 /// thing it holds that the C does not step.
@@ -827,10 +872,21 @@ fn supported(w: &World) -> Result<(), String> {
         | IntegratorKind::Symplectic => {}
         other => return refuse(&format!("the {other:?} integrator")),
     }
+    let mut planes = 0;
+    let mut floors = 0;
     for e in w.events() {
-        if !e.as_any().is::<FloorCollision>() {
+        let any = e.as_any();
+        planes += usize::from(any.is::<PlaneConstraint>());
+        floors += usize::from(any.is::<FloorCollision>());
+        if !any.is::<FloorCollision>() && !any.is::<PlaneConstraint>() {
             return refuse(&format!("the event `{}`", e.name()));
         }
+    }
+    if floors > 1 {
+        return refuse("a second floor");
+    }
+    if planes > MAX_PLANES {
+        return refuse(&format!("more than {MAX_PLANES} plane constraints"));
     }
     if f.gravity().is_some_and(|g| g.targets != Targets::All) {
         return refuse("gravity on some particles only");
@@ -994,11 +1050,15 @@ pub(crate) enum Array {
     RodDrag,
     FluidCurrent,
     RodCurrent,
+    FirstPlane,
+    PlaneParam,
+    PlaneFirstParticle,
+    PlaneParticle,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 105] = [
+    pub(crate) const ALL: [Array; 109] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1104,6 +1164,10 @@ impl Array {
         Array::RodDrag,
         Array::FluidCurrent,
         Array::RodCurrent,
+        Array::FirstPlane,
+        Array::PlaneParam,
+        Array::PlaneFirstParticle,
+        Array::PlaneParticle,
     ];
 }
 

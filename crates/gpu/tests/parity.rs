@@ -245,6 +245,85 @@ fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Bodies held in planes (events/plane_constraint.rs, the roobot's planar
+/// motion) falling onto the floor: half in a vertical plane at a random
+/// heading (the roobot's), half in a plane slanted at random, which the
+/// floor's handling and the plane's projection both move (their order, the
+/// world's order of events, matters: half the worlds add the plane before
+/// the floor), each holding every other particle of its body, and every
+/// third world a second plane holding its first particle. Every step
+/// leaves a plane by rounding, so every step projects.
+#[test]
+fn bodies_held_in_planes_are_the_engine_s_to_the_bit() {
+    // Body k of a batch, held in its planes or (`held` false) free.
+    let body = |kind, k: u64, held: bool| {
+        let mut rng = Random::for_entry(13, k);
+        let n = 2 + (rng.uniform() * 39.0) as usize;
+        let mut w = random_body(&mut rng, n, true, k.is_multiple_of(2), kind).unwrap();
+        let ids: Vec<_> = w.particle_ids().collect();
+        for &p in &ids {
+            let x = w.position(p) + DVec3::new(0.0, 1.2, 0.0);
+            w.set_position(p, x).unwrap();
+        }
+        let normal = if k % 4 < 2 {
+            let h = rng.between(0.0, std::f64::consts::TAU);
+            DVec3::new(
+                animats_engine::math::sin(h),
+                0.0,
+                animats_engine::math::cos(h),
+            )
+        } else {
+            random_vec(&mut rng, 1.0)
+        };
+        let second = random_vec(&mut rng, 1.0);
+        let floor_first = k.is_multiple_of(2);
+        if floor_first {
+            w.add_floor(FloorDef::default()).unwrap();
+        }
+        if held {
+            w.add_event(Box::new(animats_engine::PlaneConstraint::new(
+                w.position(ids[0]),
+                normal,
+                ids.iter().copied().step_by(2).collect(),
+            )));
+        }
+        if !floor_first {
+            w.add_floor(FloorDef::default()).unwrap();
+        }
+        if held && k.is_multiple_of(3) {
+            w.add_event(Box::new(animats_engine::PlaneConstraint::new(
+                DVec3::ZERO,
+                second,
+                vec![ids[0]],
+            )));
+        }
+        w.add_fluid(FluidMedium::air()).unwrap();
+        w
+    };
+    for kind in INTEGRATORS {
+        let mut worlds: Vec<World> = (0..24).map(|k| body(kind, k, true)).collect();
+        assert_same(&mut worlds, 1e-3, 500, 4, &format!("planes, {kind:?}"));
+        // The planes matter: free, the same bodies end elsewhere.
+        let elsewhere = (0..24)
+            .filter(|&k| {
+                let mut free = body(kind, k, false);
+                for _ in 0..2000 {
+                    if free.step(1e-3).is_err() {
+                        break;
+                    }
+                }
+                free.state().pos != worlds[k as usize].state().pos
+            })
+            .count();
+        let backtracked: u64 = worlds.iter().map(|w| w.stats().backtracks).sum();
+        eprintln!(
+            "planes, {kind:?}: {backtracked} backtracks; {elsewhere} of 24 end elsewhere free"
+        );
+        assert_eq!(elsewhere, 24, "{kind:?}");
+        assert!(backtracked > 0, "{kind:?}: no collision was located");
+    }
+}
+
 /// Bodies whose spheres collide with each other through soft (penalty)
 /// contact, every pair but those a spring joins, as an evolved body's
 /// `[contacts] model = "penalty"` builds it, dropped onto the floor: the
@@ -446,6 +525,27 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         err,
         "world 0: a fluid's current other than a uniform one is not in the GPU step yet"
     );
+
+    // At most 64 planes a world (the C notes which a trial leaves in one
+    // word); one floor.
+    let mut planar = plain();
+    for _ in 0..65 {
+        planar.add_event(Box::new(animats_engine::PlaneConstraint::new(
+            DVec3::ZERO,
+            DVec3::Z,
+            vec![animats_engine::ParticleId::from_index(0)],
+        )));
+    }
+    let err = Batch::pack(&[&planar], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: more than 64 plane constraints is not in the GPU step yet"
+    );
+    let mut floors = plain();
+    floors.add_floor(FloorDef::default()).unwrap();
+    floors.add_floor(FloorDef::default()).unwrap();
+    let err = Batch::pack(&[&floors], 1e-3).unwrap_err();
+    assert_eq!(err, "world 0: a second floor is not in the GPU step yet");
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);

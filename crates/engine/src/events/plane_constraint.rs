@@ -36,6 +36,16 @@ impl PlaneConstraint {
     pub fn normal(&self) -> DVec3 {
         self.normal
     }
+
+    /// The point the plane passes through.
+    pub fn point(&self) -> DVec3 {
+        self.point
+    }
+
+    /// The particles it holds, in its order.
+    pub fn particles(&self) -> &[ParticleId] {
+        &self.particles
+    }
 }
 
 impl DiscreteEvent for PlaneConstraint {
