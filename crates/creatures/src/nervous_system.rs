@@ -37,6 +37,11 @@ pub trait Senses: Send {
         actuators: &[(String, AnyActuator)],
         out: &mut [f64],
     );
+    /// Itself, for those that expose what they read (the GPU's packer
+    /// reads the roobot's); a user's senses need not say.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }
 
 /// Where a controller's inputs come from.

@@ -13,7 +13,11 @@
 //! and gaits around it, each gene moved by up to 5 % of its range (a late
 //! population of `animats evolve`: most walk, some fall).
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped] [COUNT] [SECONDS]
+//! `roobot`: the thesis's hopper (`scenes/hop_evolver.toml`, RK4 at 8 ms,
+//! held in its plane, its hopping FSM) with the evolved parameters and
+//! parameters around them, each moved by up to 2 % of its range.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot] [COUNT] [SECONDS]
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -29,6 +33,7 @@ use std::time::Instant;
 const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
 const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml");
+const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
 
 fn fail(e: impl std::fmt::Display) -> ! {
     eprintln!("gpu_evaluate: {e}");
@@ -51,16 +56,25 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
             .map(|&(lo, hi)| rng.between(lo, hi))
             .collect();
         problem.scene(&g)
-    } else if kind == "quadruped" {
-        let text = QUADRUPED_WALK.replace("duration = 20.0", &format!("duration = {seconds}"));
-        let problem =
-            SceneProblem::parse(&text, "scenes/quadruped3_walk.toml").map_err(|e| e.to_string())?;
+    } else if kind == "quadruped" || kind == "roobot" {
+        let (text, file, spread) = if kind == "quadruped" {
+            (
+                QUADRUPED_WALK.to_string(),
+                "scenes/quadruped3_walk.toml",
+                0.05,
+            )
+        } else {
+            let evolved = HOP_EVOLVER.replace("params = \"initial\"", "params = \"evolved\"");
+            (evolved, "scenes/hop_evolver.toml", 0.02)
+        };
+        let text = text.replace("duration = 20.0", &format!("duration = {seconds}"));
+        let problem = SceneProblem::parse(&text, file).map_err(|e| e.to_string())?;
         let g: Vec<f64> = problem
             .start()
             .iter()
             .zip(problem.bounds())
             .map(|(&x, &(lo, hi))| {
-                let moved = x + (hi - lo) * rng.between(-0.05, 0.05);
+                let moved = x + (hi - lo) * rng.between(-spread, spread);
                 if k == 0 {
                     x
                 } else {
@@ -93,10 +107,12 @@ fn main() {
         .get(3)
         .map_or(Ok(10.0), |a| a.parse())
         .unwrap_or_else(|_| fail("SECONDS: a number"));
-    if !matches!(kind, "walker" | "bodies" | "neural" | "quadruped")
-        || !(1..=10_000_000).contains(&count)
+    if !matches!(
+        kind,
+        "walker" | "bodies" | "neural" | "quadruped" | "roobot"
+    ) || !(1..=10_000_000).contains(&count)
     {
-        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped] [COUNT 1 to 10,000,000] [SECONDS]");
+        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");

@@ -125,8 +125,20 @@ AN_FN double an_angle_at(const double *a, const double *j, const double *b) {
     return an_atan2(sqrt(an_dot(n, n)), an_dot(ra, rb));
 }
 
-/* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`). */
-enum { AN_S_HEIGHT = 0, AN_S_SPEED = 1, AN_S_TOUCH = 2, AN_S_LENGTH = 3, AN_S_ANGLE = 4, AN_S_TILT = 5 };
+/* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`; then the
+ * roobot's own: sensors/height.rs, tilt.rs, touchdown.rs; its speed
+ * sensor is AN_S_SPEED mapped from [0, 1]). */
+enum {
+    AN_S_HEIGHT = 0,
+    AN_S_SPEED = 1,
+    AN_S_TOUCH = 2,
+    AN_S_LENGTH = 3,
+    AN_S_ANGLE = 4,
+    AN_S_TILT = 5,
+    AN_S_CLEARANCE = 6, /* HeightSensor: the clearance above the flat floor, y - r */
+    AN_S_LEG_ANGLE = 7, /* TiltSensor: 0.5 + gain atan2(d . forward, d.y), d = b - a */
+    AN_S_TOUCHDOWN = 8  /* TouchdownSensor: (v + sqrt(v^2 + 2 g h)) / g */
+};
 
 /* ScaledSensor::level of sensor q (over the batch) of the creature whose
  * state is st: the probe's reading mapped from [min, max] onto [0, 1]. */
@@ -137,6 +149,17 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
     const double *pa = x + 3 * ids[0], *pb = x + 3 * ids[1], *pc = x + 3 * ids[2];
     double reading, d[3];
     switch (b->sensor_kind[q]) {
+    case AN_S_CLEARANCE:
+        return an_unit(pa[1] - st.r[ids[0]]);
+    case AN_S_LEG_ANGLE:
+        for (int k = 0; k < 3; k++) {
+            d[k] = pb[k] - pa[k];
+        }
+        return an_unit(0.5 + param[3] * an_atan2(an_dot(d, param), d[1]));
+    case AN_S_TOUCHDOWN: {
+        double h = an_unit(pa[1] - st.r[ids[0]]), vy = v[3 * ids[0] + 1], g = param[3];
+        return an_unit((vy + sqrt(vy * vy + 2.0 * g * h)) / g);
+    }
     case AN_S_HEIGHT:
         reading = pa[1];
         break;
@@ -334,6 +357,93 @@ AN_FN void an_fsm(const an_batch *b, long long c, long long m, double t, double 
     an_net_outputs(b, c, u0, m, levels, dt);
 }
 
+/* f64::max and f64::min: a NaN operand gives the other; of equal ones
+ * (zeros of either sign) the second, as on x86-64. */
+AN_FN double an_maxnum(double a, double b) {
+    if (a != a) {
+        return b;
+    }
+    if (b != b) {
+        return a;
+    }
+    return a > b ? a : b;
+}
+AN_FN double an_minnum(double a, double b) {
+    if (a != a) {
+        return b;
+    }
+    if (b != b) {
+        return a;
+    }
+    return a < b ? a : b;
+}
+
+/* The roobot's hopping FSM m (a network entry of kind 4) of creature c,
+ * whose state is st (roobot/fsm.rs `HopFsm::step`, Appendix B's
+ * HopBehaviour): reads its four sensors, the hip's velocity along the
+ * forward direction and the leg's level; orders each of leg, hip and ankle
+ * to keep its level (NaN), return to its initial level, or take a level;
+ * the state changes take effect on the next step. Its numbers: the 14
+ * parameters, forward x, y, z, the hip, the three initial levels; its
+ * scratch: the state (0 stance, 1 leap, 2 launch, 3 flight). */
+AN_FN void an_hop(const an_batch *b, an_state st, long long c, long long m, double dt) {
+    long long u0 = b->first_muscle[c], q0 = b->first_sensor[c];
+    const double *p = b->net_weight + b->net_first_weight[m];
+    const double *fwd = p + 14, *init = p + 18;
+    long long hip = (long long)p[17];
+    const int *in = b->net_input + b->net_first_input[m];
+    double height = b->sensor_level[q0 + in[0]], angle = b->sensor_level[q0 + in[1]];
+    double speed = b->sensor_level[q0 + in[2]], touchdown = b->sensor_level[q0 + in[3]];
+    double hip_velocity = an_dot(st.v + 3 * hip, fwd);
+    long long o0 = b->net_first_output[m];
+    double leg_level = b->muscle_level[u0 + b->net_output_muscle[o0]];
+    double *state = b->net_scratch + b->net_first_scratch[m];
+    const double keep = an_from_bits(0x7ff8000000000000ULL);
+    double out[3] = {keep, keep, keep};
+    switch ((int)state[0]) {
+    case 0: /* stance */
+        if (angle < p[1]) {
+            double rate = p[3] * (leg_level - p[0]) / (p[1] - angle);
+            double leg = an_maxnum(p[0], leg_level - rate * dt);
+            double ankle = 0.5 + p[4] * (p[1] - angle) + p[5] * (p[2] - speed);
+            out[0] = an_unit(leg);
+            out[1] = init[1];
+            out[2] = an_unit(ankle);
+        } else {
+            state[0] = 1.0;
+            out[1] = init[1];
+            out[2] = init[2];
+        }
+        break;
+    case 1: /* leap */
+        if (leg_level < p[6]) {
+            out[0] = an_unit(an_minnum(p[6], leg_level + p[7] * dt));
+        } else {
+            state[0] = 2.0;
+        }
+        break;
+    case 2: /* launch */
+        if (height < p[9]) {
+            out[0] = an_unit(an_maxnum(p[10], leg_level - p[8] * dt));
+        } else {
+            state[0] = 3.0;
+        }
+        break;
+    default: /* flight */
+        if (height > 0.0) {
+            double target = 0.5 + an_unit(-p[12] * hip_velocity);
+            double to = 0.5 + p[13] * (target - angle) / (touchdown + 0.05);
+            out[0] = an_unit(an_maxnum(p[10], leg_level - p[11] * dt));
+            out[1] = an_unit(to);
+            out[2] = init[2];
+        } else {
+            state[0] = 0.0;
+        }
+        break;
+    }
+    an_net_outputs(b, c, u0, m, out, dt);
+}
+
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order. */
 AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double dt) {
@@ -352,6 +462,8 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
             an_network(b, c, b->ctrl_index[k], t, dt);
         } else if (b->ctrl_kind[k] == 2) {
             an_ctrnn(b, c, b->ctrl_index[k], t, dt);
+        } else if (b->ctrl_kind[k] == 4) {
+            an_hop(b, st, c, b->ctrl_index[k], dt);
         } else {
             an_fsm(b, c, b->ctrl_index[k], t, dt);
         }

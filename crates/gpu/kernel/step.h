@@ -140,7 +140,7 @@ typedef struct {
     const double *sensor_param; /* 5 per sensor: axis x, y, z, min, max */
     double *sensor_level; /* per sensor: its level this step */
     const long long *first_ctrl; /* per creature: its controllers, in order */
-    const int *ctrl_kind; /* 0: an oscillator, 1: a neural network, 2: a CTRNN, 3: an FSM (network entries) */
+    const int *ctrl_kind; /* 0: an oscillator, 1: a neural network, 2: a CTRNN, 3: an FSM, 4: a roobot's hopping FSM (network entries) */
     const int *ctrl_index; /* the oscillator or network, over the batch */
     const long long *net_first_layer; /* per network, over the batch: its layer sizes */
     const int *layer_size; /* inputs (clock included) first, outputs last */

@@ -5,11 +5,12 @@
 //! `animats_scene::evaluate::evaluate` does, returning the same
 //! [`Evaluation`] to the bit.
 //!
-//! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt),
-//! actuators (a spring's rest length, an angle joint's rest angle, a
+//! Covered: `[[sensor]]`s (height, speed, touch, length, angle, tilt) and
+//! the roobot's own (foot clearance, time till touchdown, leg angle, hip
+//! speed), actuators (a spring's rest length, an angle joint's rest angle, a
 //! torque joint's torque, a constant force's scale; with or without a
 //! `rate`, gated or not) and the positive work they do, oscillator, neural,
-//! CTRNN and FSM brains, the centre of the particles that count,
+//! CTRNN and FSM brains and the roobot's hopping FSM, the centre of the particles that count,
 //! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
 //! scene, the `[archive]` measures and `[evolve] terms`, and every term of
 //! the fitness (time, distance, energy, target, measures). Anything else a
@@ -21,9 +22,11 @@ use animats_creatures::actuators::AnyActuator;
 use animats_creatures::brains::ctrnn::Ctrnn;
 use animats_creatures::brains::fsm::{Condition, Fsm};
 use animats_creatures::brains::neural::Neural;
-use animats_creatures::nervous_system::{Inputs, Wired};
+use animats_creatures::nervous_system::{Inputs, NervousSystem, Wired};
+use animats_creatures::roobot::{FsmSenses, HopFsm, HopState};
 use animats_creatures::sensor::Sensor;
 use animats_creatures::sensors::probe::{Probe, ScaledSensor};
+use animats_creatures::sensors::{HeightSensor, SpeedSensor, TiltSensor, TouchdownSensor};
 use animats_engine::{DVec3, ParticleId, World};
 use animats_scene::archive::{Measure, Recorder};
 use animats_scene::evaluate::{Batches, Ended, Evaluation};
@@ -178,7 +181,7 @@ impl Rules {
                     format!("the creature `{}`", s.name)
                 });
             return Err(format!(
-                "{who} (roobot, quadruped, jellyfish or bubble column) is not in the GPU evaluation yet"
+                "{who} (a jellyfish, a bubble column, a quadruped with its scripted step) is not in the GPU evaluation yet"
             ));
         }
         let nervous = &scene.nervous;
@@ -227,6 +230,9 @@ impl Rules {
         }
         for c in &nervous.controllers {
             let shift = |o: usize| nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
+            if self.add_hop(c, nervous, &shift)? {
+                continue;
+            }
             if self.add_network(c, &shift)? {
                 continue;
             }
@@ -235,7 +241,7 @@ impl Rules {
             let n = c.outputs.len();
             if kind != "oscillator" || g.len() != 1 + 3 * n {
                 return Err(format!(
-                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks, CTRNNs and FSMs are",
+                    "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks, CTRNNs, FSMs and the roobot's hopping FSM are",
                     c.name
                 ));
             }
@@ -419,12 +425,103 @@ impl Rules {
         Ok(true)
     }
 
-    /// Appends sensor `name` (a scene's `[[sensor]]`).
+    /// Appends the roobot's hopping FSM `c` (thesis §3.2.1.4, a network
+    /// entry of kind 4): its inputs the roobot's four sensors; its numbers
+    /// the 14 parameters, the forward direction, the hip (whose velocity
+    /// along it the FSM reads) and the leg's, hip's and ankle's initial
+    /// levels; its scratch the state. `Ok(false)` if `c` is not one.
+    fn add_hop(
+        &mut self,
+        c: &Wired,
+        nervous: &NervousSystem,
+        shift: &dyn Fn(usize) -> f64,
+    ) -> Result<bool, String> {
+        let Some(hop) = c.brain.as_any().and_then(|a| a.downcast_ref::<HopFsm>()) else {
+            return Ok(false);
+        };
+        let senses = match &c.inputs {
+            Inputs::Senses(s) => s.as_any().and_then(|a| a.downcast_ref::<FsmSenses>()),
+            Inputs::Sensors(_) => None,
+        };
+        let Some(senses) = senses.filter(|s| {
+            c.outputs == [s.actuators, s.actuators + 1, s.actuators + 2]
+                && s.sensors + 4 <= nervous.sensors.len()
+        }) else {
+            return Err(format!(
+                "the controller `{}` (hop) reads senses other than a roobot's: not in the GPU evaluation yet",
+                c.name
+            ));
+        };
+        self.ctrl_kind.push(4);
+        self.ctrl_index.push(self.net_clock.len() as i32);
+        self.net_weight.extend(&hop.params.0);
+        self.net_weight.extend(senses.speed.forward.to_array());
+        self.net_weight.push(senses.speed.particle.index() as f64);
+        for &o in &c.outputs {
+            self.net_weight.push(nervous.actuators[o].1.initial_level());
+        }
+        self.net_clock.push(f64::NAN);
+        self.net_scratch.push(match hop.state() {
+            HopState::Stance => 0.0,
+            HopState::Leap => 1.0,
+            HopState::Launch => 2.0,
+            HopState::Flight => 3.0,
+        });
+        self.net_first_scratch.push(self.net_scratch.len() as i64);
+        self.net_first_layer.push(self.layer_size.len() as i64);
+        self.net_first_weight.push(self.net_weight.len() as i64);
+        self.net_first_neuron.push(self.neuron_state.len() as i64);
+        self.net_input
+            .extend((0..4).map(|k| (senses.sensors + k) as i32));
+        self.net_first_input.push(self.net_input.len() as i64);
+        for &o in &c.outputs {
+            self.net_output_muscle.push(o as i32);
+            self.net_output_shift.push(shift(o));
+        }
+        self.net_first_output
+            .push(self.net_output_muscle.len() as i64);
+        Ok(true)
+    }
+
+    /// Appends sensor `name`: a scene's `[[sensor]]`, or one of a
+    /// roobot's own (its foot's height and time till touchdown, its leg's
+    /// angle, its hip's forward speed).
     fn add_sensor(&mut self, name: &str, sensor: &dyn Sensor) -> Result<(), String> {
-        let Some(s) = sensor
-            .as_any()
-            .and_then(|a| a.downcast_ref::<ScaledSensor>())
-        else {
+        let any = sensor.as_any();
+        let own =
+            |kind: i32, particles: [i32; 3], axis: DVec3, p: [f64; 2]| (kind, particles, axis, p);
+        let roobot = if let Some(h) = any.and_then(|a| a.downcast_ref::<HeightSensor>()) {
+            Some(own(
+                6,
+                [h.particle.index() as i32, 0, 0],
+                DVec3::ZERO,
+                [0.0; 2],
+            ))
+        } else if let Some(t) = any.and_then(|a| a.downcast_ref::<TiltSensor>()) {
+            let ends = [t.base.index() as i32, t.tip.index() as i32, 0];
+            Some(own(7, ends, t.forward, [t.gain, 0.0]))
+        } else if let Some(v) = any.and_then(|a| a.downcast_ref::<SpeedSensor>()) {
+            // A speed probe mapped from [0, 1]: (v - 0) / (1 - 0) is v.
+            Some(own(
+                1,
+                [v.particle.index() as i32, 0, 0],
+                v.forward,
+                [0.0, 1.0],
+            ))
+        } else if let Some(t) = any.and_then(|a| a.downcast_ref::<TouchdownSensor>()) {
+            let foot = [t.height.particle.index() as i32, 0, 0];
+            Some(own(8, foot, DVec3::ZERO, [t.g, 0.0]))
+        } else {
+            None
+        };
+        if let Some((kind, particles, axis, p)) = roobot {
+            self.sensor_kind.push(kind);
+            self.sensor_particle.extend(particles);
+            self.sensor_param.extend(axis.to_array());
+            self.sensor_param.extend(p);
+            return Ok(());
+        }
+        let Some(s) = any.and_then(|a| a.downcast_ref::<ScaledSensor>()) else {
             return Err(format!(
                 "the sensor `{name}` (a creature's own) is not in the GPU evaluation yet"
             ));

@@ -17,6 +17,7 @@ const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
 const WALKER_CTRNN: &str = include_str!("../../../scenes/walker_ctrnn.toml");
 const QUADRUPED: &str = include_str!("../../../scenes/quadruped3_gait.toml");
+const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
 const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml");
 
 /// Evaluates `scenes` with the engine and, packed in one batch, with the
@@ -623,6 +624,56 @@ fn the_quadruped_s_gaits_are_the_engine_s_to_the_bit() {
             got.iter().map(|e| &e.ended).collect::<Vec<_>>()
         );
     }
+}
+
+#[test]
+fn the_thesis_s_roobot_is_the_engine_s_to_the_bit() {
+    // scenes/hop_evolver.toml, the thesis's experiment (RK4 at 8 ms, 20 s,
+    // air, the floor's envelope of 1 cm): the roobot held in its plane,
+    // its own sensors (the foot's height and time till touchdown, the
+    // leg's angle, the hip's speed), its hopping FSM, the hip motor gated
+    // to flight and the ankle's to stance, the thesis's end rules.
+    // Appendix B's starting parameters, the evolved ones and random ones
+    // about them; then facing 0.7 rad (a plane off the axes, which every
+    // step leaves by rounding) and at the thesis's step halved.
+    let evolved = HOP_EVOLVER.replace("params = \"initial\"", "params = \"evolved\"");
+    let turned = HOP_EVOLVER.replace(
+        "params = \"initial\"",
+        "params = \"initial\"\nheading = 0.7",
+    );
+    let halved = HOP_EVOLVER.replace("dt = 0.008", "dt = 0.004");
+    for (what, text, n) in [
+        ("initial", HOP_EVOLVER.to_string(), 24),
+        ("evolved", evolved.clone(), 8),
+        ("turned", turned, 8),
+        ("halved", halved, 8),
+    ] {
+        let got = assert_same(genomes(&text, n, 3), &format!("roobot, {what}"));
+        assert!(distinct_distances(&got) > n / 2, "{what}: {got:?}");
+    }
+    // Gaits about the evolved one (each gene moved by up to 2 % of its
+    // range): they hop 3 to 20 s, 170 s in all (some the whole 20 s),
+    // through hundreds of landings.
+    let problem = SceneProblem::parse(&evolved, "hop_evolver.toml").unwrap();
+    let mut rng = Random::for_entry(5, 0);
+    let scenes: Vec<Scene> = (0..16)
+        .map(|_| {
+            let g: Vec<f64> = problem
+                .start()
+                .iter()
+                .zip(problem.bounds())
+                .map(|(&x, &(lo, hi))| (x + (hi - lo) * rng.between(-0.02, 0.02)).clamp(lo, hi))
+                .collect();
+            problem.scene(&g).unwrap()
+        })
+        .collect();
+    let got = assert_same(scenes, "roobot, about the evolved gait");
+    let whole = got.iter().filter(|e| e.ended == Ended::Timeout).count();
+    let hopped: f64 = got.iter().map(|e| e.time).sum();
+    assert!(
+        whole >= 1 && hopped > 100.0 && distinct_distances(&got) == 16,
+        "{got:?}"
+    );
 }
 
 #[test]

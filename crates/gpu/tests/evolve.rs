@@ -103,3 +103,17 @@ fn the_body_ga_in_batches_writes_the_engine_s_log() {
     let neural = text.replace("controller = \"oscillator\"", "controller = \"neural\"");
     assert_same(&neural, choices, "body GA, neural brains");
 }
+
+#[test]
+fn the_thesis_s_experiment_in_batches_writes_the_engine_s_log() {
+    // scenes/hop_evolver.toml as shipped (Appendix B's hill climber, six
+    // lanes, the improvements logged, Appendix B's starting parameters):
+    // 40 generations, the lanes' bests hopping further as they go.
+    let text = include_str!("../../../scenes/hop_evolver.toml");
+    let choices = Choices {
+        generations: Some(40),
+        seed: Some(1),
+        ..Choices::default()
+    };
+    assert_same(text, choices, "the roobot's hill climber");
+}

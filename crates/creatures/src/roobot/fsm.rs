@@ -244,6 +244,10 @@ impl crate::brain::Brain for HopFsm {
         "hop"
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     /// See [`BRAIN_INPUTS`] and [`BRAIN_OUTPUTS`].
     fn think(&mut self, _t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {
         let senses = Senses {

@@ -170,12 +170,13 @@ pub fn install(
 /// What the hopping FSM reads ([`fsm::BRAIN_INPUTS`]): the four sensors'
 /// levels, the hip's forward velocity (m/s, unclamped, as Appendix B reads
 /// it), then the leg's, hip's and ankle's levels now and at the start.
-struct FsmSenses {
+pub struct FsmSenses {
     /// Index of the foot height sensor (the others follow).
-    sensors: usize,
+    pub sensors: usize,
     /// Index of the leg actuator (hip and ankle follow).
-    actuators: usize,
-    speed: SpeedSensor,
+    pub actuators: usize,
+    /// The hip's forward velocity.
+    pub speed: SpeedSensor,
 }
 
 impl Senses for FsmSenses {
@@ -197,6 +198,10 @@ impl Senses for FsmSenses {
             out[5 + k] = a.level();
             out[8 + k] = a.initial_level();
         }
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 }
 

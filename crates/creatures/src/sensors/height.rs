@@ -16,4 +16,8 @@ impl Sensor for HeightSensor {
     fn level(&self, world: &World) -> f64 {
         unit(world.clearance(self.particle))
     }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }

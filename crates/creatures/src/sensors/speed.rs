@@ -24,4 +24,8 @@ impl Sensor for SpeedSensor {
     fn level(&self, world: &World) -> f64 {
         unit(self.speed(world))
     }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }

@@ -39,4 +39,8 @@ impl Sensor for TiltSensor {
     fn level(&self, world: &World) -> f64 {
         unit(0.5 + self.gain * self.angle(world))
     }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }

@@ -22,4 +22,8 @@ impl Sensor for TouchdownSensor {
         let v = world.velocity(self.height.particle).y;
         unit((v + (v * v + 2.0 * self.g * h).sqrt()) / self.g)
     }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
 }
