@@ -591,15 +591,20 @@ fn report_schedule(
     threads: usize,
 ) -> Result<(), Failure> {
     use animats_evolve::schedule::Piece;
-    let mut csv = String::from("lane,generation,piece,candidate,batch,thread,start_s,seconds\n");
+    let mut csv =
+        String::from("lane,generation,piece,candidate,batch,thread,start_s,seconds,position\n");
     for w in &s.work {
         let (piece, k) = match w.piece {
             Piece::Ask => ("ask", String::new()),
             Piece::Evaluate(k) => ("evaluate", k.to_string()),
             Piece::Tell => ("tell", String::new()),
         };
+        let position = match w.piece {
+            Piece::Evaluate(_) => w.position.to_string(),
+            _ => String::new(),
+        };
         csv.push_str(&format!(
-            "{},{},{piece},{k},{},{},{:.9},{:.9}\n",
+            "{},{},{piece},{k},{},{},{:.9},{:.9},{position}\n",
             w.lane, w.generation, w.batch, w.thread, w.start, w.seconds
         ));
     }

@@ -430,7 +430,7 @@ fn the_schedule_is_recorded_without_changing_the_run() {
         let csv = std::fs::read_to_string(out.join("schedule.csv")).unwrap();
         assert_eq!(
             csv.lines().next(),
-            Some("lane,generation,piece,candidate,batch,thread,start_s,seconds")
+            Some("lane,generation,piece,candidate,batch,thread,start_s,seconds,position")
         );
         // 3 lanes × 6 generations, each with an ask and a tell.
         let rows: Vec<&str> = csv.lines().skip(1).collect();
@@ -450,7 +450,7 @@ fn the_schedule_is_recorded_without_changing_the_run() {
         // One worker's predicted wall is the recorded work.
         let work: f64 = rows
             .iter()
-            .map(|r| r.rsplit(',').next().unwrap().parse::<f64>().unwrap())
+            .map(|r| r.split(',').nth(7).unwrap().parse::<f64>().unwrap())
             .sum();
         let line = stdout
             .lines()
@@ -458,5 +458,63 @@ fn the_schedule_is_recorded_without_changing_the_run() {
             .unwrap();
         let one: f64 = line.split_whitespace().nth(1).unwrap().parse().unwrap();
         assert!((one - work).abs() < 2e-3, "{one} vs {work}");
+    }
+}
+
+/// Bodies start their generation's longest evaluations first (their sizes
+/// say which): schedule.csv's positions are each generation's order of
+/// starts, not the candidates' order, and the log is the same bits on 1, 2
+/// and 3 threads and without the flag.
+#[test]
+fn bodies_start_their_longest_evaluations_first_with_the_same_log() {
+    let dir = scratch("schedule-bodies");
+    let scene = dir.join("bodies.toml");
+    let walk = include_str!("../../../scenes/bodies_walk.toml");
+    assert!(walk.contains("duration = 10.0"));
+    std::fs::write(&scene, walk.replace("duration = 10.0", "duration = 0.5")).unwrap();
+    let run = |name: &str, threads: &str, schedule: bool| {
+        let out = dir.join(name);
+        let mut a = vec![
+            "evolve",
+            scene.to_str().unwrap(),
+            "--generations",
+            "2",
+            "--seed",
+            "2",
+            "--no-check",
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        if schedule {
+            a.push("--schedule");
+        }
+        let o = animats(&a);
+        assert!(o.status.success(), "{}", text(&o).1);
+        (std::fs::read_to_string(out.join("log.csv")).unwrap(), out)
+    };
+    let (plain, _) = run("plain", "2", false);
+    for t in ["1", "2", "3"] {
+        let (log, out) = run(&format!("s{t}"), t, true);
+        assert_eq!(log, plain, "{t} threads");
+        let csv = std::fs::read_to_string(out.join("schedule.csv")).unwrap();
+        let mut by_generation: std::collections::BTreeMap<&str, Vec<(usize, usize)>> =
+            Default::default();
+        for r in csv.lines().skip(1) {
+            let f: Vec<&str> = r.split(',').collect();
+            if f[2] == "evaluate" {
+                let at = (f[3].parse().unwrap(), f[8].parse().unwrap());
+                by_generation.entry(f[1]).or_default().push(at);
+            }
+        }
+        assert_eq!(by_generation.len(), 2, "{t} threads");
+        for (g, mut evals) in by_generation {
+            // Every position once; not the candidates' order.
+            evals.sort_by_key(|e| e.1);
+            let positions: Vec<usize> = evals.iter().map(|e| e.1).collect();
+            assert_eq!(positions, (0..evals.len()).collect::<Vec<_>>());
+            assert!(evals.iter().any(|e| e.0 != e.1), "generation {g}");
+        }
     }
 }

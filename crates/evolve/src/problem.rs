@@ -63,6 +63,17 @@ pub trait Problem: Send + Sync {
     fn stats(&self, _genome: &[f64]) -> Option<BodyStats> {
         None
     }
+    /// A relative guess at how long `genome`'s evaluation takes, where the
+    /// problem can tell, so that a generation starts its longest
+    /// evaluations first (bodies: each step's work grows with the
+    /// particles, the springs and the pairs of spheres that may touch).
+    /// `None`: the candidates' own order.
+    fn cost(&self, genome: &[f64]) -> Option<f64> {
+        self.stats(genome).map(|s| {
+            let n = s.particles as f64;
+            n + s.springs as f64 + n * (n - 1.0) / 4.0
+        })
+    }
     /// The scene's `[archive]` grid and settings, if it has one.
     fn grid(&self) -> Option<&animats_scene::archive::Grid> {
         None

@@ -1024,18 +1024,14 @@ fn advance_lane(
         let batch = problem.evaluate_population(&population, &|_, o| screen.fine(o));
         let outcomes: Vec<Outcome> = match batch {
             Some(batch) => batch?,
-            None => population
-                .par_iter()
-                .enumerate()
-                .map(|(i, genome)| {
-                    let began = std::time::Instant::now();
-                    let o = problem.evaluate_screened(genome, &screen);
-                    if let Some(t) = tracer {
-                        t.done(k, g, Piece::Evaluate(i), began);
-                    }
-                    o
-                })
-                .collect::<Result<_, _>>()?,
+            None => longest_first(problem, &population, &|i, position, genome| {
+                let began = std::time::Instant::now();
+                let o = problem.evaluate_screened(genome, &screen);
+                if let Some(t) = tracer {
+                    t.done_evaluation(k, g, i, position, began);
+                }
+                o
+            })?,
         };
         let began = std::time::Instant::now();
         rows.push(record(lane, Some(problem), population, &outcomes)?);
@@ -1044,6 +1040,53 @@ fn advance_lane(
         }
     }
     Ok(rows)
+}
+
+/// An evaluation of candidate `index`, the `position`-th its generation
+/// starts, of `genome`: `evaluate(index, position, genome)`.
+type EvaluateAt<'a> = dyn Fn(usize, usize, &[f64]) -> Result<Outcome, String> + Sync + 'a;
+
+/// Evaluates every genome of `population` with `evaluate(index, position,
+/// genome)` on the current rayon pool, the longest first where the problem
+/// can guess their costs ([`Problem::cost`]; ties, and problems that
+/// cannot guess, in the population's order): each free thread takes the
+/// next evaluation in that order, so the last to start are the shortest and
+/// the generation's end waits less for a long one started late (Graham's
+/// longest-processing-time rule). Each evaluation is a pure function of its
+/// genome: the outcomes, in the population's order, are the same whatever
+/// the order and the threads. The first error in the population's order is
+/// returned.
+fn longest_first(
+    problem: &dyn Problem,
+    population: &[Vec<f64>],
+    evaluate: &EvaluateAt<'_>,
+) -> Result<Vec<Outcome>, String> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::OnceLock;
+    let n = population.len();
+    let costs: Vec<Option<f64>> = population.iter().map(|g| problem.cost(g)).collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    if costs.iter().all(Option::is_some) {
+        let c = |i: usize| costs[i].unwrap_or(0.0);
+        order.sort_by(|&a, &b| c(b).total_cmp(&c(a)).then(a.cmp(&b)));
+    }
+    let next = AtomicUsize::new(0);
+    let slots: Vec<OnceLock<Result<Outcome, String>>> = (0..n).map(|_| OnceLock::new()).collect();
+    let threads = rayon::current_num_threads().min(n).max(1);
+    (0..threads).into_par_iter().for_each(|_| loop {
+        let position = next.fetch_add(1, Ordering::Relaxed);
+        let Some(&i) = order.get(position) else {
+            return;
+        };
+        let _ = slots[i].set(evaluate(i, position, &population[i]));
+    });
+    slots
+        .into_iter()
+        .map(|s| {
+            s.into_inner()
+                .unwrap_or_else(|| Err("an evaluation was never run".into()))
+        })
+        .collect()
 }
 
 /// Tells `lane`'s optimiser how its `population` fared and keeps its best:

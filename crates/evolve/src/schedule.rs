@@ -12,7 +12,9 @@
 //! The replay is greedy list scheduling (Graham's): a free worker takes the
 //! ready piece that comes first in the order the run's own scheduler would
 //! reach it — the lane that has done the fewest generations of its batch,
-//! then the lowest lane, then the candidate's index. Its makespan `T(W)`
+//! then the lowest lane, then the order its generation started its
+//! evaluations (the longest first where the problem can guess their
+//! costs, as bodies' sizes let it; else the candidates' order). Its makespan `T(W)`
 //! lies between `max(work / W, critical path)` and `work / W + critical
 //! path` (Graham, 1969); the tests check both. It models no contention
 //! (memory bandwidth, frequency scaling): the prediction is what the
@@ -49,6 +51,9 @@ pub struct Work {
     pub start: f64,
     /// How long it took, s.
     pub seconds: f64,
+    /// An evaluation's place in the order its generation started them (its
+    /// longest first, where the problem can tell); 0 for the rest.
+    pub position: usize,
 }
 
 /// Records a run's work as it happens (many threads at once).
@@ -72,6 +77,23 @@ impl Default for Tracer {
 impl Tracer {
     /// Records a piece that started at `began`.
     pub fn done(&self, lane: usize, generation: u64, piece: Piece, began: Instant) {
+        self.record(lane, generation, piece, 0, began);
+    }
+
+    /// Candidate `k`'s evaluation, begun at `began`, the `position`-th its
+    /// generation started, has just ended.
+    pub fn done_evaluation(
+        &self,
+        lane: usize,
+        generation: u64,
+        k: usize,
+        position: usize,
+        began: Instant,
+    ) {
+        self.record(lane, generation, Piece::Evaluate(k), position, began);
+    }
+
+    fn record(&self, lane: usize, generation: u64, piece: Piece, position: usize, began: Instant) {
         let seconds = began.elapsed().as_secs_f64();
         let start = began.duration_since(self.origin).as_secs_f64();
         let batch = *self.batch.lock().unwrap_or_else(|p| p.into_inner());
@@ -83,6 +105,7 @@ impl Tracer {
             thread: rayon::current_thread_index().unwrap_or(0),
             start,
             seconds,
+            position,
         };
         self.work.lock().unwrap_or_else(|p| p.into_inner()).push(w);
     }
@@ -116,6 +139,7 @@ struct Step {
     /// Its rank among the lane's generations in the batch.
     rank: u64,
     ask: f64,
+    /// Its evaluations' durations, in the order the run started them.
     evaluations: Vec<f64>,
     tell: f64,
 }
@@ -155,12 +179,15 @@ impl Schedule {
     /// The batches, each a list of lane-generations in (lane, generation)
     /// order.
     fn batches(&self) -> Vec<Vec<Step>> {
+        // Each step's evaluations as (position, seconds), put in order below.
+        let mut started: Vec<Vec<Vec<(usize, usize, f64)>>> = Vec::new();
         let mut out: Vec<Vec<Step>> = Vec::new();
         let mut last: Option<(usize, usize, u64)> = None;
         let mut rank: std::collections::BTreeMap<(usize, usize), u64> = Default::default();
         for w in &self.work {
             if out.len() <= w.batch {
                 out.resize_with(w.batch + 1, Vec::new);
+                started.resize_with(w.batch + 1, Vec::new);
             }
             let key = (w.batch, w.lane, w.generation);
             if last != Some(key) {
@@ -172,16 +199,25 @@ impl Schedule {
                     evaluations: Vec::new(),
                     tell: 0.0,
                 });
+                started[w.batch].push(Vec::new());
                 *r += 1;
                 last = Some(key);
             }
-            let Some(step) = out[w.batch].last_mut() else {
+            let (Some(step), Some(evaluations)) =
+                (out[w.batch].last_mut(), started[w.batch].last_mut())
+            else {
                 continue;
             };
             match w.piece {
                 Piece::Ask => step.ask += w.seconds,
-                Piece::Evaluate(_) => step.evaluations.push(w.seconds),
+                Piece::Evaluate(k) => evaluations.push((w.position, k, w.seconds)),
                 Piece::Tell => step.tell += w.seconds,
+            }
+        }
+        for (steps, started) in out.iter_mut().zip(started) {
+            for (step, mut evaluations) in steps.iter_mut().zip(started) {
+                evaluations.sort_by_key(|&(position, k, _)| (position, k));
+                step.evaluations = evaluations.into_iter().map(|e| e.2).collect();
             }
         }
         out
@@ -321,6 +357,10 @@ mod tests {
                     thread: 0,
                     start: 0.0,
                     seconds,
+                    position: match piece {
+                        Piece::Evaluate(k) => k,
+                        _ => 0,
+                    },
                 };
                 work.push(w(Piece::Ask, 0.001));
                 for k in 0..population {
@@ -335,6 +375,33 @@ mod tests {
             (a.batch, a.lane, a.generation, a.piece).cmp(&(b.batch, b.lane, b.generation, b.piece))
         });
         s
+    }
+
+    #[test]
+    fn the_replay_starts_evaluations_in_the_run_s_order() {
+        // One generation of three evaluations, 1, 1 and 2 s, on two
+        // workers: in the candidates' order the long one starts last (3 s);
+        // started first, as the run starts its longest (2 s).
+        let at = |k: usize, position: usize, seconds: f64| Work {
+            lane: 0,
+            generation: 0,
+            piece: Piece::Evaluate(k),
+            batch: 0,
+            thread: 0,
+            start: 0.0,
+            seconds,
+            position,
+        };
+        let s = |positions: [usize; 3]| Schedule {
+            work: vec![
+                at(0, positions[0], 1.0),
+                at(1, positions[1], 1.0),
+                at(2, positions[2], 2.0),
+            ],
+        };
+        assert_eq!(s([0, 1, 2]).makespan(2, true), 3.0);
+        assert_eq!(s([1, 2, 0]).makespan(2, true), 2.0);
+        assert_eq!(s([1, 2, 0]).makespan(1, true), 4.0);
     }
 
     #[test]
