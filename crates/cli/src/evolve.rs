@@ -596,6 +596,7 @@ fn report_schedule(
     for w in &s.work {
         let (piece, k) = match w.piece {
             Piece::Ask => ("ask", String::new()),
+            Piece::Vary(k) => ("vary", k.to_string()),
             Piece::Evaluate(k) => ("evaluate", k.to_string()),
             Piece::Tell => ("tell", String::new()),
         };

@@ -464,7 +464,8 @@ fn the_schedule_is_recorded_without_changing_the_run() {
 /// Bodies start their generation's longest evaluations first (their sizes
 /// say which): schedule.csv's positions are each generation's order of
 /// starts, not the candidates' order, and the log is the same bits on 1, 2
-/// and 3 threads and without the flag.
+/// and 3 threads and without the flag. Each child's making is a piece of
+/// its own (`vary`), one a candidate.
 #[test]
 fn bodies_start_their_longest_evaluations_first_with_the_same_log() {
     let dir = scratch("schedule-bodies");
@@ -501,14 +502,23 @@ fn bodies_start_their_longest_evaluations_first_with_the_same_log() {
         let csv = std::fs::read_to_string(out.join("schedule.csv")).unwrap();
         let mut by_generation: std::collections::BTreeMap<&str, Vec<(usize, usize)>> =
             Default::default();
+        let mut made: std::collections::BTreeMap<&str, Vec<usize>> = Default::default();
         for r in csv.lines().skip(1) {
             let f: Vec<&str> = r.split(',').collect();
+            if f[2] == "vary" {
+                made.entry(f[1]).or_default().push(f[3].parse().unwrap());
+            }
             if f[2] == "evaluate" {
                 let at = (f[3].parse().unwrap(), f[8].parse().unwrap());
                 by_generation.entry(f[1]).or_default().push(at);
             }
         }
         assert_eq!(by_generation.len(), 2, "{t} threads");
+        for (g, children) in &made {
+            let n = by_generation[g].len();
+            assert_eq!(children, &(0..n).collect::<Vec<_>>(), "generation {g}");
+        }
+        assert_eq!(made.len(), 2, "{t} threads");
         for (g, mut evals) in by_generation {
             // Every position once; not the candidates' order.
             evals.sort_by_key(|e| e.1);

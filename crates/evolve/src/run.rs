@@ -10,6 +10,7 @@
 //! (seed, lane, generation), so the log, the best and the checkpoint are the
 //! same bits whatever the number of threads.
 
+use crate::optimiser::body_ga::Variation;
 use crate::optimiser::{AnyOptimiser, Optimiser, OptimiserKind, Setup};
 use crate::problem::{BodyEvolution, Outcome, Problem, SceneEvolution};
 use crate::screen::Screen;
@@ -1016,10 +1017,25 @@ fn advance_lane(
     for _ in 0..n {
         let (k, g) = (lane.lane, lane.generation);
         let began = std::time::Instant::now();
-        let population = lane.optimiser.ask_with(problem.variation())?;
+        // Traced, the children's making (in parallel, inside the ask) is
+        // recorded piece by piece, and the ask as what is left of it.
+        let timed = tracer.and(problem.variation()).map(|inner| Timed {
+            inner,
+            made: std::sync::Mutex::new(None),
+        });
+        let variation = match &timed {
+            Some(t) => Some(t as &dyn Variation),
+            None => problem.variation(),
+        };
+        let population = lane.optimiser.ask_with(variation)?;
         let screen = lane.optimiser.screen();
         if let Some(t) = tracer {
-            t.done(k, g, Piece::Ask, began);
+            let made = timed.and_then(|t| t.made.into_inner().ok().flatten());
+            let children = made.as_ref().map_or(0.0, |m| m.1);
+            t.done_part(k, g, Piece::Ask, began, children);
+            for (i, &s) in made.iter().flat_map(|m| m.0.iter()).enumerate() {
+                t.done_seconds(k, g, Piece::Vary(i), s);
+            }
         }
         let batch = problem.evaluate_population(&population, &|_, o| screen.fine(o));
         let outcomes: Vec<Outcome> = match batch {
@@ -1040,6 +1056,39 @@ fn advance_lane(
         }
     }
     Ok(rows)
+}
+
+/// A problem's variation that notes how long its children took to make
+/// (for the schedule model), and otherwise is the problem's own.
+struct Timed<'a> {
+    inner: &'a dyn Variation,
+    /// Each child's seconds and the wall time of making them all.
+    made: std::sync::Mutex<Option<(Vec<f64>, f64)>>,
+}
+
+impl Variation for Timed<'_> {
+    fn start(&self) -> Option<Vec<f64>> {
+        self.inner.start()
+    }
+    fn random(&self, rng: &mut crate::optimiser::Random) -> Vec<f64> {
+        self.inner.random(rng)
+    }
+    fn mutate(&self, parent: &[f64], rng: &mut crate::optimiser::Random) -> Vec<f64> {
+        self.inner.mutate(parent, rng)
+    }
+    fn crossover(&self, a: &[f64], b: &[f64], rng: &mut crate::optimiser::Random) -> Vec<f64> {
+        self.inner.crossover(a, b, rng)
+    }
+    fn check(&self, genome: &[f64]) -> Result<(), &'static str> {
+        self.inner.check(genome)
+    }
+    fn made(&self, children: &[f64], wall: f64) {
+        if let Ok(mut m) = self.made.lock() {
+            let (all, total) = m.get_or_insert_with(Default::default);
+            all.extend_from_slice(children);
+            *total += wall;
+        }
+    }
 }
 
 /// An evaluation of candidate `index`, the `position`-th its generation

@@ -26,8 +26,12 @@ use std::time::Instant;
 /// What a piece of work was.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Piece {
-    /// The optimiser asking for a generation.
+    /// The optimiser asking for a generation (what is left of it beside
+    /// its children's making, where that is recorded apart).
     Ask,
+    /// Child `k`'s making (a body's variation and checks), in parallel
+    /// within the ask, after its serial part.
+    Vary(usize),
     /// Candidate `k`'s evaluation.
     Evaluate(usize),
     /// The optimiser told the generation's outcomes (and the log row).
@@ -80,6 +84,25 @@ impl Tracer {
         self.record(lane, generation, piece, 0, began);
     }
 
+    /// `piece`, begun at `began`, has just ended; `apart` s of it were
+    /// recorded as other pieces (its children's making), and are left out.
+    pub fn done_part(
+        &self,
+        lane: usize,
+        generation: u64,
+        piece: Piece,
+        began: Instant,
+        apart: f64,
+    ) {
+        let seconds = (began.elapsed().as_secs_f64() - apart).max(0.0);
+        self.push(lane, generation, piece, 0, began, seconds);
+    }
+
+    /// `piece` took `seconds`, measured by whoever ran it.
+    pub fn done_seconds(&self, lane: usize, generation: u64, piece: Piece, seconds: f64) {
+        self.push(lane, generation, piece, 0, Instant::now(), seconds);
+    }
+
     /// Candidate `k`'s evaluation, begun at `began`, the `position`-th its
     /// generation started, has just ended.
     pub fn done_evaluation(
@@ -95,6 +118,18 @@ impl Tracer {
 
     fn record(&self, lane: usize, generation: u64, piece: Piece, position: usize, began: Instant) {
         let seconds = began.elapsed().as_secs_f64();
+        self.push(lane, generation, piece, position, began, seconds);
+    }
+
+    fn push(
+        &self,
+        lane: usize,
+        generation: u64,
+        piece: Piece,
+        position: usize,
+        began: Instant,
+        seconds: f64,
+    ) {
         let start = began.duration_since(self.origin).as_secs_f64();
         let batch = *self.batch.lock().unwrap_or_else(|p| p.into_inner());
         let w = Work {
@@ -139,6 +174,8 @@ struct Step {
     /// Its rank among the lane's generations in the batch.
     rank: u64,
     ask: f64,
+    /// Its children's making, each.
+    varies: Vec<f64>,
     /// Its evaluations' durations, in the order the run started them.
     evaluations: Vec<f64>,
     tell: f64,
@@ -159,7 +196,8 @@ impl Schedule {
             let mut in_batch: std::collections::BTreeMap<usize, f64> = Default::default();
             for s in batch {
                 let longest = s.evaluations.iter().cloned().fold(0.0, f64::max);
-                *in_batch.entry(s.lane).or_default() += s.ask + longest + s.tell;
+                let child = s.varies.iter().cloned().fold(0.0, f64::max);
+                *in_batch.entry(s.lane).or_default() += s.ask + child + longest + s.tell;
             }
             if barriers {
                 total += in_batch.values().cloned().fold(0.0, f64::max);
@@ -196,6 +234,7 @@ impl Schedule {
                     lane: w.lane,
                     rank: *r,
                     ask: 0.0,
+                    varies: Vec::new(),
                     evaluations: Vec::new(),
                     tell: 0.0,
                 });
@@ -210,6 +249,7 @@ impl Schedule {
             };
             match w.piece {
                 Piece::Ask => step.ask += w.seconds,
+                Piece::Vary(_) => step.varies.push(w.seconds),
                 Piece::Evaluate(k) => evaluations.push((w.position, k, w.seconds)),
                 Piece::Tell => step.tell += w.seconds,
             }
@@ -259,6 +299,7 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
     #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
     enum What {
         Ask,
+        Vary(usize),
         Evaluate(usize),
         Tell,
     }
@@ -290,7 +331,17 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
     // Running tasks by end time (ties by order, for determinism).
     let mut running: BinaryHeap<Reverse<(u64, Key)>> = BinaryHeap::new();
     let mut left: Vec<usize> = steps.iter().map(|s| s.evaluations.len()).collect();
+    let mut unmade: Vec<usize> = steps.iter().map(|s| s.varies.len()).collect();
     let (mut now, mut free) = (0.0f64, workers);
+    // Step i's evaluations (or, with none, its tell) become ready.
+    let evaluations_ready = |ready: &mut BTreeSet<Key>, i: usize| {
+        if steps[i].evaluations.is_empty() {
+            ready.insert(order(i, What::Tell));
+        }
+        for k in 0..steps[i].evaluations.len() {
+            ready.insert(order(i, What::Evaluate(k)));
+        }
+    };
     // Time in integer nanoseconds inside the heap, so that it orders totally.
     let nanos = |t: f64| (t * 1e9).round() as u64;
     loop {
@@ -302,6 +353,7 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
             let (_, _, what, i) = task;
             let seconds = match what {
                 What::Ask => steps[i].ask,
+                What::Vary(k) => steps[i].varies[k],
                 What::Evaluate(k) => steps[i].evaluations[k],
                 What::Tell => steps[i].tell,
             };
@@ -315,11 +367,17 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
         free += 1;
         match what {
             What::Ask => {
-                if steps[i].evaluations.is_empty() {
-                    ready.insert(order(i, What::Tell));
+                if steps[i].varies.is_empty() {
+                    evaluations_ready(&mut ready, i);
                 }
-                for k in 0..steps[i].evaluations.len() {
-                    ready.insert(order(i, What::Evaluate(k)));
+                for k in 0..steps[i].varies.len() {
+                    ready.insert(order(i, What::Vary(k)));
+                }
+            }
+            What::Vary(_) => {
+                unmade[i] -= 1;
+                if unmade[i] == 0 {
+                    evaluations_ready(&mut ready, i);
                 }
             }
             What::Evaluate(_) => {
@@ -402,6 +460,35 @@ mod tests {
         assert_eq!(s([0, 1, 2]).makespan(2, true), 3.0);
         assert_eq!(s([1, 2, 0]).makespan(2, true), 2.0);
         assert_eq!(s([1, 2, 0]).makespan(1, true), 4.0);
+    }
+
+    #[test]
+    fn children_made_within_an_ask_are_replayed_in_parallel() {
+        // An ask of 0.1 s serial and four children of 1 s each, then two
+        // evaluations of 1 s: 6.1 s on one worker, 0.1 + 2 + 1 on two,
+        // 0.1 + 1 + 1 on four; the critical path 0.1 + 1 + 1.
+        let piece = |piece, seconds| Work {
+            lane: 0,
+            generation: 0,
+            piece,
+            batch: 0,
+            thread: 0,
+            start: 0.0,
+            seconds,
+            position: match piece {
+                Piece::Evaluate(k) => k,
+                _ => 0,
+            },
+        };
+        let mut work = vec![piece(Piece::Ask, 0.1)];
+        work.extend((0..4).map(|k| piece(Piece::Vary(k), 1.0)));
+        work.extend((0..2).map(|k| piece(Piece::Evaluate(k), 1.0)));
+        let s = Schedule { work };
+        for (workers, wall) in [(1, 6.1), (2, 3.1), (4, 2.1)] {
+            assert!((s.makespan(workers, true) - wall).abs() < 1e-9, "{workers}");
+        }
+        assert!((s.critical_path(true) - 2.1).abs() < 1e-12);
+        assert!((s.work_seconds() - 6.1).abs() < 1e-12);
     }
 
     #[test]

@@ -45,6 +45,31 @@ pub trait Variation: Sync {
     fn crossover(&self, a: &[f64], b: &[f64], rng: &mut Random) -> Vec<f64>;
     /// Whether `genome` may be evaluated; if not, the reason's name.
     fn check(&self, genome: &[f64]) -> Result<(), &'static str>;
+    /// Hears how long making each child of a generation took, s (in the
+    /// children's order), and the wall time of making them all on the
+    /// pool's threads: for the schedule model (`evolve --schedule`).
+    fn made(&self, _children: &[f64], _wall: f64) {}
+}
+
+/// Makes `n` children with `make(i)` on the current pool, each timed, and
+/// tells `variation` the times ([`Variation::made`]).
+pub(crate) fn make_children(
+    variation: &dyn Variation,
+    n: usize,
+    make: impl Fn(usize) -> Made + Sync,
+) -> Vec<Made> {
+    let began = std::time::Instant::now();
+    let timed: Vec<(Made, f64)> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let t = std::time::Instant::now();
+            let m = make(i);
+            (m, t.elapsed().as_secs_f64())
+        })
+        .collect();
+    let seconds: Vec<f64> = timed.iter().map(|t| t.1).collect();
+    variation.made(&seconds, began.elapsed().as_secs_f64());
+    timed.into_iter().map(|t| t.0).collect()
 }
 
 /// A body GA's state: what a checkpoint holds.
@@ -140,22 +165,19 @@ impl BodyGa {
     /// The next generation's children, made and checked by `variation`.
     pub fn ask(&mut self, variation: &dyn Variation) -> Vec<Vec<f64>> {
         let start = variation.start();
-        let made: Vec<Made> = (0..self.size)
-            .into_par_iter()
-            .map(|i| {
-                let mut rng = Random::for_child(self.seed, self.lane, self.generation, i as u64);
-                match (&start, self.parents.is_empty()) {
-                    (Some(s), true) if i == 0 => Made {
-                        genome: s.clone(),
-                        refused: Vec::new(),
-                        kept: false,
-                    },
-                    (Some(s), true) => vary(variation, &mut rng, |v, r| v.mutate(s, r), s),
-                    (None, true) => random_body(variation, &mut rng),
-                    (_, false) => self.child(variation, &mut rng),
-                }
-            })
-            .collect();
+        let made = make_children(variation, self.size, |i| {
+            let mut rng = Random::for_child(self.seed, self.lane, self.generation, i as u64);
+            match (&start, self.parents.is_empty()) {
+                (Some(s), true) if i == 0 => Made {
+                    genome: s.clone(),
+                    refused: Vec::new(),
+                    kept: false,
+                },
+                (Some(s), true) => vary(variation, &mut rng, |v, r| v.mutate(s, r), s),
+                (None, true) => random_body(variation, &mut rng),
+                (_, false) => self.child(variation, &mut rng),
+            }
+        });
         self.asked = Vec::with_capacity(made.len());
         for m in made {
             for r in m.refused {

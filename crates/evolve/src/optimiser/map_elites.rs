@@ -28,7 +28,6 @@ use super::{check_told, gaussian, BestSoFar, Bounds, Random};
 use crate::archive::{Added, Candidate, GridArchive};
 use crate::problem::Outcome;
 use animats_scene::archive::{EmitterName, Grid};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -324,39 +323,36 @@ impl Qd {
         let start = v.start();
         let (seed, lane, generation) = (self.seed, self.lane, self.generation);
         let archive = &self.archive;
-        let made: Vec<Made> = (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let key = (1u64 << 48) | ((k as u64) << 24) | i as u64;
-                let mut rng = Random::for_child(seed, lane, generation, key);
-                if archive.is_empty() {
-                    return match &start {
-                        Some(s) if i == 0 && k == 0 => Made {
-                            genome: s.clone(),
-                            refused: Vec::new(),
-                            kept: false,
-                        },
-                        Some(s) => body_ga::vary(v, &mut rng, |v, r| v.mutate(s, r), s),
-                        None => body_ga::random_body(v, &mut rng),
-                    };
-                }
-                let parent: &[f64] = &archive.parents(1, &mut rng)[0].genome;
-                if rng.uniform() < CROSSOVER {
-                    let other: &[f64] = &archive.parents(1, &mut rng)[0].genome;
-                    body_ga::vary(
-                        v,
-                        &mut rng,
-                        |v, r| {
-                            let c = v.crossover(parent, other, r);
-                            v.mutate(&c, r)
-                        },
-                        parent,
-                    )
-                } else {
-                    body_ga::vary(v, &mut rng, |v, r| v.mutate(parent, r), parent)
-                }
-            })
-            .collect();
+        let made = body_ga::make_children(v, n, |i| {
+            let key = (1u64 << 48) | ((k as u64) << 24) | i as u64;
+            let mut rng = Random::for_child(seed, lane, generation, key);
+            if archive.is_empty() {
+                return match &start {
+                    Some(s) if i == 0 && k == 0 => Made {
+                        genome: s.clone(),
+                        refused: Vec::new(),
+                        kept: false,
+                    },
+                    Some(s) => body_ga::vary(v, &mut rng, |v, r| v.mutate(s, r), s),
+                    None => body_ga::random_body(v, &mut rng),
+                };
+            }
+            let parent: &[f64] = &archive.parents(1, &mut rng)[0].genome;
+            if rng.uniform() < CROSSOVER {
+                let other: &[f64] = &archive.parents(1, &mut rng)[0].genome;
+                body_ga::vary(
+                    v,
+                    &mut rng,
+                    |v, r| {
+                        let c = v.crossover(parent, other, r);
+                        v.mutate(&c, r)
+                    },
+                    parent,
+                )
+            } else {
+                body_ga::vary(v, &mut rng, |v, r| v.mutate(parent, r), parent)
+            }
+        });
         made.into_iter()
             .map(|m| {
                 for r in m.refused {
