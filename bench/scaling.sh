@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Evolution's scaling with threads (issue 41): the issue's three runs and a
-# [morphology] run (bodies and brains evolving)
+# Evolution's scaling with threads (issue 41): the issue's three runs,
+# [morphology] runs (bodies and brains evolving: 16 lanes of the body GA;
+# the shipped land task, MAP-Elites in one lane, 36 bodies a generation
+# and 144)
 # at 1, 2, 4, 8 and 16 threads, wall time and speed-up each, every log
 # checked identical; then the schedule model's prediction (`evolve
 # --schedule`) from each row's 1-thread run, to set beside the measured.
@@ -9,7 +11,7 @@
 # a many-core machine in an ignored folder):
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
-# About 3 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
+# About 4 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ANIMATS:-target/carry/animats}
@@ -24,6 +26,8 @@ rows=(
   "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
   "quadruped3|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1"
   "bodies_walk|scenes/bodies_walk.toml --optimiser body-ga --lanes 16 --generations 2 --seed 1"
+  "bodies_map|scenes/bodies_walk.toml --generations 20 --seed 1 --no-check"
+  "bodies_map_144|scenes/bodies_walk.toml --population 144 --generations 5 --seed 1 --no-check"
 )
 header="| run |"; rule="|---|"
 for t in $THREADS; do header+=" $t |"; rule+="---|"; done
