@@ -400,6 +400,23 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
 mod tests {
     use super::*;
 
+    /// A piece of a made-up run (an evaluation's position its candidate).
+    fn made_up(lane: usize, generation: u64, batch: usize, piece: Piece, seconds: f64) -> Work {
+        Work {
+            lane,
+            generation,
+            piece,
+            batch,
+            thread: 0,
+            start: 0.0,
+            seconds,
+            position: match piece {
+                Piece::Evaluate(k) => k,
+                _ => 0,
+            },
+        }
+    }
+
     /// A made-up run: `lanes` lanes, `generations` each in batches of
     /// `per_batch`, `population` candidates of uneven length.
     fn run(lanes: usize, generations: u64, per_batch: u64, population: usize) -> Schedule {
@@ -407,19 +424,7 @@ mod tests {
         for g in 0..generations {
             for lane in 0..lanes {
                 let batch = (g / per_batch) as usize;
-                let w = |piece, seconds| Work {
-                    lane,
-                    generation: g,
-                    piece,
-                    batch,
-                    thread: 0,
-                    start: 0.0,
-                    seconds,
-                    position: match piece {
-                        Piece::Evaluate(k) => k,
-                        _ => 0,
-                    },
-                };
+                let w = |piece, seconds| made_up(lane, g, batch, piece, seconds);
                 work.push(w(Piece::Ask, 0.001));
                 for k in 0..population {
                     let s = 0.01 * (1.0 + ((lane * 7 + k * 3 + g as usize) % 5) as f64);
@@ -441,14 +446,8 @@ mod tests {
         // workers: in the candidates' order the long one starts last (3 s);
         // started first, as the run starts its longest (2 s).
         let at = |k: usize, position: usize, seconds: f64| Work {
-            lane: 0,
-            generation: 0,
-            piece: Piece::Evaluate(k),
-            batch: 0,
-            thread: 0,
-            start: 0.0,
-            seconds,
             position,
+            ..made_up(0, 0, 0, Piece::Evaluate(k), seconds)
         };
         let s = |positions: [usize; 3]| Schedule {
             work: vec![
@@ -467,19 +466,7 @@ mod tests {
         // An ask of 0.1 s serial and four children of 1 s each, then two
         // evaluations of 1 s: 6.1 s on one worker, 0.1 + 2 + 1 on two,
         // 0.1 + 1 + 1 on four; the critical path 0.1 + 1 + 1.
-        let piece = |piece, seconds| Work {
-            lane: 0,
-            generation: 0,
-            piece,
-            batch: 0,
-            thread: 0,
-            start: 0.0,
-            seconds,
-            position: match piece {
-                Piece::Evaluate(k) => k,
-                _ => 0,
-            },
-        };
+        let piece = |piece, seconds| made_up(0, 0, 0, piece, seconds);
         let mut work = vec![piece(Piece::Ask, 0.1)];
         work.extend((0..4).map(|k| piece(Piece::Vary(k), 1.0)));
         work.extend((0..2).map(|k| piece(Piece::Evaluate(k), 1.0)));

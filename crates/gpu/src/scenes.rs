@@ -411,18 +411,30 @@ impl Rules {
             ]);
             self.net_first_scratch.push(self.net_scratch.len() as i64);
         }
+        self.end_network(inputs.iter().copied(), &c.outputs, shift);
+        Ok(true)
+    }
+
+    /// Closes the network entry just appended: its layers', weights' and
+    /// neurons' ends, its inputs (sensors within the creature) and its
+    /// outputs (muscles, each with a trial's level offset).
+    fn end_network(
+        &mut self,
+        inputs: impl Iterator<Item = usize>,
+        outputs: &[usize],
+        shift: &dyn Fn(usize) -> f64,
+    ) {
         self.net_first_layer.push(self.layer_size.len() as i64);
         self.net_first_weight.push(self.net_weight.len() as i64);
         self.net_first_neuron.push(self.neuron_state.len() as i64);
-        self.net_input.extend(inputs.iter().map(|&i| i as i32));
+        self.net_input.extend(inputs.map(|i| i as i32));
         self.net_first_input.push(self.net_input.len() as i64);
-        for &o in &c.outputs {
+        for &o in outputs {
             self.net_output_muscle.push(o as i32);
             self.net_output_shift.push(shift(o));
         }
         self.net_first_output
             .push(self.net_output_muscle.len() as i64);
-        Ok(true)
     }
 
     /// Appends the roobot's hopping FSM `c` (thesis §3.2.1.4, a network
@@ -468,18 +480,7 @@ impl Rules {
             HopState::Flight => 3.0,
         });
         self.net_first_scratch.push(self.net_scratch.len() as i64);
-        self.net_first_layer.push(self.layer_size.len() as i64);
-        self.net_first_weight.push(self.net_weight.len() as i64);
-        self.net_first_neuron.push(self.neuron_state.len() as i64);
-        self.net_input
-            .extend((0..4).map(|k| (senses.sensors + k) as i32));
-        self.net_first_input.push(self.net_input.len() as i64);
-        for &o in &c.outputs {
-            self.net_output_muscle.push(o as i32);
-            self.net_output_shift.push(shift(o));
-        }
-        self.net_first_output
-            .push(self.net_output_muscle.len() as i64);
+        self.end_network((0..4).map(|k| senses.sensors + k), &c.outputs, shift);
         Ok(true)
     }
 
