@@ -59,7 +59,7 @@ for run in "65536 1000 20" "16384 1000 0"; do
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
-for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10" "quadruped 8192 10" "roobot 16384 20"; do
+for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10" "quadruped 8192 10" "roobot 16384 20" "rough 16384 10"; do
   echo "== gpu_evaluate $run"
   # shellcheck disable=SC2086
   "$E" $run

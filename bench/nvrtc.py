@@ -3,7 +3,8 @@
 `animats_gpu::Device::open` does (the same headers in the same order, the
 same strict options) for a GPU architecture, with no GPU: NVRTC only needs
 its own libraries, which the PyPI package nvidia-cuda-nvrtc provides. Prints
-ptxas's registers, stack and spills for each entry; exit 1 if NVRTC refuses
+ptxas's registers, stack and spills for each entry of both kernels (the
+flat floor's and terrain's); exit 1 if NVRTC refuses
 the kernel (its log printed), 2 if NVRTC cannot be found.
 
     python3 -m venv target/venv-nvrtc
@@ -21,7 +22,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNEL = os.path.join(ROOT, "crates", "gpu", "kernel")
 # In the order of crates/gpu/src/cuda.rs's `source`.
-PARTS = ["libm.h", "trig.h", "exp.h", "step.h", "eval.h", "kernel.cu"]
+PARTS = ["libm.h", "terrain.h", "trig.h", "exp.h", "step.h", "eval.h", "kernel.cu"]
 # As crates/gpu/src/cuda.rs's `options`, with ptxas's report.
 OPTIONS = ["--fmad=false", "--prec-div=true", "--prec-sqrt=true", "--ftz=false", "--ptxas-options=-v"]
 
@@ -54,11 +55,11 @@ def source():
     return "\n".join(text)
 
 
-def compile_for(lib, arch, src):
+def compile_for(lib, arch, src, extra):
     prog = ctypes.c_void_p()
     if lib.nvrtcCreateProgram(ctypes.byref(prog), src.encode(), b"kernel.cu", 0, None, None) != 0:
         return False, "nvrtcCreateProgram failed"
-    opts = [f"--gpu-architecture={arch}"] + OPTIONS
+    opts = [f"--gpu-architecture={arch}"] + OPTIONS + extra
     arr = (ctypes.c_char_p * len(opts))(*[o.encode() for o in opts])
     result = lib.nvrtcCompileProgram(prog, len(opts), arr)
     size = ctypes.c_size_t()
@@ -78,12 +79,15 @@ def main():
     src = source()
     failed = False
     for arch in sys.argv[1:] or ["sm_90"]:
-        ok, log = compile_for(lib, arch, src)
-        print(f"NVRTC {major.value}.{minor.value}, {arch}: {'compiled' if ok else 'REFUSED'}")
-        for line in log.splitlines():
-            if not ok or "entry function" in line or "registers" in line or "stack frame" in line or "warning" in line:
-                print("  " + line.strip())
-        failed |= not ok
+        # As crates/gpu/src/cuda.rs's two kernels: the flat floor's, and
+        # terrain's.
+        for kernel, extra in [("flat floor", ["-DAN_FLAT_ONLY"]), ("terrain", [])]:
+            ok, log = compile_for(lib, arch, src, extra)
+            print(f"NVRTC {major.value}.{minor.value}, {arch}, {kernel}: {'compiled' if ok else 'REFUSED'}")
+            for line in log.splitlines():
+                if not ok or "entry function" in line or "registers" in line or "spill" in line or "warning" in line:
+                    print("  " + line.strip())
+            failed |= not ok
     sys.exit(1 if failed else 0)
 
 

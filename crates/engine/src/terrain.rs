@@ -176,14 +176,22 @@ impl Terrain {
         match self {
             Terrain::Flat => (p.y <= reach).then_some((p.y, UP)),
             Terrain::Slope(s) => {
-                let (sin, cos) = crate::math::sincos(s.angle);
-                let n = UP * cos - s.uphill * sin;
+                let n = s.normal();
                 let d = p.dot(n);
                 (d <= reach).then_some((d, n))
             }
             Terrain::Steps(s) => s.probe(p, reach),
             Terrain::Heightfield(h) => h.probe(p, reach),
         }
+    }
+}
+
+impl Slope {
+    /// The surface's outward unit normal.
+    #[inline]
+    pub fn normal(&self) -> DVec3 {
+        let (sin, cos) = crate::math::sincos(self.angle);
+        UP * cos - self.uphill * sin
     }
 }
 
@@ -289,6 +297,12 @@ impl Heightfield {
         h
     }
 
+    /// The cosine of the steepest triangle's slope.
+    #[inline]
+    pub fn steepest_cos(&self) -> f64 {
+        1.0 / (1.0 + self.steepest * self.steepest).sqrt()
+    }
+
     /// Vertex (i, j), its indices clamped to the grid.
     fn vertex(&self, i: i64, j: i64) -> DVec3 {
         let (ci, cj) = (
@@ -337,8 +351,7 @@ impl Heightfield {
         let vertical = p.y - self.height(p.x, p.z);
         // Above a surface no steeper than `steepest`, the distance is at
         // least the height over it times the cosine of that slope.
-        let cos = 1.0 / (1.0 + self.steepest * self.steepest).sqrt();
-        if vertical * cos > reach {
+        if vertical * self.steepest_cos() > reach {
             return None;
         }
         // The nearest point is no farther than the point straight below (or

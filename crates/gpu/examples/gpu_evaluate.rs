@@ -17,7 +17,11 @@
 //! held in its plane, its hopping FSM) with the evolved parameters and
 //! parameters around them, each moved by up to 2 % of its range.
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot] [COUNT] [SECONDS]
+//! `rough`: the walker on rough ground (`scenes/walker_rough.toml`: a
+//! heightfield, the kernel compiled with terrain), its evolved gait and
+//! random ones.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|rough] [COUNT] [SECONDS]
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -34,6 +38,7 @@ const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
 const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml");
 const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
+const WALKER_ROUGH: &str = include_str!("../../../scenes/walker_rough_evolved.toml");
 
 fn fail(e: impl std::fmt::Display) -> ! {
     eprintln!("gpu_evaluate: {e}");
@@ -44,9 +49,13 @@ fn fail(e: impl std::fmt::Display) -> ! {
 fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
     let duration = |t: &str| t.replace("duration = 10.0", &format!("duration = {seconds}"));
     let mut rng = Random::for_entry(42, k);
-    if kind == "walker" {
-        let problem = SceneProblem::parse(&duration(WALKER), "scenes/walker.toml")
-            .map_err(|e| e.to_string())?;
+    if kind == "walker" || kind == "rough" {
+        let (text, file) = if kind == "walker" {
+            (WALKER, "scenes/walker.toml")
+        } else {
+            (WALKER_ROUGH, "scenes/walker_rough_evolved.toml")
+        };
+        let problem = SceneProblem::parse(&duration(text), file).map_err(|e| e.to_string())?;
         if k == 0 {
             return problem.fresh();
         }
@@ -109,10 +118,10 @@ fn main() {
         .unwrap_or_else(|_| fail("SECONDS: a number"));
     if !matches!(
         kind,
-        "walker" | "bodies" | "neural" | "quadruped" | "roobot"
+        "walker" | "bodies" | "neural" | "quadruped" | "roobot" | "rough"
     ) || !(1..=10_000_000).contains(&count)
     {
-        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot] [COUNT 1 to 10,000,000] [SECONDS]");
+        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot|rough] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");

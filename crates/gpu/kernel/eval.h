@@ -125,6 +125,20 @@ AN_FN double an_angle_at(const double *a, const double *j, const double *b) {
     return an_atan2(sqrt(an_dot(n, n)), an_dot(ra, rb));
 }
 
+/* World::clearance: how far particle p's surface is from the ground
+ * (the floor's terrain; the plane y = 0 on the flat floor or without a
+ * floor), m. */
+AN_FN double an_clearance(const an_batch *b, an_state st, long long p) {
+    const double *x = st.x + 3 * p;
+    if (b->floor && AN_ON_TERRAIN(b)) {
+        double d, n[3];
+        if (an_probe(b->terrain, b->terrain_param, b->terrain_height, x, an_inf(), &d, n)) {
+            return d - st.r[p];
+        }
+    }
+    return x[1] - st.r[p];
+}
+
 /* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`; then the
  * roobot's own: sensors/height.rs, tilt.rs, touchdown.rs; its speed
  * sensor is AN_S_SPEED mapped from [0, 1]). */
@@ -135,7 +149,7 @@ enum {
     AN_S_LENGTH = 3,
     AN_S_ANGLE = 4,
     AN_S_TILT = 5,
-    AN_S_CLEARANCE = 6, /* HeightSensor: the clearance above the flat floor, y - r */
+    AN_S_CLEARANCE = 6, /* HeightSensor: the clearance above the floor (World::clearance) */
     AN_S_LEG_ANGLE = 7, /* TiltSensor: 0.5 + gain atan2(d . forward, d.y), d = b - a */
     AN_S_TOUCHDOWN = 8  /* TouchdownSensor: (v + sqrt(v^2 + 2 g h)) / g */
 };
@@ -150,14 +164,14 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
     double reading, d[3];
     switch (b->sensor_kind[q]) {
     case AN_S_CLEARANCE:
-        return an_unit(pa[1] - st.r[ids[0]]);
+        return an_unit(an_clearance(b, st, ids[0]));
     case AN_S_LEG_ANGLE:
         for (int k = 0; k < 3; k++) {
             d[k] = pb[k] - pa[k];
         }
         return an_unit(0.5 + param[3] * an_atan2(an_dot(d, param), d[1]));
     case AN_S_TOUCHDOWN: {
-        double h = an_unit(pa[1] - st.r[ids[0]]), vy = v[3 * ids[0] + 1], g = param[3];
+        double h = an_unit(an_clearance(b, st, ids[0])), vy = v[3 * ids[0] + 1], g = param[3];
         return an_unit((vy + sqrt(vy * vy + 2.0 * g * h)) / g);
     }
     case AN_S_HEIGHT:
@@ -166,8 +180,8 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
     case AN_S_SPEED:
         reading = an_dot(v + 3 * ids[0], param);
         break;
-    case AN_S_TOUCH: /* TOUCH_TOLERANCE, on the flat floor */
-        reading = pa[1] - st.r[ids[0]] <= 1e-3 ? 1.0 : 0.0;
+    case AN_S_TOUCH: /* TOUCH_TOLERANCE */
+        reading = an_clearance(b, st, ids[0]) <= 1e-3 ? 1.0 : 0.0;
         break;
     case AN_S_LENGTH: /* glam's distance: (a - b).length() */
         for (int k = 0; k < 3; k++) {
@@ -522,10 +536,10 @@ AN_FN const int *an_measure_ids(const an_batch *b, long long q, long long *nk) {
     return b->measure_id + k0;
 }
 
-/* Whether particle p of the creature whose state is st touches the flat
+/* Whether particle p of the creature whose state is st touches the
  * floor within `tolerance` (World::clearance). */
-AN_FN int an_on_floor(an_state st, long long p, double tolerance) {
-    return st.x[3 * p + 1] - st.r[p] <= tolerance;
+AN_FN int an_on_floor(const an_batch *b, an_state st, long long p, double tolerance) {
+    return an_clearance(b, st, p) <= tolerance;
 }
 
 /* Recorder::new: the centres that displacements and speeds start from. */
@@ -550,13 +564,13 @@ AN_FN void an_measures_step(const an_batch *b, an_state st, long long c) {
         const int *ids = an_measure_ids(b, q, &nk);
         int kind = b->measure_kind[q];
         if (kind == AN_M_CONTACT) {
-            if (an_on_floor(st, ids[0], tolerance)) {
+            if (an_on_floor(b, st, ids[0], tolerance)) {
                 b->measure_sum[q] = b->measure_sum[q] + 1.0;
             }
         } else if (kind == AN_M_FEET) {
             long long count = 0;
             for (long long i = 0; i < n; i++) {
-                if (st.w[i] > 0.0 && an_on_floor(st, i, tolerance)) {
+                if (st.w[i] > 0.0 && an_on_floor(b, st, i, tolerance)) {
                     count++;
                 }
             }
@@ -600,14 +614,14 @@ AN_FN void an_measures_finish(const an_batch *b, an_state st, long long c, long 
 }
 
 /* EvolveSpec::ending: the first fail_on_touch particle within the
- * tolerance of the (flat) floor, else the first fail_on_stretch pair
+ * tolerance of the floor, else the first fail_on_stretch pair
  * stretched; AN_TIMEOUT where none holds. `which` gets the rule. */
 AN_FN int an_ending(const an_batch *b, an_state st, long long c, long long *which) {
     const double *x = st.x;
     double tolerance = b->eval_param[AN_PARAMS * c + 5];
     for (long long k = b->first_touch[c]; k < b->first_touch[c + 1]; k++) {
         long long p = b->touch_particle[k];
-        if (x[3 * p + 1] - st.r[p] <= tolerance) {
+        if (an_on_floor(b, st, p, tolerance)) {
             *which = k - b->first_touch[c];
             return AN_TOUCH;
         }

@@ -16,7 +16,7 @@
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
  * constant forces, fluids (still or in a uniform current) on every particle and their drag across springs ([fluid]
  * springs), soft (penalty) contact between spheres, the
- * flat floor (its located collisions with backtracking, and its contact force), and the explicit integrators
+ * floor, flat or on terrain (terrain.h: its located collisions with backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
  */
@@ -30,6 +30,7 @@
 #define AN_FN static inline
 #endif
 #include "libm.h"
+#include "terrain.h"
 
 /* Integrators, as IntegratorKind's order in the engine. */
 enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
@@ -175,6 +176,9 @@ typedef struct {
     const double *plane_param;    /* 7 per plane: point, unit normal, 1 if handled before the floor */
     const long long *plane_first_particle; /* per plane, over the batch: its particles */
     const int *plane_particle;    /* a particle, within the creature */
+    const double *terrain_param;  /* the floor's shape (terrain.h): its numbers */
+    const double *terrain_height; /* a heightfield's heights */
+    int terrain;                  /* AN_T_FLAT ... (terrain.h) */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -400,20 +404,11 @@ AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const doub
     }
 }
 
-/* The flat floor's contact force on particle i (forces/floor_contact.rs,
- * `contact` and `friction`): a sphere resting on the plane and pressed
- * into it is held up, and rubs. h is the trial's step. */
-AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long long p,
-                            const double *x, const double *v, double *f, double h) {
-    if (st.w[i] == 0.0 || x[1] - st.r[i] > b->contact_tolerance) {
-        return;
-    }
-    if (v[1] > 0.0 || v[1] < -b->rest_speed || f[1] >= 0.0) {
-        return;
-    }
-    double normal = -f[1];
-    f[1] = 0.0;
-    double vt[3] = {v[0], 0.0, v[2]}, ft[3] = {f[0], 0.0, f[2]}, fr[3];
+/* The friction on resting particle i (forces/floor_contact.rs,
+ * `friction`) sliding at vt under the tangential force ft, pressed with
+ * `normal`, into fr. h is the trial's step. */
+AN_FN void an_friction(const an_batch *b, an_state st, long long i, long long p, const double *vt,
+                       const double *ft, double normal, double h, double *fr) {
     double m = st.m[i];
     double speed = sqrt(an_dot(vt, vt));
     if (speed < b->static_speed) {
@@ -444,6 +439,65 @@ AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long lo
             fr[q] = -(dir[q] * kinetic);
         }
     }
+}
+
+/* The floor's contact force on particle i on terrain (floor_contact.rs,
+ * `on_terrain`): as on the flat floor, along the surface's normal at the
+ * nearest point, a normal speed within 1 um/s of zero cancelled too. */
+AN_COLD void an_terrain_contact(const an_batch *b, an_state st, long long i, long long p,
+                              const double *x, const double *v, double *f, double h) {
+    if (st.w[i] == 0.0) {
+        return;
+    }
+    double r = st.r[i], d, n[3];
+    if (!an_probe(b->terrain, b->terrain_param, b->terrain_height, x, r + b->contact_tolerance,
+                  &d, n)) {
+        return;
+    }
+    if (d - r > b->contact_tolerance) {
+        return;
+    }
+    double vn = an_dot(v, n), fn = an_dot(f, n);
+    if (vn > 1e-6 || vn < -b->rest_speed || fn >= 0.0) {
+        return;
+    }
+    double m = st.m[i];
+    double normal = -fn;
+    double ft[3], vt[3], fr[3];
+    for (int q = 0; q < 3; q++) {
+        ft[q] = f[q] - n[q] * fn;
+    }
+    double residual = an_fabs(vn) <= 1e-6 ? vn : 0.0;
+    double cancel = residual * m / h;
+    for (int q = 0; q < 3; q++) {
+        f[q] = ft[q] - n[q] * cancel;
+        vt[q] = v[q] - n[q] * vn;
+    }
+    an_friction(b, st, i, p, vt, ft, normal, h, fr);
+    for (int q = 0; q < 3; q++) {
+        f[q] += fr[q];
+    }
+}
+
+/* The flat floor's contact force on particle i (forces/floor_contact.rs,
+ * `contact` and `friction`): a sphere resting on the plane and pressed
+ * into it is held up, and rubs. h is the trial's step. */
+AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long long p,
+                            const double *x, const double *v, double *f, double h) {
+    if (AN_ON_TERRAIN(b)) {
+        an_terrain_contact(b, st, i, p, x, v, f, h);
+        return;
+    }
+    if (st.w[i] == 0.0 || x[1] - st.r[i] > b->contact_tolerance) {
+        return;
+    }
+    if (v[1] > 0.0 || v[1] < -b->rest_speed || f[1] >= 0.0) {
+        return;
+    }
+    double normal = -f[1];
+    f[1] = 0.0;
+    double vt[3] = {v[0], 0.0, v[2]}, ft[3] = {f[0], 0.0, f[2]}, fr[3];
+    an_friction(b, st, i, p, vt, ft, normal, h, fr);
     for (int q = 0; q < 3; q++) {
         f[q] += fr[q];
     }
@@ -666,6 +720,105 @@ AN_FN void an_floor_handle(const an_batch *b, an_state st, long long p0, long lo
     }
 }
 
+/* The floor's check of a trial on terrain (events/floor_collision.rs,
+ * `check_terrain`): the deepest sphere below the surface. */
+AN_COLD int an_terrain_check(const an_batch *b, an_state st, long long n, const double *x1) {
+    double deepest = 0.0;
+    int any = 0;
+    for (long long i = 0; i < n; i++) {
+        double d, nrm[3];
+        if (st.w[i] == 0.0 ||
+            !an_probe(b->terrain, b->terrain_param, b->terrain_height, x1 + 3 * i, st.r[i], &d,
+                      nrm)) {
+            continue;
+        }
+        double gap = d - st.r[i];
+        if (gap < 0.0) {
+            any = 1;
+            deepest = deepest < gap ? deepest : gap;
+        }
+    }
+    if (!any) {
+        return AN_NONE;
+    }
+    return deepest < -b->envelope ? AN_MISSED : AN_OCCURRING;
+}
+
+/* The floor's handling of a trial of step h on terrain (`resolve` off
+ * the flat floor): each sphere below the surface moved out along the
+ * normal at its nearest point, its normal speed resolved as on the flat
+ * floor (`normal_speed`), and a sphere that the move lifts against
+ * gravity, or whose rebound gains speed, slowed along the surface so
+ * that it gains no energy. */
+AN_COLD void an_terrain_handle(const an_batch *b, an_state st, long long p0, long long n, double h,
+                             double step, const double *v0, double *x1, double *v1) {
+    double g[3] = {0.0, 0.0, 0.0};
+    if (b->gravity) {
+        g[0] = b->gx;
+        g[1] = b->gy;
+        g[2] = b->gz;
+    }
+    for (long long i = 0; i < n; i++) {
+        long long p = p0 + i;
+        double r = st.r[i], d, nrm[3];
+        double *x = x1 + 3 * i, *v = v1 + 3 * i;
+        if (st.w[i] == 0.0 ||
+            !an_probe(b->terrain, b->terrain_param, b->terrain_height, x, r, &d, nrm)) {
+            continue;
+        }
+        double gap = d - r;
+        if (!(gap < 0.0)) {
+            continue;
+        }
+        double dv[3];
+        for (int e = 0; e < 3; e++) {
+            dv[e] = v[e] - v0[3 * i + e];
+        }
+        double accel = an_dot(dv, nrm) / h;
+        double shift = b->flight_shift * accel * step;
+        double e = b->restitution[p];
+        double depth = -gap;
+        for (int q = 0; q < 3; q++) {
+            x[q] = x[q] + nrm[q] * depth;
+        }
+        double vn = an_dot(v, nrm);
+        /* normal_speed */
+        double under = vn * vn + 2.0 * accel * depth;
+        double at_plane = sqrt(under > 0.0 ? under : 0.0);
+        double after;
+        if (vn >= 0.0) {
+            after = at_plane;
+        } else {
+            double wv = vn + shift;
+            double wunder = wv * wv + 2.0 * accel * depth;
+            double w_at_plane = sqrt(wunder > 0.0 ? wunder : 0.0);
+            double r1 = e * at_plane, r2 = e * w_at_plane - shift;
+            double rebound = r1 < r2 ? r1 : r2;
+            double flight = accel < 0.0 ? 2.0 * rebound / -accel : an_inf();
+            after = (at_plane < b->rest_speed || flight <= step) ? 0.0 : rebound;
+        }
+        double change = after - vn;
+        for (int q = 0; q < 3; q++) {
+            v[q] = v[q] + nrm[q] * change;
+        }
+        double climb = -2.0 * an_dot(g, nrm) * depth;
+        double excess = after * after - vn * vn + climb;
+        if (excess > 0.0) {
+            double slide[3];
+            for (int q = 0; q < 3; q++) {
+                slide[q] = v[q] - nrm[q] * after;
+            }
+            double slide2 = an_dot(slide, slide);
+            if (slide2 > 0.0) {
+                double keep = 1.0 - sqrt(an_max(slide2 - excess, 0.0) / slide2);
+                for (int q = 0; q < 3; q++) {
+                    v[q] = v[q] - slide[q] * keep;
+                }
+            }
+        }
+    }
+}
+
 /* Which of creature c's planes a trial leaves (events/plane_constraint.rs
  * `check`: a particle whose offset from the plane, or whose velocity,
  * along its normal is not 0), bit k for its k-th plane. */
@@ -759,7 +912,9 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     while (done < total) {
         double h = piece == total ? dt : dt * ((double)piece / (double)total);
         an_integrate(b, st, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
-        int state = b->floor ? an_floor_check(b, st, n, x1) : AN_NONE;
+        int state = !b->floor                  ? AN_NONE
+                    : AN_ON_TERRAIN(b) ? an_terrain_check(b, st, n, x1)
+                                              : an_floor_check(b, st, n, x1);
         if (state == AN_MISSED) {
             if (piece == total) {
                 piece = total / 2; /* the step again, in pieces */
@@ -782,7 +937,9 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
             }
             an_planes_handle(b, c, off, 1, x1, v1);
         }
-        if (state != AN_NONE) {
+        if (state != AN_NONE && AN_ON_TERRAIN(b)) {
+            an_terrain_handle(b, st, p0, n, h, dt, v, x1, v1); /* (no planes on terrain) */
+        } else if (state != AN_NONE) {
             an_floor_handle(b, st, p0, n, h, dt, v, x1, v1, rec);
         }
         an_planes_handle(b, c, off, 0, x1, v1);

@@ -25,6 +25,7 @@ fn source() -> String {
     };
     [
         include_str!("../kernel/libm.h"),
+        include_str!("../kernel/terrain.h"),
         include_str!("../kernel/trig.h"),
         include_str!("../kernel/exp.h"),
         include_str!("../kernel/step.h"),
@@ -39,16 +40,27 @@ fn source() -> String {
 
 /// A GPU ready to step batches.
 pub struct Device {
+    ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
-    function: CudaFunction,
-    evaluate: CudaFunction,
+    /// The kernel for batches on the flat floor (or none), compiled with
+    /// `AN_FLAT_ONLY`: without terrain's code it holds fewer registers
+    /// (`bench/nvrtc.py`: 168 against 240 for an evaluation on sm_90).
+    flat: Kernels,
+    /// The kernel with terrain, compiled when a batch on terrain first comes.
+    terrain: std::sync::OnceLock<Result<Kernels, String>>,
     name: String,
     arch: (i32, i32),
+    schedule: Schedule,
+}
+
+/// One compiled kernel's entries.
+struct Kernels {
+    step: CudaFunction,
+    evaluate: CudaFunction,
     /// Evaluation threads the GPU holds at once (its multiprocessors
     /// times the blocks of the evaluation each holds, times [`BLOCK`]):
     /// the threads of a [`Schedule::Queue`] launch.
     resident: i64,
-    schedule: Schedule,
 }
 
 /// How a GPU's threads share the evaluations of a batch. Either gives the
@@ -94,56 +106,28 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let src = source();
-        let options = options(arch);
-        // The kernel compiled by an earlier run, where one was kept
-        // (src/cache.rs); else compiled now, and kept.
-        let kept = crate::cache::folder().map(|dir| {
-            crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch)
-        });
-        let load = |cubin: Vec<u8>| ctx.load_module(cudarc::nvrtc::Ptx::from_binary(cubin));
-        let cached = kept
-            .as_deref()
-            .and_then(crate::cache::read)
-            .and_then(|cubin| load(cubin).ok());
-        let module = match cached {
-            Some(module) => module,
-            None => {
-                let cubin = compile(&src, &options, arch)?;
-                let module = load(cubin.clone())
-                    .map_err(|e| format!("loading the compiled step on {name}: {e}"))?;
-                if let Some(path) = &kept {
-                    // Without a cache the next run compiles again: no error.
-                    let _ = crate::cache::write(path, &cubin);
-                }
-                module
-            }
-        };
-        let function = module
-            .load_function("animats_step_kernel")
-            .map_err(|e| format!("the step's entry: {e}"))?;
-        let evaluate = module
-            .load_function("animats_evaluate_kernel")
-            .map_err(|e| format!("the evaluation's entry: {e}"))?;
-        let sms = ctx
-            .attribute(
-                cudarc::driver::sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT,
-            )
-            .map_or(1, |n| i64::from(n.max(1)));
-        let per_sm = evaluate
-            .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
-            .map_err(|e| format!("the evaluation's occupancy: {e}"))?
-            .max(1);
-        let resident = sms * i64::from(per_sm) * i64::from(BLOCK);
+        let flat = kernels(&ctx, arch, &name, true)?;
         Ok(Device {
             stream: ctx.default_stream(),
-            function,
-            evaluate,
+            ctx,
+            flat,
+            terrain: std::sync::OnceLock::new(),
             name,
             arch,
-            resident,
             schedule: Schedule::default(),
         })
+    }
+
+    /// The kernel for `batch`: the flat floor's, or terrain's (compiled
+    /// now if it was not yet).
+    fn kernels(&self, batch: &Batch) -> Result<&Kernels, String> {
+        if !batch.on_terrain() {
+            return Ok(&self.flat);
+        }
+        self.terrain
+            .get_or_init(|| kernels(&self.ctx, self.arch, &self.name, false))
+            .as_ref()
+            .map_err(Clone::clone)
     }
 
     /// The device's name.
@@ -165,7 +149,8 @@ impl Device {
         let creatures = batch.creatures() as i64;
         let steps = steps.min(i64::MAX as u64) as i64;
         let local = batch.layout().flag();
-        let mut launch = s.launch_builder(&self.function);
+        let kernels = self.kernels(batch)?;
+        let mut launch = s.launch_builder(&kernels.step);
         launch.arg(&raw).arg(&creatures).arg(&steps).arg(&local);
         // SAFETY: the kernel reads and writes within the arrays just
         // uploaded, at the offsets `Batch::pack` checked; the arguments
@@ -196,11 +181,12 @@ impl Device {
         let next = s
             .alloc_zeros::<u64>(1)
             .map_err(err("the queue's counter"))?;
+        let kernels = self.kernels(batch)?;
         let (queue, threads) = match self.schedule {
             Schedule::Static => (0i32, creatures),
-            Schedule::Queue => (1i32, creatures.min(self.resident)),
+            Schedule::Queue => (1i32, creatures.min(kernels.resident)),
         };
-        let mut launch = s.launch_builder(&self.evaluate);
+        let mut launch = s.launch_builder(&kernels.evaluate);
         launch
             .arg(&raw)
             .arg(&creatures)
@@ -238,6 +224,62 @@ impl Device {
             device.evaluate(&mut batch)
         }))
     }
+}
+
+/// The kernel compiled for `arch` (`flat`: with `AN_FLAT_ONLY`), from
+/// the disk's cache where an earlier run kept it (src/cache.rs), else by
+/// NVRTC now, and kept.
+fn kernels(
+    ctx: &Arc<CudaContext>,
+    arch: (i32, i32),
+    name: &str,
+    flat: bool,
+) -> Result<Kernels, String> {
+    let src = source();
+    let mut options = options(arch);
+    if flat {
+        options.push("-DAN_FLAT_ONLY".into());
+    }
+    let kept = crate::cache::folder()
+        .map(|dir| crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch));
+    let load = |cubin: Vec<u8>| ctx.load_module(cudarc::nvrtc::Ptx::from_binary(cubin));
+    let cached = kept
+        .as_deref()
+        .and_then(crate::cache::read)
+        .and_then(|cubin| load(cubin).ok());
+    let module = match cached {
+        Some(module) => module,
+        None => {
+            let cubin = compile(&src, &options, arch)?;
+            let module = load(cubin.clone())
+                .map_err(|e| format!("loading the compiled step on {name}: {e}"))?;
+            if let Some(path) = &kept {
+                // Without a cache the next run compiles again: no error.
+                let _ = crate::cache::write(path, &cubin);
+            }
+            module
+        }
+    };
+    let step = module
+        .load_function("animats_step_kernel")
+        .map_err(|e| format!("the step's entry: {e}"))?;
+    let evaluate = module
+        .load_function("animats_evaluate_kernel")
+        .map_err(|e| format!("the evaluation's entry: {e}"))?;
+    let sms = ctx
+        .attribute(
+            cudarc::driver::sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT,
+        )
+        .map_or(1, |n| i64::from(n.max(1)));
+    let per_sm = evaluate
+        .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
+        .map_err(|e| format!("the evaluation's occupancy: {e}"))?
+        .max(1);
+    Ok(Kernels {
+        step,
+        evaluate,
+        resident: sms * i64::from(per_sm) * i64::from(BLOCK),
+    })
 }
 
 /// A driver error as a message saying what was being done.
@@ -400,6 +442,7 @@ mod tests {
             "an_atan2",
             "an_sin",
             "an_step_creature",
+            "an_probe",
             "an_evaluate_creature",
             "animats_evaluate_kernel",
             "animats_step_kernel",

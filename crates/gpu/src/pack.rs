@@ -3,9 +3,10 @@
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
 use animats_engine::{
-    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, World,
+    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, Terrain, World,
 };
 use std::os::raw::{c_double, c_int, c_longlong};
+use std::sync::Arc;
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
 /// copies on a GPU).
@@ -134,6 +135,9 @@ pub(crate) struct Raw {
     plane_param: *const c_double,
     plane_first_particle: *const c_longlong,
     plane_particle: *const c_int,
+    terrain_param: *const c_double,
+    terrain_height: *const c_double,
+    terrain: c_int,
 }
 
 extern "C" {
@@ -263,6 +267,11 @@ pub struct Batch {
     plane_param: Vec<f64>,
     plane_first_particle: Vec<i64>,
     plane_particle: Vec<i32>,
+    /// The floor's shape (`kernel/terrain.h`): its kind, its numbers and a
+    /// heightfield's heights.
+    terrain: c_int,
+    terrain_param: Vec<f64>,
+    terrain_height: Vec<f64>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -329,6 +338,9 @@ impl Batch {
             push_particle: Vec::new(),
             push_force: Vec::new(),
             floor: floor_of(first).map_err(|e| format!("world 0: {e}"))?,
+            terrain: 0,
+            terrain_param: Vec::new(),
+            terrain_height: Vec::new(),
             g,
             gravity,
             integrator,
@@ -350,6 +362,9 @@ impl Batch {
             plane_particle: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
+        if let Some(f) = &b.floor {
+            (b.terrain, b.terrain_param, b.terrain_height) = terrain_arrays(&f.terrain);
+        }
         for (k, w) in worlds.iter().enumerate() {
             supported(w).map_err(|what| format!("world {k}: {what}"))?;
             let same_gravity = w.forces().gravity().is_some() == gravity
@@ -479,6 +494,11 @@ impl Batch {
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         b.ev.no_rules(worlds.len());
         Ok(b)
+    }
+
+    /// Whether the batch's floor has a shape (`[terrain]`).
+    pub fn on_terrain(&self) -> bool {
+        self.terrain != 0
     }
 
     /// Creatures in the batch.
@@ -690,6 +710,8 @@ impl Batch {
             Array::PlaneParam => F64(&self.plane_param),
             Array::PlaneFirstParticle => I64(&self.plane_first_particle),
             Array::PlaneParticle => I32(&self.plane_particle),
+            Array::TerrainParam => F64(&self.terrain_param),
+            Array::TerrainHeight => F64(&self.terrain_height),
         }
     }
 
@@ -772,11 +794,19 @@ impl Batch {
             },
             dt: self.dt,
             floor: c_int::from(self.floor.is_some()),
-            floor_contact: c_int::from(self.floor.is_some_and(|f| f.contact.is_some())),
-            envelope: self.floor.map_or(0.0, |f| f.envelope),
-            rest_speed: self.floor.map_or(0.0, |f| f.rest_speed),
-            static_speed: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.0),
-            contact_tolerance: self.floor.and_then(|f| f.contact).map_or(0.0, |c| c.1),
+            floor_contact: c_int::from(self.floor.as_ref().is_some_and(|f| f.contact.is_some())),
+            envelope: self.floor.as_ref().map_or(0.0, |f| f.envelope),
+            rest_speed: self.floor.as_ref().map_or(0.0, |f| f.rest_speed),
+            static_speed: self
+                .floor
+                .as_ref()
+                .and_then(|f| f.contact)
+                .map_or(0.0, |c| c.0),
+            contact_tolerance: self
+                .floor
+                .as_ref()
+                .and_then(|f| f.contact)
+                .map_or(0.0, |c| c.1),
             flight_shift: self.integrator.free_flight_shift(),
             first_pair: l(Array::FirstPair),
             pair_a: i(Array::PairA),
@@ -851,6 +881,9 @@ impl Batch {
             plane_param: c(Array::PlaneParam),
             plane_first_particle: l(Array::PlaneFirstParticle),
             plane_particle: i(Array::PlaneParticle),
+            terrain_param: c(Array::TerrainParam),
+            terrain_height: c(Array::TerrainHeight),
+            terrain: self.terrain,
         }
     }
 }
@@ -887,6 +920,9 @@ fn supported(w: &World) -> Result<(), String> {
     }
     if planes > MAX_PLANES {
         return refuse(&format!("more than {MAX_PLANES} plane constraints"));
+    }
+    if planes > 0 && w.terrain().is_some_and(|t| !t.is_flat()) {
+        return refuse("a plane constraint on terrain");
     }
     if f.gravity().is_some_and(|g| g.targets != Targets::All) {
         return refuse("gravity on some particles only");
@@ -1054,11 +1090,13 @@ pub(crate) enum Array {
     PlaneParam,
     PlaneFirstParticle,
     PlaneParticle,
+    TerrainParam,
+    TerrainHeight,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 109] = [
+    pub(crate) const ALL: [Array; 111] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1168,6 +1206,8 @@ impl Array {
         Array::PlaneParam,
         Array::PlaneFirstParticle,
         Array::PlaneParticle,
+        Array::TerrainParam,
+        Array::TerrainHeight,
     ];
 }
 
@@ -1181,17 +1221,70 @@ mod tests {
     }
 }
 
-/// A batch's floor: the plane y = 0 under every particle.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A batch's floor, under every particle: the plane y = 0 or terrain.
+#[derive(Clone)]
 struct Floor {
     envelope: f64,
     rest_speed: f64,
     /// The contact force's static speed and contact tolerance, if it has one.
     contact: Option<(f64, f64)>,
+    /// The ground's shape.
+    terrain: Arc<Terrain>,
 }
 
-/// World `w`'s floor, if it has one the C steps (flat, under every
-/// particle); `Err` names what it does not.
+impl PartialEq for Floor {
+    fn eq(&self, other: &Floor) -> bool {
+        (self.envelope, self.rest_speed, self.contact)
+            == (other.envelope, other.rest_speed, other.contact)
+            && (Arc::ptr_eq(&self.terrain, &other.terrain) || self.terrain == other.terrain)
+    }
+}
+
+impl std::fmt::Debug for Floor {
+    /// Its numbers and the ground's kind (not a heightfield's heights).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ground = match &*self.terrain {
+            Terrain::Flat => "flat".to_string(),
+            Terrain::Slope(s) => format!("a slope of {} rad", s.angle),
+            Terrain::Steps(s) => format!("{} steps", s.count),
+            Terrain::Heightfield(h) => format!("a {} x {} heightfield", h.nx, h.nz),
+        };
+        write!(
+            f,
+            "envelope {}, rest speed {}, contact {:?}, ground {ground}",
+            self.envelope, self.rest_speed, self.contact
+        )
+    }
+}
+
+/// The C's terrain (`kernel/terrain.h`): its kind, its numbers and a
+/// heightfield's heights, each number as the engine computes it.
+fn terrain_arrays(t: &Terrain) -> (c_int, Vec<f64>, Vec<f64>) {
+    match t {
+        Terrain::Flat => (0, Vec::new(), Vec::new()),
+        Terrain::Slope(s) => (1, s.normal().to_array().to_vec(), Vec::new()),
+        Terrain::Steps(s) => {
+            let mut p = s.direction.to_array().to_vec();
+            p.extend([s.start, s.height, s.depth, f64::from(s.count)]);
+            (2, p, Vec::new())
+        }
+        Terrain::Heightfield(h) => (
+            3,
+            vec![
+                h.origin.x,
+                h.origin.y,
+                h.cell,
+                h.steepest_cos(),
+                h.nx as f64,
+                h.nz as f64,
+            ],
+            h.heights.clone(),
+        ),
+    }
+}
+
+/// World `w`'s floor, if it has one the C steps (under every particle);
+/// `Err` names what it does not.
 fn floor_of(w: &World) -> Result<Option<Floor>, String> {
     use animats_engine::Targets;
     let collision = w
@@ -1207,8 +1300,8 @@ fn floor_of(w: &World) -> Result<Option<Floor>, String> {
             ),
         };
     };
-    if !collision.terrain().is_flat() {
-        return Err("terrain is not in the GPU step yet".into());
+    if contact.is_some_and(|c| *c.terrain != *collision.terrain()) {
+        return Err("a floor whose contact force and collisions meet different ground is not in the GPU step yet".into());
     }
     if collision.targets != Targets::All || contact.is_some_and(|c| c.targets != Targets::All) {
         return Err("a floor under some particles only is not in the GPU step yet".into());
@@ -1220,5 +1313,6 @@ fn floor_of(w: &World) -> Result<Option<Floor>, String> {
         envelope: collision.envelope,
         rest_speed: collision.rest_speed,
         contact: contact.map(|c| (c.static_speed, c.contact_tolerance)),
+        terrain: Arc::clone(collision.shared_terrain()),
     }))
 }

@@ -397,6 +397,74 @@ clock = 2.0
 }
 
 #[test]
+fn walkers_on_terrain_are_the_engine_s_to_the_bit() {
+    // scenes/walker_rough.toml (the evolved walker on a heightfield), its
+    // gait and random ones; then the walker on a slope, up steps and down
+    // them, feeling the ground with a touch sensor on each foot (its
+    // clearance from the terrain) through a network, counting its feet on
+    // the ground (`feet`, `contact_fraction`) and ending when a hip
+    // touches it.
+    let rough = include_str!("../../../scenes/walker_rough.toml")
+        .replace("duration = 10.0", "duration = 2.0");
+    let got = assert_same(genomes(&rough, 8, 9), "walker on rough ground");
+    assert!(distinct_distances(&got) > 5, "{got:?}");
+    let senses = r#"
+[[sensor]]
+name = "fl"
+kind = "touch"
+particle = "foot_fl"
+
+[[sensor]]
+name = "br"
+kind = "touch"
+particle = "foot_br"
+
+[[controller]]
+name = "gait"
+kind = "neural"
+inputs = ["fl", "br"]
+outputs = ["leg_fl", "leg_fr", "leg_bl", "leg_br", "stride_l", "stride_r"]
+hidden = [4]
+clock = 2.0
+"#;
+    let archive = r#"
+[archive]
+measures = [{ kind = "contact_fraction", particle = "foot_fl" }, { kind = "feet" }]
+bins = [2, 2]
+ranges = [[0.0, 1.0], [0.0, 6.0]]
+"#;
+    let start = WALKER.find("[[controller]]").unwrap();
+    let end = WALKER.find("[evolve]").unwrap();
+    let brain = format!("{}{senses}\n{}", &WALKER[..start], &WALKER[end..])
+        .replace("duration = 10.0", "duration = 2.0")
+        + archive;
+    for (ground, terrain) in [
+        (
+            "a slope",
+            "kind = \"slope\"\nangle = 6.0\ndirection = [0.8, 0.0, 0.6]",
+        ),
+        (
+            "steps up",
+            "kind = \"steps\"\nheight = 0.03\ndepth = 0.25\nstart = 0.2",
+        ),
+        (
+            "steps down",
+            "kind = \"steps\"\nheight = -0.03\ndepth = 0.25\nstart = 0.2",
+        ),
+    ] {
+        let text = brain.replace("[floor]\n", &format!("[floor]\n\n[terrain]\n{terrain}\n"));
+        assert!(text.contains("[terrain]"), "{ground}");
+        let got = assert_same(genomes(&text, 8, 10), &format!("neural walker on {ground}"));
+        assert!(distinct_distances(&got) > 5, "{ground}: {got:?}");
+        let touched = got.iter().filter(|e| e.measures[0] > 0.0).count();
+        assert!(
+            touched > 4,
+            "{ground}: a foot touched in {touched} of 8: {got:?}"
+        );
+    }
+}
+
+#[test]
 fn ctrnn_brains_are_the_engine_s_to_the_bit() {
     // The walker's CTRNN (its recurrent neurons' states carried from step
     // to step), its own and random genomes, and perturbed trials.

@@ -245,6 +245,103 @@ fn bodies_falling_onto_the_floor_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Bodies dropped onto terrain (terrain.rs): a slope rising along a random
+/// heading, a flight of steps up (and, for half the batches, down) along
+/// another, and a heightfield of random heights whose edge the bodies
+/// cross (where its heights go on), with and without the floor's contact
+/// force; each batch shares one ground, as a batch shares one floor. The
+/// same bodies on the flat floor end elsewhere: the ground's shape is
+/// felt.
+#[test]
+fn bodies_falling_onto_terrain_are_the_engine_s_to_the_bit() {
+    use animats_engine::{Heightfield, Slope, Steps, Terrain};
+    let mut rng = Random::for_entry(17, 0);
+    let heading = |rng: &mut Random| {
+        let a = rng.between(0.0, std::f64::consts::TAU);
+        DVec3::new(
+            animats_engine::math::cos(a),
+            0.0,
+            animats_engine::math::sin(a),
+        )
+    };
+    for (b, kind) in INTEGRATORS.into_iter().enumerate() {
+        let terrains = [
+            Terrain::Slope(Slope {
+                angle: rng.between(0.1, 0.5),
+                uphill: heading(&mut rng),
+            }),
+            Terrain::Steps(Steps {
+                direction: heading(&mut rng),
+                start: rng.between(-0.8, 0.0),
+                height: if b % 2 == 0 { 0.08 } else { -0.08 },
+                depth: rng.between(0.1, 0.3),
+                count: 8,
+            }),
+            Terrain::Heightfield(Heightfield::new(
+                animats_engine::DVec2::new(-1.5, -1.5),
+                0.1,
+                21,
+                23,
+                (0..21 * 23).map(|_| rng.between(-0.15, 0.15)).collect(),
+            )),
+        ];
+        for (ground, terrain) in ["slope", "steps", "heightfield"].into_iter().zip(terrains) {
+            for contact in [true, false] {
+                let floor = FloorDef {
+                    contact,
+                    terrain: terrain.clone(),
+                    ..FloorDef::default()
+                };
+                let mut flat = Vec::new();
+                let mut worlds: Vec<World> = (0..8)
+                    .map(|k| {
+                        let n = 2 + (rng.uniform() * 30.0) as usize;
+                        let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind).unwrap();
+                        for p in w.particle_ids().collect::<Vec<_>>() {
+                            let x = w.position(p) + DVec3::new(0.0, 2.0, 0.0);
+                            w.set_position(p, x).unwrap();
+                        }
+                        let mut on_flat = w.clone();
+                        on_flat.add_floor(FloorDef::default()).unwrap();
+                        flat.push(on_flat);
+                        w.add_floor(floor.clone()).unwrap();
+                        w
+                    })
+                    .collect();
+                let what = format!("bodies on a {ground}, {kind:?}, contact {contact}");
+                assert_same(&mut worlds, 1e-3, 400, 4, &what);
+                let backtracked: u64 = worlds.iter().map(|w| w.stats().backtracks).sum();
+                let touching = worlds
+                    .iter()
+                    .filter(|w| w.particle_ids().any(|p| w.clearance(p) < 0.05))
+                    .count();
+                for w in flat.iter_mut() {
+                    for _ in 0..1600 {
+                        if w.step(1e-3).is_err() {
+                            break;
+                        }
+                    }
+                }
+                let elsewhere = worlds
+                    .iter()
+                    .zip(&flat)
+                    .filter(|(a, b)| a.state().pos != b.state().pos)
+                    .count();
+                eprintln!("{what}: {backtracked} backtracks, {touching} of 8 within 5 cm of the ground, {elsewhere} of 8 elsewhere on the flat floor");
+                assert!(
+                    touching >= 4,
+                    "{what}: only {touching} bodies near the ground"
+                );
+                assert!(
+                    elsewhere == 8,
+                    "{what}: {elsewhere} of 8 bodies felt the terrain"
+                );
+                assert!(backtracked > 0, "{what}: no collision was located");
+            }
+        }
+    }
+}
+
 /// Bodies held in planes (events/plane_constraint.rs, the roobot's planar
 /// motion) falling onto the floor: half in a vertical plane at a random
 /// heading (the roobot's), half in a plane slanted at random, which the
@@ -432,19 +529,41 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         w.add_spring(SpringDef::new(a, b, 10.0, 0.1)).unwrap();
         w
     };
-    let mut slope = plain();
-    let terrain = animats_engine::Terrain::Slope(animats_engine::Slope {
-        angle: 0.2,
-        uphill: DVec3::X,
-    });
-    slope
-        .add_floor(FloorDef {
+    // A batch shares one ground; a body held in a plane walks on the flat
+    // floor only.
+    let sloped = |angle| {
+        let mut w = plain();
+        let terrain = animats_engine::Terrain::Slope(animats_engine::Slope {
+            angle,
+            uphill: DVec3::X,
+        });
+        w.add_floor(FloorDef {
             terrain,
             ..FloorDef::default()
         })
         .unwrap();
-    let err = Batch::pack(&[&slope], 1e-3).unwrap_err();
-    assert_eq!(err, "world 0: terrain is not in the GPU step yet");
+        w
+    };
+    assert!(Batch::pack(&[&sloped(0.2), &sloped(0.2)], 1e-3).is_ok());
+    let err = Batch::pack(&[&sloped(0.2), &sloped(0.3)], 1e-3).unwrap_err();
+    assert!(
+        err.starts_with("world 1: a batch shares one floor")
+            && err.contains("a slope of 0.2 rad")
+            && err.contains("a slope of 0.3 rad"),
+        "{err}"
+    );
+    let mut held = sloped(0.2);
+    let ids: Vec<_> = held.particle_ids().collect();
+    held.add_event(Box::new(animats_engine::PlaneConstraint::new(
+        DVec3::ZERO,
+        DVec3::Z,
+        ids,
+    )));
+    let err = Batch::pack(&[&held], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: a plane constraint on terrain is not in the GPU step yet"
+    );
     let mut floor = plain();
     floor.add_floor(FloorDef::default()).unwrap();
     let err = Batch::pack(&[&plain(), &floor], 1e-3).unwrap_err();

@@ -162,6 +162,11 @@ impl FloorCollision {
         &self.terrain
     }
 
+    /// The ground's shape, shared (the floor's contact force holds the same).
+    pub fn shared_terrain(&self) -> &Arc<Terrain> {
+        &self.terrain
+    }
+
     /// Checks the thresholds (an infinite envelope never backtracks).
     pub fn validate(&self) -> Result<(), ModelError> {
         if self.envelope.is_nan() || self.envelope < 0.0 {
