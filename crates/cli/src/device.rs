@@ -1,8 +1,9 @@
-//! `--device cpu|cuda`: where `evaluate` and `evolve` run a scene's
-//! evaluations. `cpu` (the default) is the engine on every core; `cuda`
-//! hands them to an NVIDIA GPU a batch at a time (a generation's runs at
-//! the scene's step, then those at half of it), one GPU thread per run,
-//! with the same bits (docs/GPU.md).
+//! `--device cpu|cuda|cuda-fast`: where `evaluate` and `evolve` run a
+//! scene's evaluations. `cpu` (the default) is the engine on every core;
+//! `cuda` hands them to an NVIDIA GPU a batch at a time (a generation's
+//! runs at the scene's step, then those at half of it), one GPU thread per
+//! run, with the same bits (docs/GPU.md); `cuda-fast` likewise with fused
+//! multiply-adds allowed: not the CPU's bits.
 
 use animats_creatures::random::Random;
 use animats_evolve::run::ProblemSpec;
@@ -18,6 +19,9 @@ pub enum DeviceName {
     Cpu,
     /// An NVIDIA GPU (its driver and NVRTC are loaded at run time).
     Cuda,
+    /// An NVIDIA GPU, fused multiply-adds allowed (`--fmad=true`): results
+    /// drift from the engine's bits as a step's own errors do.
+    CudaFast,
 }
 
 /// Where the evaluations of `file`'s scene run: `None` on the CPU; on
@@ -32,15 +36,21 @@ pub fn batches(
 ) -> Result<Option<Batches>, String> {
     match device {
         DeviceName::Cpu => Ok(None),
-        DeviceName::Cuda => {
+        DeviceName::Cuda | DeviceName::CudaFast => {
+            let (flag, mode) = if device == DeviceName::Cuda {
+                ("cuda", animats_gpu::Mode::Strict)
+            } else {
+                ("cuda-fast", animats_gpu::Mode::Fast)
+            };
             let scene = probe()?;
             animats_gpu::Batch::pack_scenes(&[&scene]).map_err(|e| {
                 format!(
-                    "{file}: --device cuda: {}",
+                    "{file}: --device {flag}: {}",
                     e.strip_prefix("scene 0: ").unwrap_or(&e)
                 )
             })?;
-            let device = animats_gpu::Device::open().map_err(|e| format!("--device cuda: {e}"))?;
+            let device =
+                animats_gpu::Device::open_in(mode).map_err(|e| format!("--device {flag}: {e}"))?;
             Ok(Some(device.into_batches()))
         }
     }

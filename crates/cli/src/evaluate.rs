@@ -26,8 +26,9 @@ pub struct Args {
     /// `measures` for a scene with an `[archive]`).
     #[arg(long)]
     json: bool,
-    /// Where the scene is evaluated: cpu (the engine) or cuda (an NVIDIA
-    /// GPU: the same bits; docs/GPU.md says what it covers).
+    /// Where the scene is evaluated: cpu (the engine), cuda (an NVIDIA
+    /// GPU: the same bits; docs/GPU.md says what it covers) or cuda-fast
+    /// (the GPU with fused multiply-adds: not the same bits).
     #[arg(long, value_enum, default_value_t)]
     device: crate::device::DeviceName,
 }

@@ -81,9 +81,10 @@ pub struct Args {
     /// evaluations' time at the scene's step).
     #[arg(long)]
     no_check: bool,
-    /// Where the candidates are evaluated: cpu (the engine on every core)
-    /// or cuda (a generation at a time on an NVIDIA GPU, one thread a
-    /// candidate: the same log and best; docs/GPU.md says what it covers).
+    /// Where the candidates are evaluated: cpu (the engine on every core),
+    /// cuda (a generation at a time on an NVIDIA GPU, one thread a
+    /// candidate: the same log and best; docs/GPU.md says what it covers)
+    /// or cuda-fast (the GPU with fused multiply-adds: not the same bits).
     #[arg(long, value_enum, default_value_t)]
     device: crate::device::DeviceName,
     #[command(flatten)]

@@ -188,4 +188,28 @@ fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
             "{err}"
         );
     }
+    // Fast mode: refused by name too, or a fitness (not the CPU's bits).
+    let o = animats(&["evaluate", dog, "--device", "cuda-fast"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        text(&o).1.contains(&format!("{dog}: --device cuda-fast:")),
+        "{}",
+        text(&o).1
+    );
+    let fast = animats(&[
+        "evaluate",
+        "scenes/walker.toml",
+        "--json",
+        "--device",
+        "cuda-fast",
+    ]);
+    if !fast.status.success() {
+        assert_eq!(fast.status.code(), Some(2));
+        let err = text(&fast).1;
+        assert!(
+            err.contains("--device cuda-fast:")
+                && (err.contains("driver") || err.contains("device") || err.contains("NVRTC")),
+            "{err}"
+        );
+    }
 }

@@ -27,7 +27,7 @@
 //! message says why), 1 if any bit differs.
 
 use animats_creatures::random::Random;
-use animats_gpu::{Batch, Device, Layout, Schedule};
+use animats_gpu::{Batch, Device, Layout, Mode, Schedule};
 use animats_scene::evaluate::{evaluate, Evaluation, SceneProblem};
 use animats_scene::morphology::MorphologyProblem;
 use animats_scene::Scene;
@@ -180,6 +180,13 @@ fn main() {
     let t = Instant::now();
     let c_cpu = cpu.evaluate_cpu().unwrap_or_else(|e| fail(e));
     report("C, every core:", t.elapsed().as_secs_f64());
+    if animats_gpu::cpu_has_fma() {
+        let mut fast = packed.clone();
+        let t = Instant::now();
+        fast.evaluate_cpu_with(Mode::Fast)
+            .unwrap_or_else(|e| fail(e));
+        report("C in fast mode, every core:", t.elapsed().as_secs_f64());
+    }
     let bits = |e: &Evaluation| {
         (
             [e.fitness, e.distance, e.time].map(f64::to_bits),
@@ -239,7 +246,59 @@ fn main() {
         println!("GPU, {how}, against the engine: {differ} of {count} evaluations differ");
         bad_gpu += differ;
     }
+    // Fast mode (fused multiply-adds): its own kernel; not the engine's
+    // bits, so its fitnesses' drift and the population's ranking.
+    match Device::open_in(Mode::Fast) {
+        Ok(fast) => {
+            let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
+            fast.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
+            let mut gpu = packed.clone();
+            let t = Instant::now();
+            let on_gpu = fast.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));
+            let secs = t.elapsed().as_secs_f64();
+            report("GPU, fast mode (FMA), copies included:", secs);
+            println!(
+                "GPU, fast mode: {:.1}x the engine on every core",
+                on_engine / secs
+            );
+            let rel: Vec<f64> = on_gpu
+                .iter()
+                .zip(&engine)
+                .map(|(a, b)| {
+                    (a.fitness - b.fitness).abs() / a.fitness.abs().max(b.fitness.abs()).max(1e-300)
+                })
+                .collect();
+            let mut sorted = rel.clone();
+            sorted.sort_by(f64::total_cmp);
+            let f = |v: &[Evaluation]| v.iter().map(|e| e.fitness).collect::<Vec<f64>>();
+            println!(
+                "GPU, fast mode, against the engine: {} of {count} differ; relative fitness difference median {:.2e}, max {:.2e}; rank correlation {:.4}",
+                differ(&on_gpu),
+                sorted[sorted.len() / 2],
+                sorted.last().copied().unwrap_or(0.0),
+                spearman(&f(&on_gpu), &f(&engine))
+            );
+        }
+        Err(e) => println!("GPU, fast mode: {e}"),
+    }
     if bad > 0 || bad_gpu > 0 {
         std::process::exit(1);
     }
+}
+
+/// Spearman's rank correlation of `a` and `b` (ties broken by index).
+fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    let ranks = |x: &[f64]| {
+        let mut order: Vec<usize> = (0..x.len()).collect();
+        order.sort_by(|&i, &j| x[i].total_cmp(&x[j]).then(i.cmp(&j)));
+        let mut r = vec![0.0; x.len()];
+        for (rank, &i) in order.iter().enumerate() {
+            r[i] = rank as f64;
+        }
+        r
+    };
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = a.len() as f64;
+    let d2: f64 = ra.iter().zip(&rb).map(|(x, y)| (x - y) * (x - y)).sum();
+    1.0 - 6.0 * d2 / (n * (n * n - 1.0)).max(1.0)
 }

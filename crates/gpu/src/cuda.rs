@@ -9,6 +9,7 @@
 //! `bench/gpu.sh` checks it there.
 
 use crate::pack::{Array, Batch, Raw, Slice};
+use crate::Mode;
 use cudarc::driver::{
     CudaContext, CudaFunction, CudaSlice, CudaStream, DevicePtr, DeviceRepr, LaunchConfig,
     PushKernelArg,
@@ -50,6 +51,7 @@ pub struct Device {
     terrain: std::sync::OnceLock<Result<Kernels, String>>,
     name: String,
     arch: (i32, i32),
+    mode: Mode,
     schedule: Schedule,
 }
 
@@ -84,9 +86,15 @@ impl std::fmt::Debug for Device {
 }
 
 impl Device {
-    /// The first GPU, with the kernel compiled for it; `Err` names what is
-    /// missing: the driver, a device, NVRTC, or the compilation's log.
+    /// The first GPU, with the kernel compiled for it in strict mode (the
+    /// engine's bits); `Err` names what is missing: the driver, a device,
+    /// NVRTC, or the compilation's log.
     pub fn open() -> Result<Device, String> {
+        Device::open_in(Mode::Strict)
+    }
+
+    /// [`Device::open`], the kernel compiled in `mode`.
+    pub fn open_in(mode: Mode) -> Result<Device, String> {
         // SAFETY: only looks for the library (dlopen), calls nothing in it.
         if !unsafe { cudarc::driver::sys::is_culib_present() } {
             return Err(
@@ -106,7 +114,7 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let flat = kernels(&ctx, arch, &name, true)?;
+        let flat = kernels(&ctx, arch, &name, true, mode)?;
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
@@ -114,6 +122,7 @@ impl Device {
             terrain: std::sync::OnceLock::new(),
             name,
             arch,
+            mode,
             schedule: Schedule::default(),
         })
     }
@@ -125,9 +134,14 @@ impl Device {
             return Ok(&self.flat);
         }
         self.terrain
-            .get_or_init(|| kernels(&self.ctx, self.arch, &self.name, false))
+            .get_or_init(|| kernels(&self.ctx, self.arch, &self.name, false, self.mode))
             .as_ref()
             .map_err(Clone::clone)
+    }
+
+    /// The mode its kernels were compiled in.
+    pub fn mode(&self) -> Mode {
+        self.mode
     }
 
     /// The device's name.
@@ -226,7 +240,7 @@ impl Device {
     }
 }
 
-/// The kernel compiled for `arch` (`flat`: with `AN_FLAT_ONLY`), from
+/// The kernel compiled for `arch` in `mode` (`flat`: with `AN_FLAT_ONLY`), from
 /// the disk's cache where an earlier run kept it (src/cache.rs), else by
 /// NVRTC now, and kept.
 fn kernels(
@@ -234,9 +248,10 @@ fn kernels(
     arch: (i32, i32),
     name: &str,
     flat: bool,
+    mode: Mode,
 ) -> Result<Kernels, String> {
     let src = source();
-    let mut options = options(arch);
+    let mut options = options(arch, mode);
     if flat {
         options.push("-DAN_FLAT_ONLY".into());
     }
@@ -369,12 +384,16 @@ struct DeviceBatch(Raw);
 // and ints, the layout of the kernel's `an_batch`.
 unsafe impl DeviceRepr for DeviceBatch {}
 
-/// NVRTC's options for `sm_{major}{minor}`: strict IEEE arithmetic, no
-/// contraction into fused multiply-adds.
-fn options((major, minor): (i32, i32)) -> Vec<String> {
+/// NVRTC's options for `sm_{major}{minor}`: IEEE division and square
+/// root, no flush to zero; in strict mode no contraction into fused
+/// multiply-adds, in fast mode contraction.
+fn options((major, minor): (i32, i32), mode: Mode) -> Vec<String> {
     vec![
         format!("--gpu-architecture=sm_{major}{minor}"),
-        "--fmad=false".to_string(),
+        match mode {
+            Mode::Strict => "--fmad=false".to_string(),
+            Mode::Fast => "--fmad=true".to_string(),
+        },
         "--prec-div=true".to_string(),
         "--prec-sqrt=true".to_string(),
         "--ftz=false".to_string(),

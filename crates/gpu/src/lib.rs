@@ -42,5 +42,22 @@ pub mod ported;
 mod scenes;
 
 pub use cuda::{Device, Schedule};
+pub use scenes::cpu_has_fma;
+
+/// How the C does its arithmetic.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Mode {
+    /// As the engine: no fused multiply-add (the C compiled with
+    /// contraction off, NVRTC given `--fmad=false`), so every result is
+    /// the engine's to the bit. The default.
+    #[default]
+    Strict,
+    /// Multiply-adds contracted into fused multiply-adds (NVRTC's
+    /// `--fmad=true`; on the CPU, `kernel/fast.c` with FMA instructions):
+    /// each rounds once where the strict mode rounds twice, so results
+    /// drift from the engine's as a step's errors do; opt-in, checked by
+    /// tolerance and by the ranking of a population (`tests/fast.rs`).
+    Fast,
+}
 pub use pack::{Batch, Layout};
 pub use scenes::{c_batches, c_runs};

@@ -18,6 +18,7 @@
 //! scene and the entry.
 
 use crate::pack::{Batch, Shared, CHUNK};
+use crate::Mode;
 use animats_creatures::actuators::AnyActuator;
 use animats_creatures::brains::ctrnn::Ctrnn;
 use animats_creatures::brains::fsm::{Condition, Fsm};
@@ -40,6 +41,25 @@ extern "C" {
         last: c_longlong,
         local: std::os::raw::c_int,
     );
+    fn animats_evaluate_range_fast(
+        batch: *const crate::pack::Raw,
+        first: c_longlong,
+        last: c_longlong,
+        local: std::os::raw::c_int,
+    );
+}
+
+/// Whether this CPU can run the fast mode's C (`kernel/fast.c`, compiled
+/// with FMA instructions on x86-64).
+pub fn cpu_has_fma() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        true
+    }
 }
 
 /// Numbers of `eval_param` per creature (`kernel/step.h` says which).
@@ -620,7 +640,17 @@ impl Batch {
     /// the threads of the current rayon pool (the same bits on any number),
     /// from the state it was packed in: once (`Err` after the first).
     pub fn evaluate_cpu(&mut self) -> Result<Vec<Evaluation>, String> {
+        self.evaluate_cpu_with(Mode::Strict)
+    }
+
+    /// [`Batch::evaluate_cpu`] in `mode`: [`Mode::Fast`] lets the C
+    /// contract multiply-adds into FMAs (`Err` on a CPU without FMA), as a
+    /// GPU's fast mode does; not the engine's bits.
+    pub fn evaluate_cpu_with(&mut self, mode: Mode) -> Result<Vec<Evaluation>, String> {
         use rayon::prelude::*;
+        if mode == Mode::Fast && !cpu_has_fma() {
+            return Err("fast mode: this CPU has no fused multiply-add (FMA)".into());
+        }
         self.take_ready()?;
         let shared = Shared(self.raw());
         let local = self.layout().flag();
@@ -632,9 +662,15 @@ impl Batch {
             // bounds the offsets give (as packed), and creatures
             // first..last, with their springs, muscles and results, are
             // this task's alone.
-            unsafe {
-                animats_evaluate_range(shared.get(), first as c_longlong, last as c_longlong, local)
-            };
+            let (first, last) = (first as c_longlong, last as c_longlong);
+            match mode {
+                Mode::Strict => unsafe { animats_evaluate_range(shared.get(), first, last, local) },
+                // SAFETY: as above; the same C, compiled with contraction
+                // (FMA instructions, which the CPU has: checked above).
+                Mode::Fast => unsafe {
+                    animats_evaluate_range_fast(shared.get(), first, last, local)
+                },
+            }
         });
         Ok(self.evaluations())
     }

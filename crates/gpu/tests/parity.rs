@@ -285,8 +285,15 @@ fn bodies_falling_onto_terrain_are_the_engine_s_to_the_bit() {
                 (0..21 * 23).map(|_| rng.between(-0.15, 0.15)).collect(),
             )),
         ];
-        for (ground, terrain) in ["slope", "steps", "heightfield"].into_iter().zip(terrains) {
-            for contact in [true, false] {
+        for (t, (ground, terrain)) in ["slope", "steps", "heightfield"]
+            .into_iter()
+            .zip(terrains)
+            .enumerate()
+        {
+            // Each ground with and without the contact force, each under two
+            // integrators (CI's time: the flat floor's test has every pair).
+            {
+                let contact = (b + t) % 2 == 0;
                 let floor = FloorDef {
                     contact,
                     terrain: terrain.clone(),

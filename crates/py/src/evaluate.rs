@@ -167,22 +167,29 @@ pub(crate) fn read_screens(texts: Option<Vec<String>>) -> PyResult<Option<Vec<Sc
         .transpose()
 }
 
-/// `device`: `None` for "cpu", the GPU's batches for "cuda" (opened once
-/// a process: the kernel is compiled then); a `RuntimeError` says what is
-/// missing (driver, device, NVRTC).
+/// `device`: `None` for "cpu", the GPU's batches for "cuda" (or
+/// "cuda-fast": fused multiply-adds allowed, not the CPU's bits), each
+/// opened once a process (the kernel is compiled then); a `RuntimeError`
+/// says what is missing (driver, device, NVRTC).
 pub(crate) fn device_batches(device: &str) -> PyResult<Option<Batches>> {
-    static GPU: std::sync::OnceLock<Result<Batches, String>> = std::sync::OnceLock::new();
-    match device {
-        "cpu" => Ok(None),
-        "cuda" => GPU
-            .get_or_init(|| animats_gpu::Device::open().map(animats_gpu::Device::into_batches))
-            .clone()
-            .map(Some)
-            .map_err(|e| runtime_error(format!("device=\"cuda\": {e}"))),
-        other => Err(value_error(format!(
-            "device={other:?}: \"cpu\" (the engine) or \"cuda\" (an NVIDIA GPU)"
-        ))),
-    }
+    type Opened = std::sync::OnceLock<Result<Batches, String>>;
+    static GPU: Opened = std::sync::OnceLock::new();
+    static FAST: Opened = std::sync::OnceLock::new();
+    let (opened, mode) = match device {
+        "cpu" => return Ok(None),
+        "cuda" => (&GPU, animats_gpu::Mode::Strict),
+        "cuda-fast" => (&FAST, animats_gpu::Mode::Fast),
+        other => {
+            return Err(value_error(format!(
+                "device={other:?}: \"cpu\" (the engine), \"cuda\" (an NVIDIA GPU: the same bits) or \"cuda-fast\" (the GPU with fused multiply-adds)"
+            )))
+        }
+    };
+    opened
+        .get_or_init(|| animats_gpu::Device::open_in(mode).map(animats_gpu::Device::into_batches))
+        .clone()
+        .map(Some)
+        .map_err(|e| runtime_error(format!("device={device:?}: {e}")))
 }
 
 /// `animats.evaluate_scenes`: each complete scene text (any bodies, as a

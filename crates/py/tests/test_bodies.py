@@ -94,6 +94,11 @@ def test_device_cuda_gives_the_cpu_s_bits_or_says_what_is_missing():
     scene = animats.load(animats_root() / "scenes" / "walker.toml")
     with pytest.raises(ValueError, match='device="tpu"'):
         animats.evaluate_scenes([walker], device="tpu")
+    try:  # fast mode (fused multiply-adds): a fitness, or what is missing
+        fast = animats.evaluate_scenes([walker], device="cuda-fast")
+        assert fast["fitness"].shape == (1,)
+    except RuntimeError as e:
+        assert "device=\"cuda-fast\"" in str(e), e
     try:
         gpu = animats.evaluate_scenes([walker], device="cuda")
     except RuntimeError as e:  # no GPU here (CI has none): what is missing
