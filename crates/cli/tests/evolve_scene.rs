@@ -188,6 +188,22 @@ fn device_cuda_says_what_it_cannot_evaluate_or_gives_the_cpu_s_bits() {
             "{err}"
         );
     }
+    // A walker on rough ground (terrain) is evaluated: not refused.
+    let rough = animats(&[
+        "evaluate",
+        "scenes/walker_rough.toml",
+        "--json",
+        "--device",
+        "cuda",
+    ]);
+    if !rough.status.success() {
+        let err = text(&rough).1;
+        assert!(
+            !err.contains("not in the GPU")
+                && (err.contains("driver") || err.contains("device") || err.contains("NVRTC")),
+            "{err}"
+        );
+    }
     // Fast mode: refused by name too, or a fitness (not the CPU's bits).
     let o = animats(&["evaluate", dog, "--device", "cuda-fast"]);
     assert_eq!(o.status.code(), Some(2));

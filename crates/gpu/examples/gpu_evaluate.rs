@@ -23,6 +23,8 @@
 //!
 //!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|rough] [COUNT] [SECONDS]
 //!
+//! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too.
+//!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
 
@@ -180,7 +182,9 @@ fn main() {
     let t = Instant::now();
     let c_cpu = cpu.evaluate_cpu().unwrap_or_else(|e| fail(e));
     report("C, every core:", t.elapsed().as_secs_f64());
-    if animats_gpu::cpu_has_fma() {
+    // The C in fast mode on the CPU, where asked (it costs a whole CPU
+    // run more: bench/gpu.sh does not ask).
+    if std::env::var_os("ANIMATS_CPU_FAST").is_some() && animats_gpu::cpu_has_fma() {
         let mut fast = packed.clone();
         let t = Instant::now();
         fast.evaluate_cpu_with(Mode::Fast)
