@@ -280,7 +280,7 @@ fn main() {
                 differ(&on_gpu),
                 sorted[sorted.len() / 2],
                 sorted.last().copied().unwrap_or(0.0),
-                spearman(&f(&on_gpu), &f(&engine))
+                animats_gpu::rank_correlation(&f(&on_gpu), &f(&engine))
             );
         }
         Err(e) => println!("GPU, fast mode: {e}"),
@@ -288,21 +288,4 @@ fn main() {
     if bad > 0 || bad_gpu > 0 {
         std::process::exit(1);
     }
-}
-
-/// Spearman's rank correlation of `a` and `b` (ties broken by index).
-fn spearman(a: &[f64], b: &[f64]) -> f64 {
-    let ranks = |x: &[f64]| {
-        let mut order: Vec<usize> = (0..x.len()).collect();
-        order.sort_by(|&i, &j| x[i].total_cmp(&x[j]).then(i.cmp(&j)));
-        let mut r = vec![0.0; x.len()];
-        for (rank, &i) in order.iter().enumerate() {
-            r[i] = rank as f64;
-        }
-        r
-    };
-    let (ra, rb) = (ranks(a), ranks(b));
-    let n = a.len() as f64;
-    let d2: f64 = ra.iter().zip(&rb).map(|(x, y)| (x - y) * (x - y)).sum();
-    1.0 - 6.0 * d2 / (n * (n * n - 1.0)).max(1.0)
 }

@@ -2,7 +2,7 @@
  * multiply-adds allowed (build.rs compiles this file with
  * -ffp-contract=fast and, on x86-64, -mfma), what a GPU's opt-in fast mode
  * (`--fmad=true`, src/cuda.rs) does, on the CPU. Not the engine's bits:
- * tests/fast.rs checks it by tolerance and by the ranking of a population.
+ * tests/evaluate.rs checks it by tolerance and by the ranking of a population.
  * Called only where the CPU has FMA (src/scenes.rs). */
 #include "step.h"
 #include "libm.h"

@@ -108,7 +108,7 @@ AN_COLD int an_steps_probe(const double *tp, const double *p, double reach, doub
     double height = tp[4];
     double qx = p[0] * d[0] + p[2] * d[2], qy = p[1];
     long long k = an_tread(tp, qx);
-    int below = qy < (double)an_tread(tp, qx) * height;
+    int below = qy < (double)k * height; /* profile(q.x) */
     long long n = (long long)tp[6];
     double best = an_inf(), nx = qx, ny = qy;
     long long lo = k - 2 > 0 ? k - 2 : 0, hi = k + 2 < n ? k + 2 : n;

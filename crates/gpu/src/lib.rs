@@ -56,8 +56,28 @@ pub enum Mode {
     /// `--fmad=true`; on the CPU, `kernel/fast.c` with FMA instructions):
     /// each rounds once where the strict mode rounds twice, so results
     /// drift from the engine's as a step's errors do; opt-in, checked by
-    /// tolerance and by the ranking of a population (`tests/fast.rs`).
+    /// tolerance and by the ranking of a population ([`rank_correlation`];
+    /// `tests/evaluate.rs`).
     Fast,
 }
 pub use pack::{Batch, Layout};
 pub use scenes::{c_batches, c_runs};
+
+/// Spearman's rank correlation of `a` and `b` (ties broken by index): how
+/// alike two evaluations of one population rank it, the fast mode's check
+/// against strict mode (1 for the same order).
+pub fn rank_correlation(a: &[f64], b: &[f64]) -> f64 {
+    let ranks = |x: &[f64]| {
+        let mut order: Vec<usize> = (0..x.len()).collect();
+        order.sort_by(|&i, &j| x[i].total_cmp(&x[j]).then(i.cmp(&j)));
+        let mut r = vec![0.0; x.len()];
+        for (rank, &i) in order.iter().enumerate() {
+            r[i] = rank as f64;
+        }
+        r
+    };
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = a.len() as f64;
+    let d2: f64 = ra.iter().zip(&rb).map(|(x, y)| (x - y) * (x - y)).sum();
+    1.0 - 6.0 * d2 / (n * (n * n - 1.0)).max(1.0)
+}
