@@ -169,6 +169,7 @@ fn a_body_run_is_the_same_on_any_thread_count_and_after_a_checkpoint() {
     pool(2).install(|| s.advance(3)).unwrap();
     checkpoint::save(&path, &s).unwrap();
     let mut back = checkpoint::load(&path).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
     assert_eq!(back, s);
     pool(1).install(|| back.advance(3)).unwrap();
     assert_eq!(back.log_csv(), one.log_csv());
@@ -244,53 +245,61 @@ fn run_to_end(config: Config, full: bool) -> State {
 /// the body GA keeps the same survivors, the same best and `best.toml` as
 /// with every child scored in full, and only log rows whose best child did
 /// not survive may differ, by showing its score at the step (never below
-/// its robust score).
+/// its robust score). So does the quarter step's run (`robust_halvings =
+/// 2`) of a child whose worse of the first two cannot survive.
 #[test]
 fn screened_robust_evaluation_keeps_every_survivor_and_the_best() {
-    let run = |full: bool, generations: u64| run_to_end(config(GRAPH, generations), full);
-    let screened = run(false, 10);
-    let full = run(true, 10);
-    assert_eq!(screened.lanes[0].optimiser, full.lanes[0].optimiser);
-    assert_eq!(screened.lanes[0].best, full.lanes[0].best);
-    assert_eq!(screened.best_toml().unwrap(), full.best_toml().unwrap());
-    let (a, b) = (screened.log_csv(), full.log_csv());
-    let mut differ = 0;
-    for (x, y) in a.lines().zip(b.lines()).skip(1) {
-        let (x, y): (Vec<&str>, Vec<&str>) = (x.split(',').collect(), y.split(',').collect());
-        // lane, generation, evaluations, best_fitness and the body columns
-        // are the same; the generation's best may show its score at the step.
-        for k in [0, 1, 2, 4, 8, 9, 10, 11, 12] {
-            assert_eq!(x[k], y[k], "column {k}: {x:?} against {y:?}");
+    // At the step and half of it, and with a quarter of it too.
+    let quarter = GRAPH.replace("[evolve]\n", "[evolve]\nrobust_halvings = 2\n");
+    for text in [GRAPH, quarter.as_str()] {
+        let run = |full: bool, generations: u64| run_to_end(config(text, generations), full);
+        let screened = run(false, 10);
+        let full = run(true, 10);
+        assert_eq!(screened.lanes[0].optimiser, full.lanes[0].optimiser);
+        assert_eq!(screened.lanes[0].best, full.lanes[0].best);
+        assert_eq!(screened.best_toml().unwrap(), full.best_toml().unwrap());
+        let (a, b) = (screened.log_csv(), full.log_csv());
+        let mut differ = 0;
+        for (x, y) in a.lines().zip(b.lines()).skip(1) {
+            let (x, y): (Vec<&str>, Vec<&str>) = (x.split(',').collect(), y.split(',').collect());
+            // lane, generation, evaluations, best_fitness and the body columns
+            // are the same; the generation's best may show its score at the step.
+            for k in [0, 1, 2, 4, 8, 9, 10, 11, 12] {
+                assert_eq!(x[k], y[k], "column {k}: {x:?} against {y:?}");
+            }
+            let (fx, fy): (f64, f64) = (x[3].parse().unwrap(), y[3].parse().unwrap());
+            assert!(fx >= fy, "{fx} below the robust {fy}");
+            differ += (x[3] != y[3]) as usize;
         }
-        let (fx, fy): (f64, f64) = (x[3].parse().unwrap(), y[3].parse().unwrap());
-        assert!(fx >= fy, "{fx} below the robust {fy}");
-        differ += (x[3] != y[3]) as usize;
-    }
-    println!("{differ} of 10 rows show a score at the step");
-    // The next generation's children: those at or below the worst
-    // survivor are scored once, the rest in full.
-    let mut s = run(false, 10);
-    s.config.generations = 11;
-    let problem = s.config.problem.build().unwrap();
-    let g = s.ask().unwrap();
-    let bar = match g.screen(0) {
-        Screen::Above { bar } => *bar,
-        other => panic!("a full population screens by its worst: {other:?}"),
-    };
-    let (mut cut, mut scored) = (0, 0);
-    for (i, x) in g.genomes().enumerate() {
-        let once = problem.evaluate_screened(x, g.screen(i)).unwrap();
-        let robust = problem.evaluate(x).unwrap();
-        if once.fitness > bar {
-            assert_eq!(once, robust, "child {i} above the bar is scored in full");
-            scored += 1;
-        } else {
-            assert!(robust.fitness <= once.fitness, "child {i}");
-            cut += 1;
+        println!("{differ} of 10 rows show a score at the step");
+        // The next generation's children: those at or below the worst
+        // survivor are scored once, the rest in full.
+        let mut s = run(false, 10);
+        s.config.generations = 11;
+        let problem = s.config.problem.build().unwrap();
+        let g = s.ask().unwrap();
+        let bar = match g.screen(0) {
+            Screen::Above { bar } => *bar,
+            other => panic!("a full population screens by its worst: {other:?}"),
+        };
+        let (mut cut, mut scored, mut quartered) = (0, 0, 0);
+        let halved = config(GRAPH, 1).problem.build().unwrap();
+        for (i, x) in g.genomes().enumerate() {
+            let once = problem.evaluate_screened(x, g.screen(i)).unwrap();
+            let robust = problem.evaluate(x).unwrap();
+            quartered += (robust != halved.evaluate(x).unwrap()) as usize;
+            if once.fitness > bar {
+                assert_eq!(once, robust, "child {i} above the bar is scored in full");
+                scored += 1;
+            } else {
+                assert!(robust.fitness <= once.fitness, "child {i}");
+                cut += 1;
+            }
         }
+        println!("bar {bar}: {cut} children scored once, {scored} in full, {quartered} scored lower at a quarter of the step");
+        assert_eq!(quartered > 0, text != GRAPH);
+        assert!(cut > 0, "no child was screened out");
     }
-    println!("bar {bar}: {cut} children scored once, {scored} in full");
-    assert!(cut > 0, "no child was screened out");
 }
 
 /// MAP-Elites screens a child by its cell's threshold; with measures of the

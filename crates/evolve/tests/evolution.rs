@@ -129,6 +129,7 @@ fn a_checkpointed_and_resumed_run_equals_one_never_stopped() {
     }
     assert_eq!(resumed.log_csv(), whole.log_csv());
     assert_eq!(resumed, whole);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -164,6 +165,7 @@ fn corrupt_checkpoints_are_refused() {
     assert!(checkpoint::load(&dir.join("nope.json"))
         .unwrap_err()
         .contains("cannot read"));
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The thesis's result (§5.4) in a run small enough for CI: with 6 lanes
@@ -392,6 +394,9 @@ fn lanes_that_never_wait_for_each_other_log_what_lanes_in_step_do() {
         let path = scratch(&format!("uneven-{threads}")).join("checkpoint.json");
         checkpoint::save(&path, &s).unwrap();
         let mut back = checkpoint::load(&path).unwrap();
+        if let Some(dir) = path.parent() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
         while !back.done() {
             pool(threads)
                 .install(|| back.advance_while(problem.as_ref(), None, &|| true, &|_| ()))

@@ -337,6 +337,10 @@ pub struct EvolveEntry {
     /// Score each evaluation at the scene's step and at half of it and
     /// keep the worse; default false (true in a `[morphology]` scene).
     pub robust: Option<bool>,
+    /// How many times a robust evaluation halves the step: 1 (the step
+    /// and half of it) or more (2: a quarter too; at most 4); a finer run
+    /// is made only where the worst so far could still matter. Default 1.
+    pub robust_halvings: Option<u32>,
     /// The optimiser `animats evolve` uses unless told (`hill-climber`,
     /// `cma-es`, ...); default `cma-es` (`body-ga` in a `[morphology]`
     /// scene).

@@ -69,6 +69,10 @@ pub struct EvolveSpec {
     /// Each evaluation runs at the scene's step and at half of it; the
     /// worse counts.
     pub robust: bool,
+    /// How many times a robust evaluation halves the step (1: the step and
+    /// half of it; 2: a quarter too; ...), each finer run made where the
+    /// worst so far could matter.
+    pub robust_halvings: u32,
     /// The optimiser to use unless told, by its command-line name
     /// (checked by whoever runs the evolution).
     pub optimiser: Option<String>,
@@ -98,6 +102,10 @@ impl EvolveSpec {
 
 /// The most trials an evaluation may have.
 pub const MAX_TRIALS: u32 = 1000;
+
+/// The most times a robust evaluation may halve the step (a sixteenth:
+/// 31 runs' time at the step for a candidate scored at every step).
+pub const MAX_HALVINGS: u32 = 4;
 
 /// An `[evolve]` table's end rules, resolved.
 struct EndRules {
@@ -233,6 +241,27 @@ impl EvolveSpec {
                 format!("must be in [0, 1] (a fraction of each radius and of each actuator's range), got {noise}"),
             ));
         }
+        let robust = e.robust.unwrap_or(false);
+        let robust_halvings = match e.robust_halvings {
+            None => 1,
+            Some(h) if !robust => {
+                return Err(at.err(
+                    "robust_halvings",
+                    format!(
+                    "halves the step of a robust evaluation ({h} given): set `robust = true` too"
+                ),
+                ))
+            }
+            Some(h) if !(1..=MAX_HALVINGS).contains(&h) => {
+                return Err(at.err(
+                    "robust_halvings",
+                    format!(
+                        "must be between 1 (the step and half of it) and {MAX_HALVINGS}, got {h}"
+                    ),
+                ))
+            }
+            Some(h) => h,
+        };
         let mut terms = Vec::with_capacity(e.terms.len());
         for (i, t) in e.terms.iter().enumerate() {
             let field = format!("terms[{i}]");
@@ -256,7 +285,8 @@ impl EvolveSpec {
             mutation: e.mutation,
             log: e.log,
             lanes,
-            robust: e.robust.unwrap_or(false),
+            robust,
+            robust_halvings,
             optimiser: e.optimiser.clone(),
             energy_weight: at.finite("energy_weight", e.energy_weight)?,
             target,
@@ -698,30 +728,39 @@ pub fn score_all(
     }
     let mut runs = run_checked(run, coarse)?;
     // Robust: again at half the step where it could matter, the worse
-    // counting.
-    let at: Vec<usize> = (0..trial.len())
-        .filter(|&i| {
+    // counting; then, for a scene that halves it more than once, at each
+    // finer step where the worst so far could still matter.
+    let mut at: Vec<usize> = (0..trial.len()).collect();
+    for halving in 1..=specs.iter().map(|s| s.robust_halvings).max().unwrap_or(1) {
+        at.retain(|&i| {
             let spec = &specs[trial[i].0];
-            spec.robust && (spec.noise > 0.0 || fine(trial[i].0, &runs[i]))
-        })
-        .collect();
-    let finer = at
-        .par_iter()
-        .map(|&i| {
-            let (g, k) = trial[i];
-            let mut s = makes[g]()?;
-            if specs[g].noise > 0.0 {
-                perturb(&mut s, k)?;
-            }
-            s.dt *= 0.5;
-            Ok(s)
-        })
-        .collect::<Vec<_>>()
-        .into_iter()
-        .collect::<Result<Vec<_>, String>>()?;
-    for (i, e) in at.into_iter().zip(run_checked(run, finer)?) {
-        let full = std::mem::replace(&mut runs[i], e.clone());
-        runs[i] = worse(full, e);
+            spec.robust
+                && halving <= spec.robust_halvings
+                && (spec.noise > 0.0 || fine(trial[i].0, &runs[i]))
+        });
+        if at.is_empty() {
+            break;
+        }
+        let finer = at
+            .par_iter()
+            .map(|&i| {
+                let (g, k) = trial[i];
+                let mut s = makes[g]()?;
+                if specs[g].noise > 0.0 {
+                    perturb(&mut s, k)?;
+                }
+                for _ in 0..halving {
+                    s.dt *= 0.5;
+                }
+                Ok(s)
+            })
+            .collect::<Vec<_>>()
+            .into_iter()
+            .collect::<Result<Vec<_>, String>>()?;
+        for (&i, e) in at.iter().zip(run_checked(run, finer)?) {
+            let sofar = std::mem::replace(&mut runs[i], e.clone());
+            runs[i] = worse(sofar, e);
+        }
     }
     // Each genome's trials, aggregated.
     let mut runs = runs.into_iter();

@@ -180,6 +180,19 @@ fn bad_fitness_keys_are_named() {
         "evolve.terms[0]",
     );
     bad("energy_weight = nan", "evolve.energy_weight");
+    bad("robust_halvings = 2", "evolve.robust_halvings: halves the step of a robust evaluation (2 given): set `robust = true` too");
+    bad(
+        "robust = true\nrobust_halvings = 0",
+        "evolve.robust_halvings: must be between 1",
+    );
+    bad(
+        "robust = true\nrobust_halvings = 5",
+        "evolve.robust_halvings: must be between 1 (the step and half of it) and 4, got 5",
+    );
+    bad(
+        "robust = true\nrobust_halvings = -1",
+        "evolve.robust_halvings",
+    );
 }
 
 #[test]

@@ -187,6 +187,61 @@ fn robust_evaluation_keeps_the_worse_of_the_step_and_half_of_it() {
     assert_eq!(r, coarse.min(fine));
 }
 
+/// `robust_halvings = h` keeps the worst of the runs at the step and at
+/// each of its `h` halvings, each the engine's run at that step to the
+/// bit; a screen that says no after the first run keeps that run alone,
+/// and one that says no after the half step keeps the worse of the two.
+/// The body: the land task's seed-5 best (`fragile_walker.toml`), whose
+/// gait has a second mode: robust scoring at the step and half of it lets
+/// it through (6.36 m, both runs alike to 1e-3), but its own integrator at
+/// a quarter of the step falls into a gait worth a tenth of that.
+#[test]
+fn robust_halvings_keep_the_worst_of_every_finer_step() {
+    let text = include_str!("fragile_walker.toml");
+    let at = |halvings: u32| {
+        let t = text.replacen(
+            "[evolve]",
+            &format!("[evolve]\nrobust_halvings = {halvings}"),
+            1,
+        );
+        SceneProblem::parse(&t, "fragile_walker.toml").unwrap()
+    };
+    let base = at(1);
+    assert!(base.spec().robust);
+    let once = |dt_scale: f64| {
+        let mut s = base.scene(base.start()).unwrap();
+        s.dt *= dt_scale;
+        animats_scene::evaluate::evaluate(s).unwrap().fitness
+    };
+    let runs = [once(1.0), once(0.5), once(0.25), once(0.125)];
+    println!("at dt, dt/2, dt/4, dt/8: {runs:?}");
+    // Robust scoring lets the gait through; a quarter of the step does not.
+    assert!(
+        runs[0] > 6.0 && (runs[0] - runs[1]).abs() < 1e-3 * runs[0],
+        "{runs:?}"
+    );
+    assert!(runs[2] < 0.2 * runs[0], "{runs:?}");
+    let worst = |n: usize| runs[..n].iter().copied().fold(f64::INFINITY, f64::min);
+    for h in 1..=3u32 {
+        let p = at(h);
+        assert_eq!(p.spec().robust_halvings, h);
+        let got = p.evaluate(p.start()).unwrap().fitness;
+        assert_eq!(got, worst(h as usize + 1), "{h} halvings");
+        // Screened: after the first run nothing more; after the half step
+        // nothing more (the quarter step's run is not made).
+        let make = || p.scene(p.start());
+        let first = animats_scene::evaluate::score_screened(make, &|_| false).unwrap();
+        assert_eq!(first.fitness, runs[0]);
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let two = animats_scene::evaluate::score_screened(make, &|_| {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) == 0
+        })
+        .unwrap();
+        assert_eq!(two.fitness, worst(2), "{h} halvings, screened after two");
+        assert_eq!(calls.into_inner(), 2.min(h as usize), "{h} halvings");
+    }
+}
+
 #[test]
 fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
     let text = with("encoding = \"lattice\"\ncells = [2, 1, 1]\ncell = 0.1\nmax_particles = 12\nmax_springs = 60\nmass = [0.001, 0.3]");
@@ -456,6 +511,7 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
         e.contains("morphology.start") && e.contains("fails its own checks: particles"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
     // A scene with [morphology] is not built as it is.
     let e = animats_scene::build::build(
         &animats_scene::parse_def(&animats_scene::source::Source {

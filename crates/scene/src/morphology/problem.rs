@@ -326,6 +326,7 @@ fn placeholder_spec() -> EvolveSpec {
         log: Default::default(),
         lanes: None,
         robust: false,
+        robust_halvings: 1,
         optimiser: None,
         energy_weight: 0.0,
         target: None,
