@@ -269,31 +269,67 @@ impl Schedule {
     /// run as one batch (lanes never waiting for each other).
     pub fn makespan(&self, workers: usize, barriers: bool) -> f64 {
         let workers = workers.max(1);
-        let batches = self.batches();
         if barriers {
-            batches.iter().map(|b| replay(b, workers)).sum()
+            self.batches().iter().map(|b| replay(b, workers, 0)).sum()
         } else {
-            let mut all: Vec<Step> = Vec::new();
-            let mut done: std::collections::BTreeMap<usize, u64> = Default::default();
-            for b in batches {
-                for mut s in b {
-                    let d = done.entry(s.lane).or_default();
-                    s.rank = *d;
-                    *d += 1;
-                    all.push(s);
-                }
-            }
-            all.sort_by_key(|s| (s.lane, s.rank));
-            replay(&all, workers)
+            replay(&self.as_one_batch(), workers, 0)
         }
+    }
+
+    /// [`Schedule::makespan`] without barriers had each lane asked for its
+    /// next generation as soon as the last was made, while it was still
+    /// evaluated, and told it after the last (its parents drawn from the
+    /// archive as it was a generation earlier: a different search, which
+    /// MAP-Elites's stateless emitters allow): a generation's slowest
+    /// evaluation no longer holds up the next one's.
+    pub fn makespan_overlapped(&self, workers: usize) -> f64 {
+        replay(&self.as_one_batch(), workers.max(1), 1)
+    }
+
+    /// The critical path of [`Schedule::makespan_overlapped`], s.
+    pub fn critical_path_overlapped(&self) -> f64 {
+        let mut ends: std::collections::BTreeMap<usize, (f64, f64, f64)> = Default::default();
+        let mut path = 0.0f64;
+        for s in self.as_one_batch() {
+            // (made, told, told the generation before) of the lane's last.
+            let (made, told, told_before) = ends.get(&s.lane).copied().unwrap_or((0.0, 0.0, 0.0));
+            let child = s.varies.iter().cloned().fold(0.0, f64::max);
+            let longest = s.evaluations.iter().cloned().fold(0.0, f64::max);
+            let now_made = made.max(told_before) + s.ask + child;
+            let now_told = (now_made + longest).max(told) + s.tell;
+            ends.insert(s.lane, (now_made, now_told, told));
+            path = path.max(now_told);
+        }
+        path
+    }
+
+    /// Every batch's lane-generations as one batch, each lane's in order.
+    fn as_one_batch(&self) -> Vec<Step> {
+        let mut all: Vec<Step> = Vec::new();
+        let mut done: std::collections::BTreeMap<usize, u64> = Default::default();
+        for b in self.batches() {
+            for mut s in b {
+                let d = done.entry(s.lane).or_default();
+                s.rank = *d;
+                *d += 1;
+                all.push(s);
+            }
+        }
+        all.sort_by_key(|s| (s.lane, s.rank));
+        all
     }
 }
 
 /// Greedy list scheduling of one batch's lane-generations on `workers`
-/// workers; the makespan, s.
-fn replay(steps: &[Step], workers: usize) -> f64 {
+/// workers; the makespan, s. A lane's generation is asked once the one
+/// before it is made (asked, its children made) and the one `lag` before
+/// that is told (`lag` 0: a generation asked after the last is told, as
+/// every optimiser runs today; 1: while the last is still evaluated, its
+/// parents from the archive as it was a generation earlier), and told
+/// after its evaluations and the generation before it.
+fn replay(steps: &[Step], workers: usize, lag: usize) -> f64 {
     use std::cmp::Reverse;
-    use std::collections::{BTreeSet, BinaryHeap, HashMap};
+    use std::collections::{BTreeSet, BinaryHeap};
     // A task: (step index, what). Ready tasks are ordered as the run's
     // scheduler reaches them: fewest generations done, lane, then piece.
     #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -306,42 +342,63 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
     /// A task's place in the order the run's scheduler reaches it.
     type Key = (u64, usize, What, usize);
     let order = |i: usize, what: What| -> Key { (steps[i].rank, steps[i].lane, what, i) };
-    // Each lane's steps in order: the next one becomes ready when the
-    // previous one's tell ends.
-    let mut next_of: HashMap<usize, usize> = HashMap::new();
-    let mut first: Vec<usize> = Vec::new();
+    // Each lane's steps in order, and each step's place among them.
+    let mut lanes: Vec<Vec<usize>> = Vec::new();
+    let mut place: Vec<(usize, usize)> = vec![(0, 0); steps.len()];
     {
         let mut by_lane: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
         for (i, s) in steps.iter().enumerate() {
             by_lane.entry(s.lane).or_default().push(i);
         }
-        for list in by_lane.values() {
-            let mut sorted = list.clone();
+        for list in by_lane.into_values() {
+            let mut sorted = list;
             sorted.sort_by_key(|&i| steps[i].rank);
-            first.push(sorted[0]);
-            for w in sorted.windows(2) {
-                next_of.insert(w[0], w[1]);
+            for (j, &i) in sorted.iter().enumerate() {
+                place[i] = (lanes.len(), j);
             }
+            lanes.push(sorted);
         }
     }
+    let n = steps.len();
+    let (mut asked, mut made, mut told) = (vec![false; n], vec![false; n], vec![false; n]);
+    let (mut evaluated, mut telling) = (vec![false; n], vec![false; n]);
     let mut ready: BTreeSet<Key> = BTreeSet::new();
-    for &i in &first {
-        ready.insert(order(i, What::Ask));
+    // Generation `j` of lane `l` is asked if it can be.
+    let try_ask = |ready: &mut BTreeSet<Key>,
+                   asked: &mut [bool],
+                   made: &[bool],
+                   told: &[bool],
+                   l: usize,
+                   j: usize| {
+        let Some(&i) = lanes[l].get(j) else { return };
+        let after_made = j == 0 || made[lanes[l][j - 1]];
+        let after_told = j < 1 + lag || told[lanes[l][j - 1 - lag]];
+        if !asked[i] && after_made && after_told {
+            asked[i] = true;
+            ready.insert(order(i, What::Ask));
+        }
+    };
+    // Generation `j` of lane `l` is told if it can be.
+    let try_tell = |ready: &mut BTreeSet<Key>,
+                    telling: &mut [bool],
+                    evaluated: &[bool],
+                    told: &[bool],
+                    l: usize,
+                    j: usize| {
+        let Some(&i) = lanes[l].get(j) else { return };
+        if !telling[i] && evaluated[i] && (j == 0 || told[lanes[l][j - 1]]) {
+            telling[i] = true;
+            ready.insert(order(i, What::Tell));
+        }
+    };
+    for l in 0..lanes.len() {
+        try_ask(&mut ready, &mut asked, &made, &told, l, 0);
     }
     // Running tasks by end time (ties by order, for determinism).
     let mut running: BinaryHeap<Reverse<(u64, Key)>> = BinaryHeap::new();
     let mut left: Vec<usize> = steps.iter().map(|s| s.evaluations.len()).collect();
     let mut unmade: Vec<usize> = steps.iter().map(|s| s.varies.len()).collect();
     let (mut now, mut free) = (0.0f64, workers);
-    // Step i's evaluations (or, with none, its tell) become ready.
-    let evaluations_ready = |ready: &mut BTreeSet<Key>, i: usize| {
-        if steps[i].evaluations.is_empty() {
-            ready.insert(order(i, What::Tell));
-        }
-        for k in 0..steps[i].evaluations.len() {
-            ready.insert(order(i, What::Evaluate(k)));
-        }
-    };
     // Time in integer nanoseconds inside the heap, so that it orders totally.
     let nanos = |t: f64| (t * 1e9).round() as u64;
     loop {
@@ -365,32 +422,45 @@ fn replay(steps: &[Step], workers: usize) -> f64 {
         };
         now = end as f64 * 1e-9;
         free += 1;
-        match what {
+        let (l, j) = place[i];
+        // Step i is made: its evaluations (or, with none, its tell) become
+        // ready, and so may the next generation's ask.
+        let made_now = match what {
             What::Ask => {
-                if steps[i].varies.is_empty() {
-                    evaluations_ready(&mut ready, i);
-                }
                 for k in 0..steps[i].varies.len() {
                     ready.insert(order(i, What::Vary(k)));
                 }
+                steps[i].varies.is_empty()
             }
             What::Vary(_) => {
                 unmade[i] -= 1;
-                if unmade[i] == 0 {
-                    evaluations_ready(&mut ready, i);
-                }
+                unmade[i] == 0
             }
             What::Evaluate(_) => {
                 left[i] -= 1;
                 if left[i] == 0 {
-                    ready.insert(order(i, What::Tell));
+                    evaluated[i] = true;
+                    try_tell(&mut ready, &mut telling, &evaluated, &told, l, j);
                 }
+                false
             }
             What::Tell => {
-                if let Some(&n) = next_of.get(&i) {
-                    ready.insert(order(n, What::Ask));
-                }
+                told[i] = true;
+                try_tell(&mut ready, &mut telling, &evaluated, &told, l, j + 1);
+                try_ask(&mut ready, &mut asked, &made, &told, l, j + 1 + lag);
+                false
             }
+        };
+        if made_now {
+            made[i] = true;
+            if steps[i].evaluations.is_empty() {
+                evaluated[i] = true;
+                try_tell(&mut ready, &mut telling, &evaluated, &told, l, j);
+            }
+            for k in 0..steps[i].evaluations.len() {
+                ready.insert(order(i, What::Evaluate(k)));
+            }
+            try_ask(&mut ready, &mut asked, &made, &told, l, j + 1);
         }
     }
     now
@@ -504,5 +574,46 @@ mod tests {
         assert!(s.makespan(16, false) <= s.makespan(16, true) + 1e-9);
         // The replay is a pure function of the schedule.
         assert_eq!(s.makespan(7, true), s.makespan(7, true));
+    }
+
+    #[test]
+    fn overlapped_generations_fill_the_wait_for_the_slowest() {
+        // One lane, two generations of evaluations 2, 1, 1 and 1 s (asks
+        // and tells take no time), on two workers: one after the other each
+        // takes 3 s (the long one beside two short, then the last short
+        // alone), 6 s; overlapped, the second starts in the first's idle
+        // second: 10 s of work in 5. Unbounded: the long ones side by side.
+        let mut work = Vec::new();
+        for g in 0..2 {
+            work.push(made_up(0, g, 0, Piece::Ask, 0.0));
+            for (k, seconds) in [2.0, 1.0, 1.0, 1.0].into_iter().enumerate() {
+                work.push(made_up(0, g, 0, Piece::Evaluate(k), seconds));
+            }
+            work.push(made_up(0, g, 0, Piece::Tell, 0.0));
+        }
+        let s = Schedule { work };
+        assert_eq!(s.makespan(2, false), 6.0);
+        assert_eq!(s.makespan_overlapped(2), 5.0);
+        assert_eq!(s.makespan_overlapped(1), 10.0);
+        assert_eq!(s.critical_path_overlapped(), 2.0);
+        assert_eq!(s.makespan_overlapped(100), 2.0);
+        assert_eq!(s.critical_path(false), 4.0);
+    }
+
+    #[test]
+    fn the_overlapped_replay_keeps_within_grahams_bounds() {
+        let s = run(3, 12, 4, 12);
+        let (work, path) = (s.work_seconds(), s.critical_path_overlapped());
+        assert!(path < s.critical_path(false));
+        assert!((s.makespan_overlapped(1) - work).abs() < 1e-6);
+        for w in [2, 3, 4, 8, 16, 64] {
+            let t = s.makespan_overlapped(w);
+            let lower = (work / w as f64).max(path);
+            assert!(
+                t >= lower - 1e-6 && t <= work / w as f64 + path + 1e-6,
+                "{w}: {lower} ≤ {t}"
+            );
+        }
+        assert!((s.makespan_overlapped(10_000) - path).abs() < 1e-6);
     }
 }
