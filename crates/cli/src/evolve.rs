@@ -652,7 +652,7 @@ fn report_schedule(
             one / c
         );
     }
-    say!("  (overlapped: each lane asked for its next generation while the last is evaluated; a different search, not built yet)");
+    say!("  (overlapped: each lane asked for its next generation while the last is evaluated: MAP-Elites with [archive] overlap = true)");
     say!("wrote {}/schedule.csv", dir.display());
     Ok(())
 }

@@ -440,6 +440,7 @@ mod tests {
             sigma: None,
             line_sigma: None,
             tournament: 1,
+            overlap: false,
         }
     }
 

@@ -48,6 +48,10 @@ pub trait Problem: Send + Sync {
     ) -> Option<Result<Vec<Outcome>, String>> {
         None
     }
+    /// Whether [`Problem::evaluate_population`] evaluates (a GPU's batches).
+    fn in_batches(&self) -> bool {
+        false
+    }
     /// The scene's `[evolve]` table, resolved (none for a problem that is
     /// not a scene).
     fn spec(&self) -> Option<&EvolveSpec> {
@@ -117,6 +121,9 @@ impl Problem for SceneEvolution {
         let b = self.0.batches()?;
         Some(self.0.evaluate_all(genomes, fine, &*b.0))
     }
+    fn in_batches(&self) -> bool {
+        self.0.batches().is_some()
+    }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())
     }
@@ -159,6 +166,9 @@ impl Problem for BodyEvolution {
     ) -> Option<Result<Vec<Outcome>, String>> {
         let b = self.0.batches()?;
         Some(self.0.evaluate_all(genomes, fine, &*b.0))
+    }
+    fn in_batches(&self) -> bool {
+        self.0.batches().is_some()
     }
     fn spec(&self) -> Option<&EvolveSpec> {
         Some(self.0.spec())

@@ -351,6 +351,46 @@ pub struct Lane {
     pub optimiser: AnyOptimiser,
     /// The best so far (`None` before the first generation).
     pub best: Option<Best>,
+    /// With `[archive] overlap`: the next generation, asked before the
+    /// last was told, not yet evaluated.
+    #[serde(default)]
+    pub ahead: Option<Ahead>,
+}
+
+/// A generation asked ahead (`[archive] overlap`): its genomes and the
+/// screen of the archive it was asked from.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Ahead {
+    /// The genomes.
+    pub population: Vec<Vec<f64>>,
+    /// Which of them need a robust scene's finer runs.
+    pub screen: Screen,
+}
+
+/// `lane`'s next generation and its screen: the one asked ahead, if any;
+/// and, when its optimiser overlaps generations, the one after it asked
+/// now, before this one is told (every path — [`State::advance`] on any
+/// threads, [`State::ask`] — asks and tells a lane's generations in this
+/// one order).
+fn ask_lane(
+    lane: &mut Lane,
+    variation: Option<&dyn Variation>,
+) -> Result<(Vec<Vec<f64>>, Screen), String> {
+    let now = match lane.ahead.take() {
+        Some(a) => (a.population, a.screen),
+        None => {
+            let p = lane.optimiser.ask_with(variation)?;
+            (p, lane.optimiser.screen())
+        }
+    };
+    if lane.optimiser.overlaps() {
+        let population = lane.optimiser.ask_with(variation)?;
+        lane.ahead = Some(Ahead {
+            population,
+            screen: lane.optimiser.screen(),
+        });
+    }
+    Ok(now)
 }
 
 /// Everything needed to continue a run: what a checkpoint stores.
@@ -384,6 +424,7 @@ impl State {
                         problem.variation().is_some(),
                     )?,
                     best: None,
+                    ahead: None,
                 })
             })
             .collect::<Result<_, String>>()?;
@@ -609,8 +650,8 @@ impl State {
             .iter_mut()
             .filter(|l| l.generation < target)
             .map(|l| {
-                let population = l.optimiser.ask_with(variation)?;
-                Ok(((l.lane, population), l.optimiser.screen()))
+                let (population, screen) = ask_lane(l, variation)?;
+                Ok(((l.lane, population), screen))
             })
             .collect::<Result<Vec<_>, String>>()?
             .into_iter()
@@ -922,6 +963,13 @@ fn advance_lanes(
     seen: Option<&(dyn Fn(&LogRow) + Sync)>,
 ) -> Result<Vec<LogRow>, String> {
     use std::sync::Mutex;
+    // One lane that overlaps its generations, evaluated here: its
+    // generations in flight together.
+    if let ([lane], [todo]) = (&mut *lanes, todo) {
+        if lane.optimiser.overlaps() && !problem.in_batches() && *todo > 0 {
+            return advance_overlapped(lane, *todo, problem, tracer, more, seen);
+        }
+    }
     struct Slot<'a> {
         /// `None` while a thread advances it.
         lane: Option<&'a mut Lane>,
@@ -1016,27 +1064,7 @@ fn advance_lane(
     let mut rows = Vec::with_capacity(n as usize);
     for _ in 0..n {
         let (k, g) = (lane.lane, lane.generation);
-        let began = std::time::Instant::now();
-        // Traced, the children's making (in parallel, inside the ask) is
-        // recorded piece by piece, and the ask as what is left of it.
-        let timed = tracer.and(problem.variation()).map(|inner| Timed {
-            inner,
-            made: std::sync::Mutex::new(None),
-        });
-        let variation = match &timed {
-            Some(t) => Some(t as &dyn Variation),
-            None => problem.variation(),
-        };
-        let population = lane.optimiser.ask_with(variation)?;
-        let screen = lane.optimiser.screen();
-        if let Some(t) = tracer {
-            let made = timed.and_then(|t| t.made.into_inner().ok().flatten());
-            let children = made.as_ref().map_or(0.0, |m| m.1);
-            t.done_part(k, g, Piece::Ask, began, children);
-            for (i, &s) in made.iter().flat_map(|m| m.0.iter()).enumerate() {
-                t.done_seconds(k, g, Piece::Vary(i), s);
-            }
-        }
+        let (population, screen) = traced_ask(problem, tracer, k, g, |v| ask_lane(lane, v))?;
         let batch = problem.evaluate_population(&population, &|_, o| screen.fine(o));
         let outcomes: Vec<Outcome> = match batch {
             Some(batch) => batch?,
@@ -1056,6 +1084,293 @@ fn advance_lane(
         }
     }
     Ok(rows)
+}
+
+/// `ask(variation)` for lane `k`'s generation `g`, its time recorded by
+/// `tracer` if given: the ask as one piece, each child's making (in
+/// parallel, inside the ask) as one of its own.
+fn traced_ask<T>(
+    problem: &dyn Problem,
+    tracer: Option<&crate::schedule::Tracer>,
+    k: usize,
+    g: u64,
+    ask: impl FnOnce(Option<&dyn Variation>) -> Result<T, String>,
+) -> Result<T, String> {
+    use crate::schedule::Piece;
+    let began = std::time::Instant::now();
+    let timed = tracer.and(problem.variation()).map(|inner| Timed {
+        inner,
+        made: std::sync::Mutex::new(None),
+    });
+    let variation = match &timed {
+        Some(t) => Some(t as &dyn Variation),
+        None => problem.variation(),
+    };
+    let out = ask(variation)?;
+    if let Some(t) = tracer {
+        let made = timed.and_then(|t| t.made.into_inner().ok().flatten());
+        let children = made.as_ref().map_or(0.0, |m| m.1);
+        t.done_part(k, g, Piece::Ask, began, children);
+        for (i, &s) in made.iter().flat_map(|m| m.0.iter()).enumerate() {
+            t.done_seconds(k, g, Piece::Vary(i), s);
+        }
+    }
+    Ok(out)
+}
+
+/// Up to `todo` generations of one lane whose optimiser overlaps them
+/// (`[archive] overlap`), the next generation evaluated while the last
+/// still is: each evaluation a task of the current rayon pool (a
+/// generation's longest first), each generation told, in order, by the
+/// thread that ends its last evaluation, which then asks the generation
+/// after the next. The optimiser asks and tells in the order of
+/// [`ask_lane`], so the log and the best are those of [`advance_lane`] on
+/// any threads. A generation is started only while `more()` says so; the
+/// one asked last waits in [`Lane::ahead`].
+fn advance_overlapped(
+    lane: &mut Lane,
+    todo: u64,
+    problem: &dyn Problem,
+    tracer: Option<&crate::schedule::Tracer>,
+    more: &(dyn Fn() -> bool + Sync),
+    seen: Option<&(dyn Fn(&LogRow) + Sync)>,
+) -> Result<Vec<LogRow>, String> {
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Mutex;
+    let k = lane.lane;
+    let (first, last) = (lane.generation, lane.generation + todo);
+    let start = Flight::new(
+        first,
+        traced_ask(problem, tracer, k, first, |v| ask_lane(lane, v))?,
+    );
+    let next = match lane.ahead.take() {
+        Some(a) if first + 1 < last && more() => {
+            Some(Flight::new(first + 1, (a.population, a.screen)))
+        }
+        other => {
+            lane.ahead = other;
+            None
+        }
+    };
+    let ctx = Overlapped {
+        pipe: Mutex::new(Pipe {
+            lane: Some(lane),
+            ended: Default::default(),
+            next_in_flight: next.is_some(),
+            rows: Vec::new(),
+            error: None,
+        }),
+        stop: AtomicBool::new(false),
+        problem,
+        tracer,
+        more,
+        seen,
+        k,
+        last,
+    };
+    rayon::in_place_scope_fifo(|scope| {
+        ctx.launch(scope, start);
+        if let Some(next) = next {
+            ctx.launch(scope, next);
+        }
+    });
+    let p = ctx
+        .pipe
+        .into_inner()
+        .map_err(|_| "an evaluation panicked".to_string())?;
+    match p.error {
+        Some(e) => Err(e),
+        None => Ok(p.rows),
+    }
+}
+
+/// A generation in flight ([`advance_overlapped`]).
+struct Flight {
+    generation: u64,
+    population: Vec<Vec<f64>>,
+    screen: Screen,
+    outcomes: Vec<std::sync::OnceLock<Result<Outcome, String>>>,
+    left: std::sync::atomic::AtomicUsize,
+}
+
+impl Flight {
+    fn new(
+        generation: u64,
+        (population, screen): (Vec<Vec<f64>>, Screen),
+    ) -> std::sync::Arc<Flight> {
+        std::sync::Arc::new(Flight {
+            generation,
+            outcomes: (0..population.len())
+                .map(|_| std::sync::OnceLock::new())
+                .collect(),
+            left: std::sync::atomic::AtomicUsize::new(population.len()),
+            population,
+            screen,
+        })
+    }
+}
+
+/// What the telling thread works on ([`advance_overlapped`]).
+struct Pipe<'a> {
+    /// `None` while a thread tells.
+    lane: Option<&'a mut Lane>,
+    /// Generations whose evaluations have all ended, not yet told.
+    ended: std::collections::BTreeMap<u64, std::sync::Arc<Flight>>,
+    /// Whether the generation after the one told last is in flight.
+    next_in_flight: bool,
+    rows: Vec<LogRow>,
+    error: Option<String>,
+}
+
+/// [`advance_overlapped`]'s run.
+struct Overlapped<'a> {
+    pipe: std::sync::Mutex<Pipe<'a>>,
+    /// Set on an error: evaluations not yet started are skipped.
+    stop: std::sync::atomic::AtomicBool,
+    problem: &'a dyn Problem,
+    tracer: Option<&'a crate::schedule::Tracer>,
+    more: &'a (dyn Fn() -> bool + Sync),
+    seen: Option<&'a (dyn Fn(&LogRow) + Sync)>,
+    k: usize,
+    /// The first generation not to start.
+    last: u64,
+}
+
+impl<'a> Overlapped<'a> {
+    /// Starts every evaluation of `f`, its longest first.
+    fn launch<'s>(&'s self, scope: &rayon::ScopeFifo<'s>, f: std::sync::Arc<Flight>)
+    where
+        'a: 's,
+    {
+        use std::sync::atomic::Ordering;
+        for (position, i) in start_order(self.problem, &f.population)
+            .into_iter()
+            .enumerate()
+        {
+            let f = f.clone();
+            scope.spawn_fifo(move |scope| {
+                let outcome = if self.stop.load(Ordering::Relaxed) {
+                    Err("not evaluated: the run stopped".into())
+                } else {
+                    let began = std::time::Instant::now();
+                    let o = self.problem.evaluate_screened(&f.population[i], &f.screen);
+                    if let Some(t) = self.tracer {
+                        t.done_evaluation(self.k, f.generation, i, position, began);
+                    }
+                    o
+                };
+                let _ = f.outcomes[i].set(outcome);
+                if f.left.fetch_sub(1, Ordering::AcqRel) == 1 {
+                    self.ended(scope, f);
+                }
+            });
+        }
+    }
+
+    /// Generation `f`'s evaluations have all ended. The first thread to
+    /// find the lane free takes it and tells every generation that can be
+    /// told, in order, each followed by the ask of the generation after
+    /// the next (started if the batch goes on, else kept ahead); it holds
+    /// no lock while it tells or asks (an ask makes its children on the
+    /// pool, and a thread waiting for them may end another generation).
+    fn ended<'s>(&'s self, scope: &rayon::ScopeFifo<'s>, f: std::sync::Arc<Flight>)
+    where
+        'a: 's,
+    {
+        use crate::schedule::Piece;
+        use std::sync::atomic::Ordering;
+        let lane = {
+            let Ok(mut p) = self.pipe.lock() else { return };
+            p.ended.insert(f.generation, f);
+            p.lane.take()
+        };
+        // Another thread is telling: it will find this generation.
+        let Some(lane) = lane else { return };
+        let fail = |e: String| {
+            if let Ok(mut p) = self.pipe.lock() {
+                p.error.get_or_insert(e);
+            }
+            self.stop.store(true, Ordering::Relaxed);
+        };
+        loop {
+            let told = lane.generation;
+            let (f, next_in_flight) = {
+                let Ok(mut p) = self.pipe.lock() else { return };
+                let f = if p.error.is_none() {
+                    p.ended.remove(&told)
+                } else {
+                    None
+                };
+                match f {
+                    Some(f) => (f, std::mem::take(&mut p.next_in_flight)),
+                    None => {
+                        p.lane = Some(lane);
+                        return;
+                    }
+                }
+            };
+            let outcomes: Result<Vec<Outcome>, String> = f
+                .outcomes
+                .iter()
+                .map(|o| {
+                    o.get()
+                        .cloned()
+                        .unwrap_or_else(|| Err("an evaluation was never run".into()))
+                })
+                .collect();
+            let began = std::time::Instant::now();
+            let row =
+                outcomes.and_then(|o| record(lane, Some(self.problem), f.population.clone(), &o));
+            let row = match row {
+                Ok(row) => row,
+                Err(e) => {
+                    fail(e);
+                    continue;
+                }
+            };
+            if let Some(t) = self.tracer {
+                t.done(self.k, told, Piece::Tell, began);
+            }
+            if let Some(seen) = self.seen {
+                seen(&row);
+            }
+            if let Ok(mut p) = self.pipe.lock() {
+                p.rows.push(row);
+            }
+            if !next_in_flight {
+                continue;
+            }
+            // The generation after the next, asked before the next is told.
+            let g = told + 2;
+            let asked = traced_ask(self.problem, self.tracer, self.k, g, |v| {
+                let population = lane.optimiser.ask_with(v)?;
+                Ok((population, lane.optimiser.screen()))
+            });
+            match asked {
+                Ok(a) if g < self.last && (self.more)() => {
+                    if let Ok(mut p) = self.pipe.lock() {
+                        p.next_in_flight = true;
+                    }
+                    self.launch(scope, Flight::new(g, a));
+                }
+                Ok((population, screen)) => lane.ahead = Some(Ahead { population, screen }),
+                Err(e) => fail(e),
+            }
+        }
+    }
+}
+
+/// The order a generation's evaluations start in: the longest first where
+/// the problem can guess their costs ([`Problem::cost`]; ties, and
+/// problems that cannot guess, in the population's order).
+fn start_order(problem: &dyn Problem, population: &[Vec<f64>]) -> Vec<usize> {
+    let costs: Vec<Option<f64>> = population.iter().map(|g| problem.cost(g)).collect();
+    let mut order: Vec<usize> = (0..population.len()).collect();
+    if costs.iter().all(Option::is_some) {
+        let c = |i: usize| costs[i].unwrap_or(0.0);
+        order.sort_by(|&a, &b| c(b).total_cmp(&c(a)).then(a.cmp(&b)));
+    }
+    order
 }
 
 /// A problem's variation that notes how long its children took to make

@@ -382,3 +382,91 @@ fn a_body_run_refuses_what_does_not_fit_it() {
     let e = Config::new(crawler, &bodyga).unwrap_err();
     assert!(e.contains("[morphology]"), "{e}");
 }
+
+/// `[archive] overlap = true`: each generation is asked before the last
+/// is told (its parents from the archive a generation older), and one
+/// lane's two generations are evaluated at once. The run is a pure
+/// function of its seed: the same log, best and state on 1 and 3 threads,
+/// advanced in batches across a checkpoint, by `advance_while` stopping
+/// and going on, and through `ask`/`tell` one generation at a time; and it
+/// is not the run without overlap.
+#[test]
+fn overlapped_generations_are_one_run_on_any_threads_and_paths() {
+    let text = |overlap: bool| {
+        format!(
+            "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"feet\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [0.0, 8.0]]\ntournament = 2\noverlap = {overlap}\n"
+        )
+    };
+    let config = |overlap: bool| {
+        let spec = ProblemSpec {
+            file: "bodies.toml".into(),
+            text: text(overlap),
+        };
+        let choices = Choices {
+            generations: Some(8),
+            population: Some(8),
+            seed: Some(5),
+            optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+            ..Choices::default()
+        };
+        Config::new(spec, &choices).unwrap()
+    };
+    let whole = |threads: usize| {
+        let mut s = State::new(config(true)).unwrap();
+        pool(threads).install(|| s.advance(8)).unwrap();
+        s
+    };
+    let one = whole(1);
+    assert_eq!(one.log.len(), 8);
+    assert!(one.lanes[0].ahead.is_some(), "the next generation waits");
+    let three = whole(3);
+    assert_eq!(one.log_csv(), three.log_csv());
+    assert_eq!(one, three);
+    // In batches, across a checkpoint.
+    let dir = std::env::temp_dir().join(format!("animats-overlap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("checkpoint.json");
+    let mut s = State::new(config(true)).unwrap();
+    pool(2).install(|| s.advance(3)).unwrap();
+    checkpoint::save(&path, &s).unwrap();
+    let mut back = checkpoint::load(&path).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert_eq!(back, s);
+    pool(2).install(|| back.advance(5)).unwrap();
+    assert_eq!(back, one);
+    // Stopping after every few generations, as `animats evolve` does.
+    let mut s = State::new(config(true)).unwrap();
+    let problem = s.config.problem.build().unwrap();
+    while !s.done() {
+        let calls = std::sync::atomic::AtomicUsize::new(0);
+        let more = || calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < 2;
+        pool(2)
+            .install(|| s.advance_while(problem.as_ref(), None, &more, &|_| ()))
+            .unwrap();
+    }
+    assert_eq!(s, one);
+    // Through ask and tell, one generation at a time.
+    let mut s = State::new(config(true)).unwrap();
+    while !s.done() {
+        let g = s.ask().unwrap();
+        let outcomes: Vec<_> = g
+            .genomes()
+            .enumerate()
+            .map(|(i, x)| problem.evaluate_screened(x, g.screen(i)).unwrap())
+            .collect();
+        s.tell(g, &outcomes).unwrap();
+    }
+    assert_eq!(s, one);
+    // Not the run without overlap.
+    let mut plain = State::new(config(false)).unwrap();
+    pool(2).install(|| plain.advance(8)).unwrap();
+    assert_ne!(plain.log_csv(), one.log_csv());
+    // The first generation is the same (its refusals aside: the overlapped
+    // run has made the second's children too).
+    let (a, b) = (&plain.log[0], &one.log[0]);
+    assert_eq!(
+        (a.fitness, &a.improved, a.archive),
+        (b.fitness, &b.improved, b.archive)
+    );
+    assert!(a.refused < b.refused, "{:?} {:?}", a.refused, b.refused);
+}

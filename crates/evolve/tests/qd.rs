@@ -52,6 +52,7 @@ fn grid(emitters: usize) -> Grid {
         sigma: Some(0.5),
         line_sigma: None,
         tournament: 1,
+        overlap: false,
     }
 }
 
@@ -261,4 +262,50 @@ fn iso_line_and_cma_mae_keep_their_invariants() {
         }
         assert_eq!(a, b, "{kind:?}");
     }
+}
+
+/// `[archive] overlap`: a second ask before the first is told is the next
+/// generation (its own random stream: not the first's genomes), told after
+/// the first; a third is refused, and so is overlap with CMA-ME, whose
+/// emitters adapt from each generation told before the next is asked.
+#[test]
+fn an_overlapping_search_asks_one_generation_ahead() {
+    let mut g = grid(1);
+    g.overlap = true;
+    let make = |kind: QdKind, g: Grid| Qd::new(kind, g, &[0.0; DIM], None, Some(8), 4, 0, false);
+    let e = make(QdKind::CmaMe, g.clone()).unwrap_err();
+    assert!(
+        e.contains("[archive] overlap") && e.contains("map-elites"),
+        "{e}"
+    );
+    let mut qd = make(QdKind::MapElites, g).unwrap();
+    let first = qd.ask(None).unwrap();
+    let second = qd.ask(None).unwrap();
+    assert_ne!(first, second);
+    assert!(qd.ask(None).unwrap_err().contains("one generation ahead"));
+    let told = |x: &[Vec<f64>]| -> Vec<Outcome> {
+        x.iter()
+            .map(|x| {
+                let (f, m) = sphere(x);
+                Outcome {
+                    fitness: f,
+                    distance: 0.0,
+                    time: 0.0,
+                    ended: Ended::Timeout,
+                    measures: m.to_vec(),
+                    energy: None,
+                    target_distance: None,
+                    terms: Vec::new(),
+                }
+            })
+            .collect()
+    };
+    qd.tell(&told(&first)).unwrap();
+    assert_eq!(qd.generation(), 1);
+    // The second is told next (a third asked now is the generation after).
+    let third = qd.ask(None).unwrap();
+    assert_ne!(third, second);
+    qd.tell(&told(&second)).unwrap();
+    qd.tell(&told(&third)).unwrap();
+    assert_eq!(qd.generation(), 3);
 }

@@ -72,6 +72,12 @@ pub struct ArchiveEntry {
     /// MAP-Elites's parents: each the best of this many elites drawn
     /// uniformly; default 1 (uniform, pyribs's).
     pub tournament: Option<u64>,
+    /// MAP-Elites: ask each generation before the last is told, its
+    /// parents drawn from the archive a generation older, so that two
+    /// generations are evaluated at once; default false (pyribs's
+    /// scheduler).
+    #[serde(default)]
+    pub overlap: bool,
 }
 
 /// `[archive] emitter`.
@@ -219,6 +225,9 @@ pub struct Grid {
     /// See [`ArchiveEntry::tournament`] (1: uniform).
     #[serde(default = "one")]
     pub tournament: usize,
+    /// See [`ArchiveEntry::overlap`].
+    #[serde(default)]
+    pub overlap: bool,
 }
 
 fn one() -> usize {
@@ -378,6 +387,7 @@ impl ArchiveEntry {
             sigma: self.sigma,
             line_sigma: self.line_sigma,
             tournament,
+            overlap: self.overlap,
         })
     }
 

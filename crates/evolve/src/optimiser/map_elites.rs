@@ -104,6 +104,14 @@ pub struct Qd {
     /// Candidates last asked (genomes), and how many each emitter asked.
     asked: Vec<Vec<f64>>,
     counts: Vec<usize>,
+    /// `[archive] overlap`: the next generation is asked before the last
+    /// is told.
+    #[serde(default)]
+    overlap: bool,
+    /// With `overlap`, the generation asked after the one not yet told
+    /// (its genomes and each emitter's count).
+    #[serde(default)]
+    ahead: Option<(Vec<Vec<f64>>, Vec<usize>)>,
     best: BestSoFar,
     refused: BTreeMap<String, u64>,
     kept: u64,
@@ -134,6 +142,13 @@ impl Qd {
         if bodies && kind == QdKind::CmaMe {
             return Err(
                 "optimiser: cma-me adapts a fixed-length genome; a [morphology] scene's bodies change shape: use map-elites"
+                    .into(),
+            );
+        }
+        let overlap = grid.overlap;
+        if overlap && kind == QdKind::CmaMe {
+            return Err(
+                "[archive] overlap: cma-me's emitters adapt from every generation told before the next is asked: use map-elites"
                     .into(),
             );
         }
@@ -188,6 +203,8 @@ impl Qd {
             bounds,
             asked: Vec::new(),
             counts: Vec::new(),
+            overlap,
+            ahead: None,
             best: BestSoFar::default(),
             refused: BTreeMap::new(),
             kept: 0,
@@ -197,6 +214,12 @@ impl Qd {
     /// Which search this is.
     pub fn kind(&self) -> QdKind {
         self.kind
+    }
+
+    /// Whether the next generation is asked before the last is told
+    /// (`[archive] overlap`).
+    pub fn overlaps(&self) -> bool {
+        self.overlap
     }
 
     /// True when its emitters vary bodies (a `[morphology]` scene's).
@@ -243,10 +266,21 @@ impl Qd {
     }
 
     /// The next generation: every emitter's batch, in emitter order.
+    /// With `[archive] overlap`, asked while a generation is untold, it is
+    /// the next one (its parents from the archive as it stands), told
+    /// after that one.
     pub fn ask(&mut self, variation: Option<&dyn Variation>) -> Result<Vec<Vec<f64>>, String> {
+        let ahead = self.overlap && !self.asked.is_empty();
+        if ahead && self.ahead.is_some() {
+            return Err(
+                "map-elites with [archive] overlap asks one generation ahead at most: tell the oldest first"
+                    .into(),
+            );
+        }
         let mut all = Vec::new();
         let mut counts = Vec::with_capacity(self.emitters.len());
-        let (seed, lane, generation) = (self.seed, self.lane, self.generation);
+        let (seed, lane) = (self.seed, self.lane);
+        let generation = self.generation + u64::from(ahead);
         let mut emitters = std::mem::take(&mut self.emitters);
         for (k, e) in emitters.iter_mut().enumerate() {
             let mut rng = Random::for_child(seed, lane, generation, k as u64);
@@ -287,7 +321,7 @@ impl Qd {
                     let v = variation.ok_or(
                         "map-elites over bodies varies them with the scene's [morphology]",
                     )?;
-                    self.bodies(*batch, k, v)
+                    self.bodies(*batch, k, generation, v)
                 }
                 Emitter::Cma(c) => {
                     let xs = c.ask(&mut rng);
@@ -298,8 +332,12 @@ impl Qd {
             all.extend(batch);
         }
         self.emitters = emitters;
-        self.counts = counts;
-        self.asked = all.clone();
+        if ahead {
+            self.ahead = Some((all.clone(), counts));
+        } else {
+            self.counts = counts;
+            self.asked = all.clone();
+        }
         Ok(all)
     }
 
@@ -319,9 +357,9 @@ impl Qd {
 
     /// `n` bodies of emitter `k`, each from its own stream (made in
     /// parallel).
-    fn bodies(&mut self, n: usize, k: usize, v: &dyn Variation) -> Vec<Vec<f64>> {
+    fn bodies(&mut self, n: usize, k: usize, generation: u64, v: &dyn Variation) -> Vec<Vec<f64>> {
         let start = v.start();
-        let (seed, lane, generation) = (self.seed, self.lane, self.generation);
+        let (seed, lane) = (self.seed, self.lane);
         let archive = &self.archive;
         let made = body_ga::make_children(v, n, |i| {
             let key = (1u64 << 48) | ((k as u64) << 24) | i as u64;
@@ -411,6 +449,10 @@ impl Qd {
         }
         self.emitters = emitters;
         self.generation += 1;
+        if let Some((asked, counts)) = self.ahead.take() {
+            self.asked = asked;
+            self.counts = counts;
+        }
         Ok(added)
     }
 

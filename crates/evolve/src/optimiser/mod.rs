@@ -360,6 +360,12 @@ impl AnyOptimiser {
         }
     }
 
+    /// Whether the next generation is asked before the last is told
+    /// (MAP-Elites with `[archive] overlap`).
+    pub fn overlaps(&self) -> bool {
+        matches!(self, AnyOptimiser::Qd(o) if o.overlaps())
+    }
+
     /// The archive of a quality-diversity search.
     pub fn archive(&self) -> Option<&crate::archive::GridArchive> {
         match self {
