@@ -376,21 +376,36 @@ fn ask_lane(
     lane: &mut Lane,
     variation: Option<&dyn Variation>,
 ) -> Result<(Vec<Vec<f64>>, Screen), String> {
-    let now = match lane.ahead.take() {
-        Some(a) => (a.population, a.screen),
-        None => {
-            let p = lane.optimiser.ask_with(variation)?;
-            (p, lane.optimiser.screen())
-        }
-    };
-    if lane.optimiser.overlaps() {
+    let ask = |lane: &mut Lane| -> Result<Ahead, String> {
         let population = lane.optimiser.ask_with(variation)?;
-        lane.ahead = Some(Ahead {
+        Ok(Ahead {
             population,
             screen: lane.optimiser.screen(),
-        });
-    }
-    Ok(now)
+        })
+    };
+    let now = match lane.ahead.take() {
+        // The one after it first: refused (asked twice untold), the lane
+        // stays as it was.
+        Some(a) if lane.optimiser.overlaps() => match ask(lane) {
+            Ok(next) => {
+                lane.ahead = Some(next);
+                a
+            }
+            Err(e) => {
+                lane.ahead = Some(a);
+                return Err(e);
+            }
+        },
+        Some(a) => a,
+        None => {
+            let now = ask(lane)?;
+            if lane.optimiser.overlaps() {
+                lane.ahead = Some(ask(lane)?);
+            }
+            now
+        }
+    };
+    Ok((now.population, now.screen))
 }
 
 /// Everything needed to continue a run: what a checkpoint stores.

@@ -445,10 +445,13 @@ fn overlapped_generations_are_one_run_on_any_threads_and_paths() {
             .unwrap();
     }
     assert_eq!(s, one);
-    // Through ask and tell, one generation at a time.
+    // Through ask and tell, one generation at a time (asked twice untold,
+    // refused, and the run goes on as if it had not been).
     let mut s = State::new(config(true)).unwrap();
     while !s.done() {
         let g = s.ask().unwrap();
+        let e = s.ask().unwrap_err();
+        assert!(e.contains("one generation ahead"), "{e}");
         let outcomes: Vec<_> = g
             .genomes()
             .enumerate()
