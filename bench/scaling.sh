@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Evolution's scaling with threads (issue 41): the issue's three runs,
 # [morphology] runs (bodies and brains evolving: 16 lanes of the body GA;
-# the shipped land task, MAP-Elites in one lane, 36 bodies a generation
-# and 144)
+# the shipped land task, MAP-Elites in one lane, 36 bodies a generation,
+# 144, and 36 with its generations overlapping)
 # at 1, 2, 4, 8 and 16 threads, wall time and speed-up each, every log
 # checked identical; then the schedule model's prediction (`evolve
 # --schedule`) from each row's 1-thread run, to set beside the measured.
@@ -20,6 +20,9 @@ B=${ANIMATS:-target/carry/animats}
 THREADS=${THREADS:-"1 2 4 8 16"}
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
+# The land task with its generations overlapping ([archive] overlap).
+sed 's/^tournament = 4.*/&\noverlap = true/' scenes/bodies_walk.toml > "$OUT/bodies_walk_overlap.toml"
+grep -q '^overlap = true' "$OUT/bodies_walk_overlap.toml" || { echo "scenes/bodies_walk.toml: no tournament line to add overlap after" >&2; exit 2; }
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%d)"
 rows=(
   "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
@@ -28,6 +31,7 @@ rows=(
   "bodies_walk|scenes/bodies_walk.toml --optimiser body-ga --lanes 16 --generations 2 --seed 1"
   "bodies_map|scenes/bodies_walk.toml --generations 20 --seed 1 --no-check"
   "bodies_map_144|scenes/bodies_walk.toml --population 144 --generations 5 --seed 1 --no-check"
+  "bodies_map_overlap|$OUT/bodies_walk_overlap.toml --generations 20 --seed 1 --no-check"
 )
 header="| run |"; rule="|---|"
 for t in $THREADS; do header+=" $t |"; rule+="---|"; done
