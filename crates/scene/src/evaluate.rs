@@ -677,7 +677,8 @@ pub fn engine_runs(scenes: Vec<Scene>) -> Result<Vec<Evaluation>, String> {
 /// [`score_screened`] for many genomes at once, each `makes[g]` building
 /// genome `g`'s scene and `fine(g, e)` its screen: every run at the scenes' step handed to `run` in one
 /// batch, then every run at half the step that a robust scene needs in a
-/// second one (a batch shares one step). The same scores as
+/// second one, and so on for each further halving (a batch shares one
+/// step). The same scores as
 /// [`score_screened`] on each genome, where `run` gives the engine's bits.
 pub fn score_all(
     makes: &[&Make<'_>],
