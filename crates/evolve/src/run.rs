@@ -1258,6 +1258,11 @@ impl<'a> Overlapped<'a> {
         'a: 's,
     {
         use std::sync::atomic::Ordering;
+        if f.population.is_empty() {
+            // Nothing to evaluate: told at once (and refused there).
+            self.ended(scope, f);
+            return;
+        }
         for (position, i) in start_order(self.problem, &f.population)
             .into_iter()
             .enumerate()
