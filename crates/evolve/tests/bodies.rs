@@ -473,3 +473,33 @@ fn overlapped_generations_are_one_run_on_any_threads_and_paths() {
     );
     assert!(a.refused < b.refused, "{:?} {:?}", a.refused, b.refused);
 }
+
+/// With a start body and `[archive] overlap`, the first generation holds
+/// the start body once (its first candidate) and the second, asked before
+/// the first is told, only its mutants.
+#[test]
+fn an_overlapped_run_evaluates_its_start_body_once() {
+    let text = LATTICE.replace(
+        "[morphology]\n",
+        "[morphology]\nstructure = [[3, 3, 3], [4, 0, 4]]\n",
+    ) + "[archive]\nmeasures = [{ kind = \"size\" }]\nbins = [4]\nranges = [[0.0, 0.4]]\noverlap = true\n";
+    let spec = ProblemSpec {
+        file: "bodies.toml".into(),
+        text,
+    };
+    let choices = Choices {
+        generations: Some(1),
+        population: Some(4),
+        seed: Some(2),
+        optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+        ..Choices::default()
+    };
+    let mut s = State::new(Config::new(spec, &choices).unwrap()).unwrap();
+    let start = s.config.problem.build().unwrap().start();
+    let g = s.ask().unwrap();
+    let first: Vec<&[f64]> = g.genomes().collect();
+    assert_eq!(first[0], start.as_slice());
+    let ahead = &s.lanes[0].ahead.as_ref().unwrap().population;
+    assert_eq!(ahead.len(), 4);
+    assert!(ahead.iter().all(|x| x != &start), "the start body again");
+}

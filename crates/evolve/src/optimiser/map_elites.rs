@@ -361,12 +361,15 @@ impl Qd {
         let start = v.start();
         let (seed, lane) = (self.seed, self.lane);
         let archive = &self.archive;
+        // The start body itself once: not again in a generation asked
+        // ahead of the first's telling (`[archive] overlap`).
+        let first = generation == self.generation;
         let made = body_ga::make_children(v, n, |i| {
             let key = (1u64 << 48) | ((k as u64) << 24) | i as u64;
             let mut rng = Random::for_child(seed, lane, generation, key);
             if archive.is_empty() {
                 return match &start {
-                    Some(s) if i == 0 && k == 0 => Made {
+                    Some(s) if i == 0 && k == 0 && first => Made {
                         genome: s.clone(),
                         refused: Vec::new(),
                         kept: false,
