@@ -376,13 +376,7 @@ fn ask_lane(
     lane: &mut Lane,
     variation: Option<&dyn Variation>,
 ) -> Result<(Vec<Vec<f64>>, Screen), String> {
-    let ask = |lane: &mut Lane| -> Result<Ahead, String> {
-        let population = lane.optimiser.ask_with(variation)?;
-        Ok(Ahead {
-            population,
-            screen: lane.optimiser.screen(),
-        })
-    };
+    let ask = |lane: &mut Lane| ask_one(lane, variation);
     let now = match lane.ahead.take() {
         // The one after it first: refused (asked twice untold), the lane
         // stays as it was.
@@ -406,6 +400,16 @@ fn ask_lane(
         }
     };
     Ok((now.population, now.screen))
+}
+
+/// One ask of `lane`'s optimiser, with the screen of its archive as it
+/// stands.
+fn ask_one(lane: &mut Lane, variation: Option<&dyn Variation>) -> Result<Ahead, String> {
+    let population = lane.optimiser.ask_with(variation)?;
+    Ok(Ahead {
+        population,
+        screen: lane.optimiser.screen(),
+    })
 }
 
 /// Everything needed to continue a run: what a checkpoint stores.
@@ -1362,18 +1366,15 @@ impl<'a> Overlapped<'a> {
             }
             // The generation after the next, asked before the next is told.
             let g = told + 2;
-            let asked = traced_ask(self.problem, self.tracer, self.k, g, |v| {
-                let population = lane.optimiser.ask_with(v)?;
-                Ok((population, lane.optimiser.screen()))
-            });
+            let asked = traced_ask(self.problem, self.tracer, self.k, g, |v| ask_one(lane, v));
             match asked {
                 Ok(a) if g < self.last && (self.more)() => {
                     if let Ok(mut p) = self.pipe.lock() {
                         p.next_in_flight = true;
                     }
-                    self.launch(scope, Flight::new(g, a));
+                    self.launch(scope, Flight::new(g, (a.population, a.screen)));
                 }
-                Ok((population, screen)) => lane.ahead = Some(Ahead { population, screen }),
+                Ok(a) => lane.ahead = Some(a),
                 Err(e) => fail(e),
             }
         }
@@ -1448,12 +1449,7 @@ fn longest_first(
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::OnceLock;
     let n = population.len();
-    let costs: Vec<Option<f64>> = population.iter().map(|g| problem.cost(g)).collect();
-    let mut order: Vec<usize> = (0..n).collect();
-    if costs.iter().all(Option::is_some) {
-        let c = |i: usize| costs[i].unwrap_or(0.0);
-        order.sort_by(|&a, &b| c(b).total_cmp(&c(a)).then(a.cmp(&b)));
-    }
+    let order = start_order(problem, population);
     let next = AtomicUsize::new(0);
     let slots: Vec<OnceLock<Result<Outcome, String>>> = (0..n).map(|_| OnceLock::new()).collect();
     let threads = rayon::current_num_threads().min(n).max(1);

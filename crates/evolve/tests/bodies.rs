@@ -59,6 +59,22 @@ fn config(text: &str, generations: u64) -> Config {
     Config::new(spec, &choices).unwrap()
 }
 
+/// [`config`] searched by MAP-Elites.
+fn map_elites(text: &str, generations: u64) -> Config {
+    let spec = ProblemSpec {
+        file: "bodies.toml".into(),
+        text: text.into(),
+    };
+    let choices = Choices {
+        generations: Some(generations),
+        population: Some(8),
+        seed: Some(5),
+        optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+        ..Choices::default()
+    };
+    Config::new(spec, &choices).unwrap()
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -310,20 +326,7 @@ fn screened_map_elites_over_build_measures_fills_the_same_archive() {
     let text = format!(
         "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"particles\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [1.5, 13.5]]\n"
     );
-    let run = |full: bool| {
-        let spec = ProblemSpec {
-            file: "bodies.toml".into(),
-            text: text.clone(),
-        };
-        let choices = Choices {
-            generations: Some(8),
-            population: Some(8),
-            seed: Some(5),
-            optimiser: Some(animats_evolve::OptimiserKind::MapElites),
-            ..Choices::default()
-        };
-        run_to_end(Config::new(spec, &choices).unwrap(), full)
-    };
+    let run = |full: bool| run_to_end(map_elites(&text, 8), full);
     let (screened, full) = (run(false), run(true));
     let (a, b) = (screened.archive().unwrap(), full.archive().unwrap());
     assert!(a.len() > 2, "{} elites", a.len());
@@ -397,20 +400,7 @@ fn overlapped_generations_are_one_run_on_any_threads_and_paths() {
             "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"feet\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [0.0, 8.0]]\ntournament = 2\noverlap = {overlap}\n"
         )
     };
-    let config = |overlap: bool| {
-        let spec = ProblemSpec {
-            file: "bodies.toml".into(),
-            text: text(overlap),
-        };
-        let choices = Choices {
-            generations: Some(8),
-            population: Some(8),
-            seed: Some(5),
-            optimiser: Some(animats_evolve::OptimiserKind::MapElites),
-            ..Choices::default()
-        };
-        Config::new(spec, &choices).unwrap()
-    };
+    let config = |overlap: bool| map_elites(&text(overlap), 8);
     let whole = |threads: usize| {
         let mut s = State::new(config(true)).unwrap();
         pool(threads).install(|| s.advance(8)).unwrap();

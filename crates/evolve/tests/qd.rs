@@ -74,9 +74,9 @@ fn search(kind: QdKind, seed: u64) -> Qd {
     .unwrap()
 }
 
-fn generation(qd: &mut Qd) {
-    let asked = qd.ask(None).unwrap();
-    let outcomes: Vec<Outcome> = asked
+/// The sphere benchmark's outcomes of `asked`.
+fn spheres(asked: &[Vec<f64>]) -> Vec<Outcome> {
+    asked
         .iter()
         .map(|x| {
             let (f, m) = sphere(x);
@@ -91,8 +91,12 @@ fn generation(qd: &mut Qd) {
                 terms: Vec::new(),
             }
         })
-        .collect();
-    qd.tell(&outcomes).unwrap();
+        .collect()
+}
+
+fn generation(qd: &mut Qd) {
+    let asked = qd.ask(None).unwrap();
+    qd.tell(&spheres(&asked)).unwrap();
 }
 
 fn run(kind: QdKind, seed: u64, iterations: u64) -> GridArchive {
@@ -283,29 +287,12 @@ fn an_overlapping_search_asks_one_generation_ahead() {
     let second = qd.ask(None).unwrap();
     assert_ne!(first, second);
     assert!(qd.ask(None).unwrap_err().contains("one generation ahead"));
-    let told = |x: &[Vec<f64>]| -> Vec<Outcome> {
-        x.iter()
-            .map(|x| {
-                let (f, m) = sphere(x);
-                Outcome {
-                    fitness: f,
-                    distance: 0.0,
-                    time: 0.0,
-                    ended: Ended::Timeout,
-                    measures: m.to_vec(),
-                    energy: None,
-                    target_distance: None,
-                    terms: Vec::new(),
-                }
-            })
-            .collect()
-    };
-    qd.tell(&told(&first)).unwrap();
+    qd.tell(&spheres(&first)).unwrap();
     assert_eq!(qd.generation(), 1);
     // The second is told next (a third asked now is the generation after).
     let third = qd.ask(None).unwrap();
     assert_ne!(third, second);
-    qd.tell(&told(&second)).unwrap();
-    qd.tell(&told(&third)).unwrap();
+    qd.tell(&spheres(&second)).unwrap();
+    qd.tell(&spheres(&third)).unwrap();
     assert_eq!(qd.generation(), 3);
 }
