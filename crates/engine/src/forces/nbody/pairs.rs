@@ -162,59 +162,82 @@ impl Pairs {
     /// are those the kernel weighs 0 (a body on itself or one before it,
     /// padding, two at one place unsoftened), whose terms (±0) leave an
     /// accumulator as it was, since one never holds −0 (it starts at +0,
-    /// and a sum that cancels to zero is +0).
+    /// and a sum that cancels to zero is +0). Each size from 2 to
+    /// [`LANES`] has its own code (`small::<N>`).
     pub fn sum_small(&mut self, indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) {
         let n = indices.len();
-        if self.ax.len() != n || self.rx.len() != n {
-            for v in [
-                &mut self.ax,
-                &mut self.ay,
-                &mut self.az,
-                &mut self.rx,
-                &mut self.ry,
-                &mut self.rz,
-            ] {
+        for v in [&mut self.ax, &mut self.ay, &mut self.az] {
+            if v.len() != n {
                 v.clear();
                 v.resize(n, 0.0);
             }
-        } else {
-            for v in [&mut self.rx, &mut self.ry, &mut self.rz] {
-                v.fill(0.0);
-            }
         }
-        for (k, &i) in indices.iter().enumerate() {
-            let (pi, mi) = (pos[i as usize], mass[i as usize]);
-            let mut s = [[0.0f64; LANES]; 3];
-            for (q, &j) in indices.iter().enumerate().skip(k + 1) {
-                let pj = pos[j as usize];
-                let (dx, dy, dz) = (pj.x - pi.x, pj.y - pi.y, pj.z - pi.z);
-                let r2 = dx * dx + dy * dy + dz * dz + eps2;
-                // (Not `r2 <= 0.0`: a NaN pulls nowhere too, as in the kernel.)
-                if r2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                    continue;
-                }
-                let inv = 1.0 / (r2 * r2.sqrt());
-                let (wj, wi) = (mass[j as usize] * inv, mi * inv);
-                let l = q % LANES;
-                s[0][l] += dx * wj;
-                s[1][l] += dy * wj;
-                s[2][l] += dz * wj;
-                self.rx[q] -= dx * wi;
-                self.ry[q] -= dy * wi;
-                self.rz[q] -= dz * wi;
-            }
-            self.ax[k] = tree(&s[0]);
-            self.ay[k] = tree(&s[1]);
-            self.az[k] = tree(&s[2]);
-            // The reactions of the rows before it (none for the first).
-            if k > 0 {
-                self.ax[k] += self.rx[k];
-                self.ay[k] += self.ry[k];
-                self.az[k] += self.rz[k];
-            }
+        let out = [&mut self.ax[..], &mut self.ay[..], &mut self.az[..]];
+        match n {
+            0 => {}
+            1 => out.into_iter().for_each(|a| a[0] = 0.0),
+            2 => small::<2>(indices, pos, mass, eps2, out),
+            3 => small::<3>(indices, pos, mass, eps2, out),
+            4 => small::<4>(indices, pos, mass, eps2, out),
+            5 => small::<5>(indices, pos, mass, eps2, out),
+            6 => small::<6>(indices, pos, mass, eps2, out),
+            7 => small::<7>(indices, pos, mass, eps2, out),
+            _ => small::<LANES>(indices, pos, mass, eps2, out),
         }
         // The kernel's buffers are sized again by its next `load`.
         self.bounds.clear();
+    }
+}
+
+/// [`Pairs::sum_small`] for `N` bodies: every array a fixed size, so the
+/// loops unroll and the lanes no pair writes (the row's own and those
+/// before it, and padding) are constants. Those lanes hold −0 and a pair's
+/// lane its term as it is, where the kernel's hold +0 and `+0 + term`:
+/// `x + (−0) = x` for every `x`, so the compiler drops those additions,
+/// and the two trees differ at most in the sign of a zero (a sum is
+/// changed by a ±0 operand only when it is itself zero), which the final
+/// `+ 0.0` makes the kernel's +0.
+#[inline(always)]
+fn small<const N: usize>(
+    indices: &[u32],
+    pos: &[DVec3],
+    mass: &[f64],
+    eps2: f64,
+    [ax, ay, az]: [&mut [f64]; 3],
+) {
+    let (mut p, mut m) = ([DVec3::ZERO; N], [0.0f64; N]);
+    for q in 0..N {
+        let i = indices[q] as usize;
+        (p[q], m[q]) = (pos[i], mass[i]);
+    }
+    // Row k's lanes, and the reactions on each body (rows before it, in
+    // row order, from +0 as in the kernel).
+    let mut lanes = [[[-0.0f64; LANES]; 3]; N];
+    let mut react = [[0.0f64; 3]; N];
+    for k in 0..N {
+        for q in k + 1..N {
+            let (dx, dy, dz) = (p[q].x - p[k].x, p[q].y - p[k].y, p[q].z - p[k].z);
+            let r2 = dx * dx + dy * dy + dz * dz + eps2;
+            // (Not `r2 <= 0.0`: a NaN pulls nowhere too, as in the kernel.)
+            if r2.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let inv = 1.0 / (r2 * r2.sqrt());
+            let (wj, wi) = (m[q] * inv, m[k] * inv);
+            lanes[k][0][q] = dx * wj;
+            lanes[k][1][q] = dy * wj;
+            lanes[k][2][q] = dz * wj;
+            react[q][0] -= dx * wi;
+            react[q][1] -= dy * wi;
+            react[q][2] -= dz * wi;
+        }
+    }
+    for k in 0..N {
+        for (c, out) in [&mut *ax, &mut *ay, &mut *az].into_iter().enumerate() {
+            let own = tree(&lanes[k][c]) + 0.0;
+            // The reactions of the rows before it (none for the first).
+            out[k] = if k > 0 { own + react[k][c] } else { own };
+        }
     }
 }
 
