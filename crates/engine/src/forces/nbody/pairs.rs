@@ -166,6 +166,7 @@ impl Pairs {
     /// [`LANES`] has its own code (`small::<N>`).
     pub fn sum_small(&mut self, indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) {
         let n = indices.len();
+        const { assert!(LANES == 8, "one arm of `sum_small` a size") };
         for v in [&mut self.ax, &mut self.ay, &mut self.az] {
             if v.len() != n {
                 v.clear();
@@ -182,7 +183,13 @@ impl Pairs {
             5 => small::<5>(indices, pos, mass, eps2, out),
             6 => small::<6>(indices, pos, mass, eps2, out),
             7 => small::<7>(indices, pos, mass, eps2, out),
-            _ => small::<LANES>(indices, pos, mass, eps2, out),
+            8 => small::<8>(indices, pos, mass, eps2, out),
+            // More than a block of lanes: the kernel (the same bits).
+            _ => {
+                self.load(indices, pos, mass);
+                self.sum(eps2);
+                return;
+            }
         }
         // The kernel's buffers are sized again by its next `load`.
         self.bounds.clear();
@@ -583,10 +590,11 @@ mod tests {
             .map(|i| DVec3::new(all.x[i], all.y[i], all.z[i]))
             .collect();
         let mass = all.m[..203].to_vec();
-        for n in 2..=LANES {
+        // (LANES + 1 bodies too: handed on to the kernel's code.)
+        for n in 2..=LANES + 1 {
             for eps2 in [0.0, 1e-4] {
                 // Out of order; 100 and 7 share a place.
-                let idx = [100u32, 7, 50, 3, 150, 20, 199, 60][..n].to_vec();
+                let idx = [100u32, 7, 50, 3, 150, 20, 199, 60, 11][..n].to_vec();
                 let mut kernel = Pairs::default();
                 kernel.load(&idx, &pos, &mass);
                 kernel.sum_on(eps2, Width::Base);
