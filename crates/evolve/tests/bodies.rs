@@ -46,21 +46,25 @@ time_weight = 0.0
 "#;
 
 fn config(text: &str, generations: u64) -> Config {
-    let spec = ProblemSpec {
-        file: "bodies.toml".into(),
-        text: text.into(),
-    };
-    let choices = Choices {
-        generations: Some(generations),
-        population: Some(8),
-        seed: Some(5),
-        ..Choices::default()
-    };
-    Config::new(spec, &choices).unwrap()
+    searched(text, generations, None)
 }
 
 /// [`config`] searched by MAP-Elites.
 fn map_elites(text: &str, generations: u64) -> Config {
+    searched(
+        text,
+        generations,
+        Some(animats_evolve::OptimiserKind::MapElites),
+    )
+}
+
+/// `text` run for `generations` of 8 bodies from seed 5, by `optimiser`
+/// (the scene's own when `None`).
+fn searched(
+    text: &str,
+    generations: u64,
+    optimiser: Option<animats_evolve::OptimiserKind>,
+) -> Config {
     let spec = ProblemSpec {
         file: "bodies.toml".into(),
         text: text.into(),
@@ -69,7 +73,7 @@ fn map_elites(text: &str, generations: u64) -> Config {
         generations: Some(generations),
         population: Some(8),
         seed: Some(5),
-        optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+        optimiser,
         ..Choices::default()
     };
     Config::new(spec, &choices).unwrap()
