@@ -48,6 +48,12 @@ function serve(args = ['view', resolve(root, 'scenes/seaworld.toml'), '--port', 
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+// How long a command (pause, resume, food) may take to show in the frames:
+// on a busy machine the page's software WebGL holds its main thread and the
+// frames already sent wait behind it (CI saw 71.5 frames a second arrive,
+// a backlog draining, and the paused frame later than 5 s).
+const answered = 20000;
+
 /** Luminance variance and distinct colours of the page's 3-D canvas. */
 function canvasStats(page) {
   return page.evaluate(() => {
@@ -105,14 +111,14 @@ try {
 
   // Pause stops simulated time; resume continues it.
   await page.click('#pause');
-  await page.waitForFunction(() => window.__viewer.frame.paused, null, { timeout: 5000 });
+  await page.waitForFunction(() => window.__viewer.frame.paused, null, { timeout: answered });
   const t1 = await v(() => window.__viewer.frame.t);
   await sleep(1000);
   const t2 = await v(() => window.__viewer.frame.t);
   const shown = await v(() => document.getElementById('stats').innerText);
   check(t1 === t2 && shown.includes('paused'), 'pausing stops simulated time', `t ${t1} then ${t2} a second later`);
   await page.click('#pause');
-  await page.waitForFunction(() => !window.__viewer.frame.paused, null, { timeout: 5000 });
+  await page.waitForFunction(() => !window.__viewer.frame.paused, null, { timeout: answered });
   const resumed = await v(() => [window.__viewer.frame.t, performance.now()]);
   await sleep(1000);
   const later = await v(() => [window.__viewer.frame.t, performance.now()]);
@@ -158,7 +164,7 @@ try {
     const { scene, frame } = window.__viewer;
     const i = scene.food;
     return Math.hypot(frame.p[3 * i] - x, frame.p[3 * i + 2] - z) < 0.02;
-  }, target, { timeout: 5000 }).catch(() => {});
+  }, target, { timeout: answered }).catch(() => {});
   const food = await v(() => { const { scene, frame } = window.__viewer; const i = scene.food; return [frame.p[3 * i], frame.p[3 * i + 1], frame.p[3 * i + 2]]; });
   check(Math.hypot(food[0] - target.x, food[2] - target.z) < 0.02, 'clicking the floor moves the food there',
     `clicked (${target.x}, ${target.z}) at pixel (${spot.x.toFixed(0)}, ${spot.y.toFixed(0)}); food at (${food.map((c) => c.toFixed(3)).join(', ')})`);
