@@ -1,4 +1,4 @@
-//! `animats render SCENE --seconds S --out FILE`: headless pictures of a
+//! `animats render SCENE [--seconds S] --out FILE`: headless pictures of a
 //! scene with the software renderer: the last frame or a frame sheet as
 //! PNG, an animated GIF, or an MP4 through ffmpeg.
 
@@ -87,9 +87,11 @@ pub struct Args {
     /// one farthest from those taken.
     #[arg(long, requires = "zoo", value_delimiter = ',')]
     elite: Option<Vec<u64>>,
-    /// Simulated seconds to render.
+    /// Simulated seconds to render; without it, the scene's evaluation
+    /// (its `[evolve] duration`, or else its `[world] duration`; with
+    /// --zoo, the run's).
     #[arg(long, value_parser = positive_f64)]
-    seconds: f64,
+    seconds: Option<f64>,
     /// The picture: .png (the last frame, or a sheet with --sheet), .gif
     /// (animated), or .mp4 (needs ffmpeg).
     #[arg(long, short)]
@@ -141,6 +143,12 @@ enum Format {
     Png,
     Gif,
     Mp4,
+}
+
+/// How long to render `scene` without `--seconds`: what its fitness is
+/// measured over, or else its run's length.
+fn scene_seconds(scene: &animats_scene::Scene) -> f64 {
+    scene.evolve.as_ref().map_or(scene.duration, |e| e.duration)
 }
 
 /// Simulated instants of the frames.
@@ -482,9 +490,10 @@ pub fn run(args: Args) -> Result<(), Failure> {
         return zoo(&args);
     }
     let format = format_of(&args)?;
-    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
     let mut stage = SceneStage::following(args.scene.clone(), args.follow.as_deref())
         .map_err(Failure::Input)?;
+    let seconds = args.seconds.unwrap_or_else(|| scene_seconds(stage.scene()));
+    let times = frame_times(seconds, format, args.fps, args.sheet)?;
     crate::warn(&args.scene, stage.warnings());
     let describe = stage.describe();
     let drawing = &describe.drawing;
@@ -531,7 +540,6 @@ pub fn run(args: Args) -> Result<(), Failure> {
 /// every frame.
 fn zoo(args: &Args) -> Result<(), Failure> {
     let format = format_of(args)?;
-    let times = frame_times(args.seconds, format, args.fps, args.sheet)?;
     let count = args
         .elite
         .as_ref()
@@ -620,6 +628,24 @@ fn zoo(args: &Args) -> Result<(), Failure> {
         at_rank.sort_by(|a, b| b.3.total_cmp(&a.3));
         bodies.extend(at_rank.into_iter().take(count - bodies.len()));
     }
+    // Without --seconds, as long as the best body's evaluation.
+    let seconds = match (args.seconds, bodies.first()) {
+        (Some(s), _) => s,
+        (None, Some((run, problem, genome, ..))) => {
+            let text = problem.scene_toml(genome, "").map_err(Failure::Other)?;
+            let name = run.join("best.toml").display().to_string();
+            let scene =
+                animats_scene::parse(&text, &name).map_err(|e| Failure::Other(e.to_string()))?;
+            scene_seconds(&scene)
+        }
+        (None, None) => {
+            return Err(Failure::Input(format!(
+                "{}: the run holds no bodies to show",
+                args.scene.display()
+            )))
+        }
+    };
+    let times = frame_times(seconds, format, args.fps, args.sheet)?;
     let several = dirs.len() > 1;
     let dir = &args.scene;
     let start = Instant::now();
@@ -682,7 +708,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
     write(args, format, &frames)?;
     let size = std::fs::metadata(&args.out).map_or(0, |m| m.len());
     say!(
-        "{}{}: {} {}, {} frame{} of {w}x{h} rendered in {:.2} s; wrote {} ({size} bytes)",
+        "{}{}: {} {}, {} frame{} of {w}x{h} rendered in {:.2} s, to t = {:.2} s; wrote {} ({size} bytes)",
         dir.display(),
         if several {
             format!(" and {} more runs", dirs.len() - 1)
@@ -694,6 +720,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
         frames.len(),
         if frames.len() == 1 { "" } else { "s" },
         start.elapsed().as_secs_f64(),
+        times.last().copied().unwrap_or(0.0),
         args.out.display()
     );
     for (k, (run, _, _, fitness, lane)) in bodies.iter().enumerate() {

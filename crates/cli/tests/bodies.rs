@@ -261,6 +261,25 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         listing.contains("(lane 0)") && listing.contains("(lane 1)"),
         "{listing}"
     );
+    // The issue's own command line, no --seconds: as long as the bodies'
+    // evaluation (SMALL's [evolve] duration, 1 s).
+    let z = animats(&[
+        "render",
+        lanes.to_str().unwrap(),
+        "--zoo",
+        "--width",
+        "120",
+        "--height",
+        "90",
+        "--out",
+        dir.join("zoo4.png").to_str().unwrap(),
+    ]);
+    let (listing, err) = text(&z);
+    assert!(z.status.success(), "{err}");
+    assert!(
+        listing.contains(" 1 frame of ") && listing.contains("to t = 1.00 s"),
+        "{listing}"
+    );
     // A controller's run has no bodies to show.
     let o = animats(&[
         "render",

@@ -165,6 +165,30 @@ fn the_same_scene_renders_the_same_bytes() {
     assert_eq!(frames, 6, "t = 0, 0.2, ... 1.0 s at 5 frames a second");
 }
 
+/// Without `--seconds`, a render lasts the scene's run: its `[world]
+/// duration` (4 s for the bouncing ball; `[evolve] duration` comes first,
+/// tested with the zoo in `bodies.rs`).
+#[test]
+fn without_seconds_a_render_lasts_the_scene_s_duration() {
+    let dir = scratch("render-duration");
+    let out = dir.join("ball.png");
+    let said = run_ok(&[
+        "render",
+        "scenes/bouncing_ball.toml",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        said.contains("1 frame of 64x48") && said.contains("to t = 4.00 s"),
+        "{said}"
+    );
+    assert_eq!(decode_png(&out).width, 64);
+}
+
 #[test]
 fn a_sheet_tiles_the_frames() {
     let dir = scratch("render-sheet");

@@ -451,7 +451,10 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
             "max_particles = 4\nmax_springs = 7",
             "morphology.max_springs",
         ),
-        ("stiffness = [800.0, 50.0]", "morphology.stiffness"),
+        (
+            "stiffness = [800.0, 50.0]",
+            "morphology.stiffness: must be [lo, hi] with 0 < lo <= hi, got [800, 50]",
+        ),
         ("encoding = \"voxels\"", "voxels"),
         (
             "encoding = \"lattice\"\ncells = [101, 100, 1]",
@@ -468,6 +471,9 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
         ("cells = [2, 2, 2]", "morphology.cells"),
         ("start = \"nowhere.toml\"", "morphology.start"),
         ("size = 0.01", "morphology.size"),
+        // (Far past a kilometre its built lengths overflowed: the error
+        // named a spring of the developed text.)
+        ("size = 1e300", "morphology.size: must be at most 1000 m"),
         ("wings = 2", "wings"),
     ];
     for (key, expect) in cases {

@@ -180,6 +180,10 @@ fn default_restitution() -> f64 {
 /// The most cells a lattice may have.
 pub const MAX_CELLS: usize = 10_000;
 
+/// The largest `size`, m: a body within a cube of a kilometre (far past
+/// it, its built lengths overflow).
+pub const MAX_SIZE: f64 = 1000.0;
+
 /// The most particles any body may have (a cap past this is refused).
 pub const MAX_BODY_PARTICLES: usize = 10_000;
 
@@ -238,9 +242,16 @@ impl Morphology {
         let range = |field: &str, r: [f64; 2], least: f64| -> Result<(f64, f64), SceneError> {
             let (lo, hi) = (at.finite(field, r[0])?, at.finite(field, r[1])?);
             if lo < least || lo > hi {
+                // (The least positive number reads as "0 <", not as its
+                // 300 decimal places.)
+                let floor = if least == f64::MIN_POSITIVE {
+                    "0 < lo".to_string()
+                } else {
+                    format!("{least} <= lo")
+                };
                 return Err(at.err(
                     field,
-                    format!("must be [lo, hi] with {least} <= lo <= hi, got [{lo}, {hi}]"),
+                    format!("must be [lo, hi] with {floor} <= hi, got [{lo}, {hi}]"),
                 ));
             }
             Ok((lo, hi))
@@ -292,6 +303,9 @@ impl Morphology {
             return Err(at.err("muscle_strain", format!("must be below 0.9, got {strain}")));
         }
         let size = at.positive("size", e.size)?;
+        if size > MAX_SIZE {
+            return Err(at.err("size", format!("must be at most {MAX_SIZE} m, got {size}")));
+        }
         if size < 4.0 * radius.0 {
             return Err(at.err(
                 "size",
