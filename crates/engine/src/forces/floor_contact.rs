@@ -165,11 +165,15 @@ impl FloorContact {
             return self.apply_all(ctx, forces);
         }
         let flat = self.terrain.is_flat();
+        // (A loop for each ground, not a test of it for each particle: the
+        // flat floor's loop is the commonest, and tight.)
         crate::parallel::by_pieces(true, [forces], |first, [piece]| {
-            for (k, f) in piece.iter_mut().enumerate() {
-                if flat {
+            if flat {
+                for (k, f) in piece.iter_mut().enumerate() {
                     self.contact(ctx, first + k, f);
-                } else {
+                }
+            } else {
+                for (k, f) in piece.iter_mut().enumerate() {
                     self.on_terrain(ctx, first + k, f);
                 }
             }
