@@ -594,7 +594,7 @@ fn zoo(args: &Args) -> Result<(), Failure> {
         }
         let bodies = state.best_bodies(usize::MAX).ok_or_else(|| {
             Failure::Input(format!(
-                "{}: --zoo shows the bodies of a [morphology] run; this run evolved a controller",
+                "{}: --zoo shows the bodies of a [morphology] run or the elites of a quality-diversity run (map-elites, cma-me); this run evolved one controller a lane",
                 dir.display()
             ))
         })?;
