@@ -90,7 +90,9 @@ pub struct Args {
     /// Simulated seconds to render; without it, the scene's evaluation
     /// (its `[evolve] duration`, or else its `[world] duration`; with
     /// --zoo, the run's).
-    #[arg(long, value_parser = positive_f64)]
+    // (Negative numbers are values, so that `--seconds -1` is refused as a
+    // bad --seconds, not as an unknown flag.)
+    #[arg(long, value_parser = positive_f64, allow_negative_numbers = true)]
     seconds: Option<f64>,
     /// The picture: .png (the last frame, or a sheet with --sheet), .gif
     /// (animated), or .mp4 (needs ffmpeg).
