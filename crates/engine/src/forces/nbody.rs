@@ -88,13 +88,8 @@ impl Force for NBodyGravity {
         let s = &mut self.scratch;
         // A set that fills no more than one block of lanes is summed
         // straight from the particles (the same bits, none of the
-        // kernel's copying and padding).
-        if self.indices.len() <= pairs::LANES {
-            s.sum_small(&self.indices, pos, mass, eps2);
-        } else {
-            s.load(&self.indices, pos, mass);
-            s.sum(eps2);
-        }
+        // kernel's copying and padding); a larger one by the kernel.
+        s.sum_small(&self.indices, pos, mass, eps2);
         for (k, &i) in self.indices.iter().enumerate() {
             let i = i as usize;
             let a = DVec3::new(s.ax[k], s.ay[k], s.az[k]);

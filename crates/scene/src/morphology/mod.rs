@@ -239,26 +239,21 @@ impl Morphology {
     /// Checks every key, naming the field.
     pub(crate) fn from_entry(at: &At, e: &MorphologyEntry) -> Result<Morphology, SceneError> {
         let neural = e.controller == BrainName::Neural;
-        let range = |field: &str, r: [f64; 2], least: f64| -> Result<(f64, f64), SceneError> {
+        // A range of positive numbers (not subnormal: a reciprocal of one
+        // is infinite).
+        let range = |field: &str, r: [f64; 2]| -> Result<(f64, f64), SceneError> {
             let (lo, hi) = (at.finite(field, r[0])?, at.finite(field, r[1])?);
-            if lo < least || lo > hi {
-                // (The least positive number reads as "0 <", not as its
-                // 300 decimal places.)
-                let floor = if least == f64::MIN_POSITIVE {
-                    "0 < lo".to_string()
-                } else {
-                    format!("{least} <= lo")
-                };
+            if lo < f64::MIN_POSITIVE || lo > hi {
                 return Err(at.err(
                     field,
-                    format!("must be [lo, hi] with {floor} <= hi, got [{lo}, {hi}]"),
+                    format!("must be [lo, hi] with 0 < lo <= hi, got [{lo}, {hi}]"),
                 ));
             }
             Ok((lo, hi))
         };
-        let stiffness = range("stiffness", e.stiffness, f64::MIN_POSITIVE)?;
-        let mass = range("mass", e.mass, f64::MIN_POSITIVE)?;
-        let radius = range("radius", e.radius, f64::MIN_POSITIVE)?;
+        let stiffness = range("stiffness", e.stiffness)?;
+        let mass = range("mass", e.mass)?;
+        let radius = range("radius", e.radius)?;
         let total_mass = at.positive("total_mass", e.total_mass)?;
         if total_mass < 2.0 * mass.0 {
             return Err(at.err(

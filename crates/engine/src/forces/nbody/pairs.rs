@@ -163,7 +163,8 @@ impl Pairs {
     /// padding, two at one place unsoftened), whose terms (±0) leave an
     /// accumulator as it was, since one never holds −0 (it starts at +0,
     /// and a sum that cancels to zero is +0). Each size from 2 to
-    /// [`LANES`] has its own code (`small::<N>`).
+    /// [`LANES`] has its own code (`small::<N>`); a larger set is loaded
+    /// and summed by the kernel.
     pub fn sum_small(&mut self, indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) {
         let n = indices.len();
         const { assert!(LANES == 8, "one arm of `sum_small` a size") };
