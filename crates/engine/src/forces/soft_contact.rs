@@ -156,13 +156,26 @@ impl SoftContact {
 
 impl SoftContact {
     /// The force of pair `(a, b)` on both, if they overlap.
-    #[inline]
+    ///
+    /// Most pairs are apart: a pair with `d² > s²` (both rounded) returns
+    /// before the square root. That skips only pairs the full test skips:
+    /// `s²` rounded to nearest has no float between it and the exact `s²`,
+    /// so `d² > fl(s²)` means `d² ≥ s²`, `√d² ≥ s`, and `s − |d|` rounds
+    /// to ≤ 0 (a NaN or an overflowed `s²` fails the test), so every bit
+    /// is as without it.
+    #[inline(always)]
     fn pair(&self, (a, b): (u32, u32), ctx: &ForceContext, forces: &mut [DVec3]) {
         let r = &ctx.particles.radius;
         let (a, b) = (a as usize, b as usize);
         let d = ctx.pos[b] - ctx.pos[a];
-        let dist = d.length();
-        let overlap = r[a] + r[b] - dist;
+        let reach = r[a] + r[b];
+        // (glam's `length` is `dot(self, self).sqrt()`: the same d².)
+        let d2 = d.dot(d);
+        if d2 > reach * reach {
+            return;
+        }
+        let dist = d2.sqrt();
+        let overlap = reach - dist;
         if overlap <= 0.0 || dist <= 0.0 {
             return;
         }
@@ -268,5 +281,110 @@ impl Force for SoftContact {
 
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::particle::Properties;
+
+    /// The pair's force as written before the early return: every pair's
+    /// square root taken.
+    fn reference(k: f64, c: f64, r: [f64; 2], pos: [DVec3; 2], vel: [DVec3; 2]) -> [DVec3; 2] {
+        let d = pos[1] - pos[0];
+        let dist = d.length();
+        let overlap = r[0] + r[1] - dist;
+        if overlap <= 0.0 || dist <= 0.0 {
+            return [DVec3::ZERO; 2];
+        }
+        let n = d / dist;
+        let push = (k * overlap - c * (vel[1] - vel[0]).dot(n)).max(0.0);
+        [DVec3::ZERO - n * push, DVec3::ZERO + n * push]
+    }
+
+    fn bits(v: [DVec3; 2]) -> [u64; 6] {
+        [v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z].map(f64::to_bits)
+    }
+
+    /// Spheres at, just inside and just outside touching (a few ulps and a
+    /// few millionths either way), far apart, at one place, tiny (squares
+    /// below the normal floats) and huge radii, and a NaN: the same force
+    /// bits as the reference, and many pairs of each kind (touching or not)
+    /// among them. A bound one ulp lower (`>=`) fails it.
+    #[test]
+    fn skipping_the_square_root_of_pairs_apart_changes_no_bit() {
+        let contact = SoftContact {
+            stiffness: 3000.0,
+            damping: 4.0,
+            pairs: vec![(0, 1)],
+            sweep: None,
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (mut touching, mut apart) = (0, 0);
+        for case in 0..200_000 {
+            let scale = [1e-3, 1.0, 1e3, 1e-150, 1e150, 2e-161][case % 6];
+            let r = [scale * (0.01 + uniform()), scale * (0.01 + uniform())];
+            let dir = DVec3::new(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5).normalize();
+            let mut dist = (r[0] + r[1])
+                * match case % 4 {
+                    0 => 1.0 + (uniform() - 0.5) * 4e-6,
+                    1 => 1.0 + (uniform() - 0.5) * 1e-14,
+                    2 => 3.0 * uniform(),
+                    _ => 1.0,
+                };
+            if case % 7 == 0 {
+                // Step the distance by ulps across the bound.
+                let ulps = (uniform() * 64.0) as i64 - 32;
+                dist = f64::from_bits((dist.to_bits() as i64 + ulps) as u64);
+            }
+            let p0 = DVec3::new(uniform(), uniform(), uniform()) * scale;
+            let mut pos = [p0, p0 + dir * dist];
+            if case % 1000 == 3 {
+                pos[1] = pos[0];
+            }
+            if case % 1000 == 5 {
+                pos[1].y = f64::NAN;
+            }
+            let vel = [
+                DVec3::new(uniform(), -uniform(), 0.5),
+                DVec3::new(-uniform(), 0.0, uniform()),
+            ];
+            let particles = Properties {
+                radius: r.to_vec(),
+                ..Properties::default()
+            };
+            let ctx = ForceContext {
+                t: 0.0,
+                dt: 1e-3,
+                pos: &pos,
+                vel: &vel,
+                particles: &particles,
+                gravity: DVec3::ZERO,
+            };
+            let mut forces = [DVec3::ZERO; 2];
+            contact.pair((0, 1), &ctx, &mut forces);
+            let want = reference(3000.0, 4.0, r, pos, vel);
+            assert_eq!(
+                bits(forces),
+                bits(want),
+                "case {case}: r {r:?}, pos {pos:?}"
+            );
+            if want[0] != DVec3::ZERO {
+                touching += 1;
+            } else {
+                apart += 1;
+            }
+        }
+        assert!(
+            touching > 30_000 && apart > 30_000,
+            "{touching} touching, {apart} apart"
+        );
     }
 }
