@@ -397,3 +397,38 @@ fn a_level_slope_is_the_flat_floor() {
     // It bounced, slid and stopped.
     assert!(flat.1.length() < 1e-12 && flat.0.x > 0.1);
 }
+
+/// The `feet` measure's count: the moving spheres within a tolerance of
+/// the ground, on the flat floor (its own loop) and on a slope (each
+/// particle's clearance), by the geometry. A fixed sphere on the ground
+/// is no foot.
+#[test]
+fn the_spheres_on_the_ground_are_counted_by_their_clearance() {
+    let r = 0.05;
+    // Heights of the spheres' lowest points above the ground.
+    let gaps = [-0.01, 0.0, 0.004, 0.0099, 0.0101, 0.02, 0.5];
+    for (terrain, degrees) in [(Terrain::Flat, 0.0), (slope(20.0), 20.0)] {
+        let mut w = world_on(terrain, IntegratorKind::Symplectic);
+        let (n, _) = frame(degrees);
+        for (k, &gap) in gaps.iter().enumerate() {
+            // Along the normal from a point of the ground (the slope passes
+            // through the origin), spread across it.
+            let across = DVec3::new(0.3 * k as f64, 0.0, -0.2 * k as f64);
+            let on = across - n * n.dot(across);
+            let on = if degrees == 0.0 { across } else { on };
+            w.add_particle(ParticleDef::new(0.1).with_radius(r).at(on + n * (r + gap)))
+                .unwrap();
+        }
+        let fixed = w
+            .add_particle(ParticleDef::new(0.1).with_radius(r).at(n * r).fixed())
+            .unwrap();
+        assert!(w.clearance(fixed).abs() < 1e-12);
+        for (tolerance, want) in [(0.01, 4), (0.002, 2), (0.03, 6), (-0.02, 0)] {
+            assert_eq!(
+                w.count_on_ground(tolerance),
+                want,
+                "{degrees}°, tolerance {tolerance}"
+            );
+        }
+    }
+}

@@ -575,13 +575,7 @@ impl<'a> Recorder<'a> {
         for (m, sum) in self.measures.iter().zip(&mut self.sums) {
             match m {
                 Measure::ContactFraction(p) if on_floor(*p) => *sum += 1.0,
-                Measure::Feet => {
-                    let inv = &world.particles().inv_mass;
-                    *sum += world
-                        .particle_ids()
-                        .filter(|p| inv[p.index()] > 0.0 && on_floor(*p))
-                        .count() as f64;
-                }
+                Measure::Feet => *sum += world.count_on_ground(self.tolerance) as f64,
                 Measure::MeanHeight(ids) => *sum += centre(world, ids).y,
                 _ => {}
             }

@@ -453,6 +453,26 @@ impl World {
         self.clearance_searched(p)
     }
 
+    /// How many particles that move (a positive inverse mass) have a
+    /// [`World::clearance`] of at most `tolerance`: the `feet` measure, each
+    /// step. One loop over the arrays on a flat floor.
+    pub fn count_on_ground(&self, tolerance: f64) -> usize {
+        let (pos, props) = (&self.state().pos, self.particles());
+        if let Some(f) = &self.forces.floor {
+            if f.terrain.is_flat() {
+                return pos
+                    .iter()
+                    .zip(&props.radius)
+                    .zip(&props.inv_mass)
+                    .filter(|((x, &r), &inv)| inv > 0.0 && x.y - r <= tolerance)
+                    .count();
+            }
+        }
+        self.particle_ids()
+            .filter(|&p| props.inv_mass[p.index()] > 0.0 && self.clearance(p) <= tolerance)
+            .count()
+    }
+
     /// [`World::clearance`] from the floor's collision event.
     #[inline(never)]
     fn clearance_searched(&self, p: ParticleId) -> f64 {
