@@ -332,8 +332,15 @@ AN_FN void an_soft_contact(const an_batch *b, an_state st, long long q0, long lo
         for (int k = 0; k < 3; k++) {
             d[k] = x[3 * e + k] - x[3 * a + k];
         }
-        double dist = sqrt(an_dot(d, d));
-        double overlap = st.r[a] + st.r[e] - dist;
+        /* A pair apart returns before the square root, as the engine's:
+         * d^2 > fl(s^2) means d^2 >= s^2 exactly (no double lies between
+         * fl(s^2) and s^2), so the same pairs are skipped, to the bit. */
+        double d2 = an_dot(d, d), reach = st.r[a] + st.r[e];
+        if (d2 > reach * reach) {
+            continue;
+        }
+        double dist = sqrt(d2);
+        double overlap = reach - dist;
         if (overlap <= 0.0 || dist <= 0.0) {
             continue;
         }
