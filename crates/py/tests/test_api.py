@@ -219,3 +219,12 @@ def test_python_m_animats_evolve_writes_the_command_lines_files(cli, crawler, tm
     bad = subprocess.run([sys.executable, "-m", "animats.evolve", str(tmp_path / "none.toml")],
                          capture_output=True, text=True)
     assert bad.returncode == 1 and "none.toml" in bad.stderr
+    # --device: the CPU's files again, or (no GPU here) what is missing.
+    r = subprocess.run([sys.executable, "-m", "animats.evolve", str(crawler), *args, "--device", "cuda",
+                        "--out", str(tmp_path / "gpu")], capture_output=True, text=True)
+    if r.returncode == 0:
+        for f in ("log.csv", "best.toml"):
+            assert (tmp_path / "gpu" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes()
+    else:
+        assert r.returncode == 1 and 'device="cuda"' in r.stderr, r.stderr
+        assert not (tmp_path / "gpu" / "log.csv").exists()

@@ -16,7 +16,9 @@ from animats import distributed  # noqa: E402
 
 @pytest.fixture(scope="module")
 def cluster():
-    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    # One GPU declared (Ray takes the count as given): GPU actors get
+    # scheduled here, and find no driver unless this machine has one.
+    ray.init(num_cpus=2, num_gpus=1, include_dashboard=False, log_to_driver=False)
     yield
     ray.shutdown()
 
@@ -58,6 +60,41 @@ def test_a_worker_killed_mid_generation_costs_time_not_results(cluster, cli, tmp
 def test_more_actors_than_cpus_are_refused_not_left_waiting(cluster):
     with pytest.raises(ValueError, match="CPUs"):
         distributed.Pool("roobot", actors=3)
+
+
+def _gpu_here() -> bool:
+    try:
+        animats.Evaluator("roobot", device="cuda")
+        return True
+    except RuntimeError:
+        return False
+
+
+def test_gpu_actors_need_a_gpu_each_and_a_known_device(cluster):
+    with pytest.raises(ValueError, match="2 GPUs .* has 1"):
+        distributed.Pool("roobot", actors=2, device="cuda")
+    with pytest.raises(ValueError, match='device=.gpu.: "cpu"'):
+        distributed.Pool("roobot", actors=1, device="gpu")
+
+
+def test_a_gpu_actor_says_what_it_lacks_or_gives_the_cpu_s_bits(cluster, crawler):
+    """On the GPU an actor evaluates as the engine does, to the bit; where
+    its node has no usable GPU, making the pool says what is missing (it
+    does not hang, and no evaluation is attempted)."""
+    if not _gpu_here():
+        with pytest.raises(RuntimeError, match="1 of 1 actors cannot evaluate; actor 0: device=.cuda.: .*(driver|device|NVRTC)"):
+            distributed.Pool(str(crawler), actors=1, device="cuda")
+        return
+    scene = animats.load(crawler)
+    b = scene.bounds()
+    g = b[:, 0] + (b[:, 1] - b[:, 0]) * np.random.default_rng(5).random((12, len(b)))
+    pool = distributed.Pool(scene, actors=1, device="cuda")
+    try:
+        assert pool.chunks == 1
+        got = pool.evaluate(g)
+    finally:
+        pool.shutdown()
+    assert got.tolist() == animats.evaluate(scene, g).tolist()
 
 
 def test_a_pool_evaluates_as_evaluate_does(cluster, crawler):

@@ -33,18 +33,32 @@ from . import _animats
 __all__ = ["Pool", "Stats", "evolve"]
 
 
+#: The devices an actor may evaluate on (as ``animats.Evaluator``'s).
+DEVICES = ("cpu", "cuda", "cuda-fast")
+
+
 class _Worker:
     """A Ray actor's state: one evaluator, one thread (Ray gives each actor
-    one CPU; the parallelism is across actors)."""
+    one CPU, and one GPU on a GPU device; the parallelism is across
+    actors). An evaluator that cannot be made (no driver on this node) is
+    kept as its message, for the pool to report."""
 
-    def __init__(self, file: str, text: str) -> None:
+    def __init__(self, file: str, text: str, device: str = "cpu") -> None:
         scene = "roobot" if file == "roobot" and text == "" else _animats.parse(text, file)
-        self.evaluator = _animats.Evaluator(scene, threads=1)
+        self.evaluator = None
+        self.error: Optional[str] = None
+        try:
+            self.evaluator = _animats.Evaluator(scene, threads=1, device=device)
+        except (RuntimeError, ValueError) as e:
+            self.error = str(e)
 
-    def pid(self) -> int:
-        return os.getpid()
+    def ready(self) -> "tuple[int, Optional[str]]":
+        """This actor's process id, and why it cannot evaluate (or None)."""
+        return os.getpid(), self.error
 
     def outcomes(self, genomes: np.ndarray, screens: Optional[List[str]] = None) -> dict:
+        if self.evaluator is None:
+            raise RuntimeError(self.error)
         start = time.perf_counter()
         if isinstance(genomes, list):
             g = [np.ascontiguousarray(x, dtype=np.float64) for x in genomes]
@@ -88,7 +102,12 @@ def _lost_errors() -> tuple:
 class Pool:
     """``actors`` Ray actors evaluating one problem: ``scene`` is an
     ``animats.Scene``, a path or ``"roobot"``; or give ``problem_text`` as
-    ``Evolution.problem_text()`` returns it."""
+    ``Evolution.problem_text()`` returns it. ``device``: where each actor
+    evaluates, ``"cpu"`` (one core an actor) or ``"cuda"`` / ``"cuda-fast"``
+    (one GPU and one core an actor, as ``animats.Evaluator(...,
+    device=...)``). ``chunks``: shares per actor a generation (default 4 on
+    CPUs, which evaluations of different lengths keep evenly busy; 1 on
+    GPUs, which want each batch whole)."""
 
     def __init__(
         self,
@@ -97,12 +116,19 @@ class Pool:
         *,
         problem_text: Optional[tuple] = None,
         max_retries: int = 5,
-        chunks: int = 4,
+        chunks: Optional[int] = None,
+        device: str = "cpu",
     ) -> None:
         import ray
 
         if actors < 1:
             raise ValueError(f"actors must be at least 1, got {actors}")
+        if device not in DEVICES:
+            raise ValueError(
+                f'device={device!r}: "cpu" (the engine), "cuda" (an NVIDIA GPU: the same bits) '
+                'or "cuda-fast" (the GPU with fused multiply-adds)'
+            )
+        gpu = device != "cpu"
         if problem_text is None:
             problem_text = _problem_text(scene)
         file, text = problem_text
@@ -115,12 +141,24 @@ class Pool:
                 f"{actors} actors need {actors} CPUs (one each) but the Ray cluster has {cpus:g}: "
                 "they would wait forever; use fewer actors or add machines"
             )
+        gpus = ray.cluster_resources().get("GPU", 0)
+        if gpu and actors > gpus:
+            raise ValueError(
+                f"{actors} actors on device {device!r} need {actors} GPUs (one each) but the Ray "
+                f"cluster has {gpus:g}: they would wait forever; use fewer actors or add GPU machines"
+            )
         self.max_retries = max_retries
-        self.chunks = max(1, chunks)
+        self.chunks = max(1, chunks if chunks is not None else (1 if gpu else 4))
         self.stats = Stats()
-        remote = ray.remote(num_cpus=1, max_restarts=-1)(_Worker)
-        self.actors = [remote.remote(file, text) for _ in range(actors)]
-        self.stats.pids = ray.get([a.pid.remote() for a in self.actors])
+        remote = ray.remote(num_cpus=1, num_gpus=1 if gpu else 0, max_restarts=-1)(_Worker)
+        self.actors = [remote.remote(file, text, device) for _ in range(actors)]
+        ready = ray.get([a.ready.remote() for a in self.actors])
+        failed = [(k, error) for k, (_, error) in enumerate(ready) if error is not None]
+        if failed:
+            self.shutdown()
+            k, error = failed[0]
+            raise RuntimeError(f"{len(failed)} of {actors} actors cannot evaluate; actor {k}: {error}")
+        self.stats.pids = [pid for pid, _ in ready]
         self._next = 0
 
     def outcomes(
@@ -229,6 +267,7 @@ def evolve(
     population: Optional[int] = None,
     restarts: int = 0,
     actors: int = 2,
+    device: str = "cpu",
     address: Optional[str] = None,
     out: Optional[str] = None,
     on_generation: Optional[Callable[[int, Pool], None]] = None,
@@ -238,8 +277,10 @@ def evolve(
     actors; the same arguments and defaults, and the same ``log.csv`` and
     ``best.toml`` (written into ``out`` if given). ``address``: the cluster
     (``"auto"`` on a machine that ran ``ray start``); without it, Ray starts
-    a local one unless one is already initialised. ``on_generation(g,
-    pool)`` is called as generation ``g``'s shares are sent."""
+    a local one unless one is already initialised. ``device``: where the
+    actors evaluate (``Pool``'s; on ``"cuda"`` the same bytes again).
+    ``on_generation(g, pool)`` is called as generation ``g``'s shares are
+    sent."""
     import ray
 
     if not ray.is_initialized():
@@ -253,7 +294,7 @@ def evolve(
         population=population,
         restarts=restarts,
     )
-    pool = Pool(problem_text=run.problem_text(), actors=actors)
+    pool = Pool(problem_text=run.problem_text(), actors=actors, device=device)
     try:
         last = time.monotonic()
         while not run.done:

@@ -31,6 +31,12 @@ def main(argv: "list[str] | None" = None) -> int:
     p.add_argument("--ray", metavar="ADDRESS", help="run on a Ray cluster: `auto`, HOST:PORT, or `local`")
     p.add_argument("--actors", type=int, default=2, help="Ray actors (with --ray)")
     p.add_argument("--threads", type=int, help="threads (without --ray)")
+    p.add_argument(
+        "--device",
+        choices=("cpu", "cuda", "cuda-fast"),
+        default="cpu",
+        help="where evaluations run: cpu (default), cuda or cuda-fast (here, or one GPU a Ray actor)",
+    )
     a = p.parse_args(argv)
     start = time.perf_counter()
     # `animats evolve`'s arguments, the same here and on Ray.
@@ -44,7 +50,7 @@ def main(argv: "list[str] | None" = None) -> int:
     )
     try:
         if a.ray is None:
-            run = _animats.Evolution(a.scene, **run_args)
+            run = _animats.Evolution(a.scene, **run_args, device=a.device)
             run.run(threads=a.threads)
             run.save(a.out)
             how = "here"
@@ -55,6 +61,7 @@ def main(argv: "list[str] | None" = None) -> int:
                 a.scene,
                 **run_args,
                 actors=a.actors,
+                device=a.device,
                 address=None if a.ray == "local" else a.ray,
                 out=a.out,
                 progress=True,
