@@ -9,6 +9,7 @@ import sys
 import time
 
 from . import _animats
+from .distributed import DEVICES
 
 
 def main(argv: "list[str] | None" = None) -> int:
@@ -33,7 +34,7 @@ def main(argv: "list[str] | None" = None) -> int:
     p.add_argument("--threads", type=int, help="threads (without --ray)")
     p.add_argument(
         "--device",
-        choices=("cpu", "cuda", "cuda-fast"),
+        choices=DEVICES,
         default="cpu",
         help="where evaluations run: cpu (default), cuda or cuda-fast (here, or one GPU a Ray actor)",
     )
