@@ -28,6 +28,7 @@
 
 #![warn(missing_docs)]
 
+pub mod cpu;
 pub mod error;
 pub mod event;
 pub mod events;

@@ -82,6 +82,7 @@ pub(crate) fn on<T: Send>(pool: &Option<rayon::ThreadPool>, f: impl FnOnce() -> 
 fn _animats(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("SceneError", m.py().get_type::<SceneError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("CPU_FEATURES", animats_engine::cpu::required_features())?;
     use animats_creatures::roobot::{params::BOUNDS, HopParams};
     m.add("ROOBOT_INITIAL", HopParams::INITIAL.0.to_vec())?;
     m.add(

@@ -2,6 +2,7 @@
 evaluations (to the bit), the same evolution logs."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -228,3 +229,22 @@ def test_python_m_animats_evolve_writes_the_command_lines_files(cli, crawler, tm
     else:
         assert r.returncode == 1 and 'device="cuda"' in r.stderr, r.stderr
         assert not (tmp_path / "gpu" / "log.csv").exists()
+
+
+def test_a_cpu_without_the_build_s_instructions_is_refused_at_import():
+    """The build's CPU check runs when the module is loaded, before any of
+    its code: a CPU said to lack AVX2 (the tests' hook) stops the import
+    with exit status 2 and a message naming it."""
+    import subprocess
+    import sys
+
+    env = dict(os.environ, ANIMATS_TEST_CPU_LACKS="avx2")
+    r = subprocess.run([sys.executable, "-c", "import animats; print('imported')"],
+                       env=env, capture_output=True, text=True, timeout=60)
+    if "avx2" in animats._animats.CPU_FEATURES.split(","):
+        assert r.returncode == 2, r
+        assert r.stdout == ""
+        assert "(avx2)" in r.stderr and "target-cpu=native" in r.stderr, r.stderr
+    else:
+        # A baseline build (RUSTFLAGS="-C target-cpu=x86-64") needs nothing.
+        assert r.returncode == 0 and "imported" in r.stdout, r

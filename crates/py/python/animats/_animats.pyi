@@ -10,6 +10,12 @@ F64 = npt.NDArray[np.float64]
 SceneLike = Union["Scene", str, PathLike[str]]
 
 __version__: str
+#: The x86-64 extensions this build uses beyond the baseline, as rustc names
+#: them ("sse4.2,popcnt,avx,avx2,fma,bmi1,bmi2" for the workspace's
+#: x86-64-v3; "" for a baseline build): a CPU without them is refused at
+#: import, before any of the module's code runs (README, "Building for
+#: another CPU").
+CPU_FEATURES: str
 #: The compiled module's lists; ``animats.ROOBOT_INITIAL`` and
 #: ``animats.ROOBOT_BOUNDS`` are float64 arrays of them.
 ROOBOT_INITIAL: List[float]
