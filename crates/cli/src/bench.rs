@@ -44,7 +44,18 @@ fn machine() -> serde_json::Value {
         "os": std::env::consts::OS,
         "arch": std::env::consts::ARCH,
         "simd": animats_engine::simd_summary(),
+        "built_for": built_for(),
     })
+}
+
+/// The instruction sets the binary was compiled to use beyond its
+/// architecture's baseline (`avx2,fma,…` for the workspace's x86-64-v3),
+/// or `baseline`.
+fn built_for() -> &'static str {
+    match animats_engine::cpu::required_features() {
+        "" => "baseline",
+        f => f,
+    }
 }
 
 /// Today's UTC date, YYYY-MM-DD (civil from days since 1970, Hinnant's algorithm).
@@ -220,10 +231,11 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let (machine, date) = (machine(), today());
     if !args.json {
         say!(
-        "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}; vectors: {}",
+        "animats bench: f64, 1 thread unless noted; median [min–max] of {} runs after a warm-up{}; vectors: {}; built for: {}",
         opts.runs,
         if opts.quick { " (quick)" } else { "" },
-        animats_engine::simd_summary()
+        animats_engine::simd_summary(),
+        built_for()
     );
     }
     let mut failed = 0;

@@ -43,6 +43,17 @@ fn json_has_every_run_the_checks_the_machine_and_the_date() {
             simd.starts_with("arithmetic ") && simd.contains(", updates "),
             "{simd}"
         );
+        // The build's instruction sets, as the engine reports them.
+        let built = r["machine"]["built_for"].as_str().unwrap();
+        match animats_engine::cpu::required_features() {
+            "" => assert_eq!(built, "baseline"),
+            f => assert_eq!(built, f),
+        }
+        assert_eq!(
+            built.contains("avx2"),
+            cfg!(target_feature = "avx2"),
+            "{built}"
+        );
         let date = r["date"].as_str().unwrap();
         assert!(date.len() == 10 && date.starts_with("20"), "{date}");
     }
