@@ -15,25 +15,39 @@ fn main() {
     }
     let features = var("CARGO_CFG_TARGET_FEATURE");
     let features: Vec<&str> = features.split(',').collect();
-    // rustc's names beyond the x86-64 baseline that the check knows.
+    // rustc's names beyond the x86-64 baseline that the check knows, with
+    // `__builtin_cpu_supports`'s for each.
     let known = [
-        "sse4.2", "popcnt", "avx", "avx2", "fma", "bmi1", "bmi2", "avx512f",
+        ("sse4.2", "sse4.2"),
+        ("popcnt", "popcnt"),
+        ("avx", "avx"),
+        ("avx2", "avx2"),
+        ("fma", "fma"),
+        ("bmi1", "bmi"),
+        ("bmi2", "bmi2"),
+        ("avx512f", "avx512f"),
     ];
-    let needs: Vec<&str> = known.into_iter().filter(|f| features.contains(f)).collect();
-    println!("cargo:rustc-env=ANIMATS_CPU_NEEDS={}", needs.join(","));
+    let needs: Vec<(&str, &str)> = known
+        .into_iter()
+        .filter(|(rustc, _)| features.contains(rustc))
+        .collect();
+    let names: Vec<&str> = needs.iter().map(|(rustc, _)| *rustc).collect();
+    println!("cargo:rustc-env=ANIMATS_CPU_NEEDS={}", names.join(","));
     if needs.is_empty() {
         return;
     }
-    let mut c = cc::Build::new();
-    c.file("src/cpu_check.c")
+    // The C checks each in this order: `CHECK("avx") CHECK("avx2") …`.
+    let checks: Vec<String> = needs
+        .iter()
+        .map(|(_, gcc)| format!("CHECK(\"{gcc}\")"))
+        .collect();
+    cc::Build::new()
+        .file("src/cpu_check.c")
         // The check itself must run on any x86-64.
         .flag("-march=x86-64")
         .flag("-mtune=generic")
-        .opt_level(2);
-    for f in &needs {
-        let name = format!("ANIMATS_NEEDS_{}", f.replace('.', "_").to_uppercase());
-        c.define(&name, None);
-    }
-    c.compile("animats_cpu_check");
+        .opt_level(2)
+        .define("ANIMATS_CHECKS", checks.join(" ").as_str())
+        .compile("animats_cpu_check");
     println!("cargo:rustc-cfg=animats_cpu_check");
 }

@@ -7,10 +7,11 @@
  * Compiled by build.rs for the baseline x86-64 (no AVX), and run as a
  * constructor: it executes before Rust's `main` and before the Python
  * module's initialisation, whose code may use any of those instructions.
- * build.rs defines ANIMATS_NEEDS_<FEATURE> for each feature rustc was told
- * to use. ANIMATS_TEST_CPU_LACKS (a comma-separated list of those names)
- * makes it act as if this CPU lacked them: the tests' way to see the
- * refusal on a CPU that has everything. */
+ * build.rs defines ANIMATS_CHECKS as one CHECK("name") for each feature
+ * rustc was told to use, in GCC's names ("bmi" for rustc's "bmi1").
+ * ANIMATS_TEST_CPU_LACKS (a comma-separated list of those names) makes it
+ * act as if this CPU lacked them: the tests' way to see the refusal on a
+ * CPU that has everything. */
 
 #include <stdlib.h>
 #include <string.h>
@@ -44,7 +45,7 @@ static void lacks(const char *name) {
     strcat(missing, name);
 }
 
-/* __builtin_cpu_supports takes a string literal. */
+/* __builtin_cpu_supports takes a string literal: hence a macro. */
 #define CHECK(name)                                                          \
     if (!__builtin_cpu_supports(name) || pretends_to_lack(name)) {           \
         lacks(name);                                                         \
@@ -52,30 +53,7 @@ static void lacks(const char *name) {
 
 __attribute__((constructor)) void animats_cpu_check(void) {
     __builtin_cpu_init();
-#ifdef ANIMATS_NEEDS_SSE4_2
-    CHECK("sse4.2")
-#endif
-#ifdef ANIMATS_NEEDS_POPCNT
-    CHECK("popcnt")
-#endif
-#ifdef ANIMATS_NEEDS_AVX
-    CHECK("avx")
-#endif
-#ifdef ANIMATS_NEEDS_AVX2
-    CHECK("avx2")
-#endif
-#ifdef ANIMATS_NEEDS_FMA
-    CHECK("fma")
-#endif
-#ifdef ANIMATS_NEEDS_BMI1
-    CHECK("bmi")
-#endif
-#ifdef ANIMATS_NEEDS_BMI2
-    CHECK("bmi2")
-#endif
-#ifdef ANIMATS_NEEDS_AVX512F
-    CHECK("avx512f")
-#endif
+    ANIMATS_CHECKS
     if (missing[0] != '\0') {
         say("error: this build of animats uses instructions this CPU does not have (");
         say(missing);
