@@ -34,6 +34,82 @@ impl Format {
     }
 }
 
+/// The fewest bytes a trajectory of `frames` recorded steps of particles
+/// named `names` can take: each particle's row or object holds its name
+/// and seven numbers (t, position, velocity), each at least three
+/// characters (`0.0`), with their separators.
+pub fn least_bytes(frames: u64, names: &[String]) -> f64 {
+    let per_frame: usize = names.iter().map(|n| n.len() + 7 * 4 + 1).sum();
+    frames as f64 * per_frame as f64
+}
+
+/// Bytes free to an unprivileged writer on the file system holding `dir`
+/// (`None` where that cannot be found out).
+pub fn free_bytes(dir: &Path) -> Option<f64> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
+        let c = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+        // SAFETY: `c` is a NUL-terminated path and `st` a zeroed statvfs
+        // that the call fills in; nothing else is read or written.
+        unsafe {
+            let mut st: libc::statvfs = std::mem::zeroed();
+            if libc::statvfs(c.as_ptr(), &mut st) != 0 {
+                return None;
+            }
+            Some(st.f_bavail as f64 * st.f_frsize as f64)
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        None
+    }
+}
+
+/// Refuses, before anything is simulated, a trajectory of `frames`
+/// recorded steps that could not fit in the free space where `path` is
+/// to be written (a step mistyped a thousand times too small would
+/// otherwise fill the disk for hours before failing).
+pub fn check_room(path: &Path, frames: u64, names: &[String]) -> Result<(), String> {
+    let need = least_bytes(frames, names);
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let Some(free) = free_bytes(dir) else {
+        return Ok(());
+    };
+    if need > free {
+        return Err(format!(
+            "{}: the trajectory would take at least {} ({frames} recorded steps of {} particles), more than the {} free there: record fewer with --every N, or raise --dt or lower --duration",
+            path.display(),
+            size(need),
+            names.len(),
+            size(free)
+        ));
+    }
+    Ok(())
+}
+
+/// A byte count for people: `4.2 GB`.
+fn size(bytes: f64) -> String {
+    let units = ["bytes", "kB", "MB", "GB", "TB", "PB", "EB"];
+    let mut v = bytes;
+    let mut u = 0;
+    while v >= 1000.0 && u + 1 < units.len() {
+        v /= 1000.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{v:.0} {}", units[0])
+    } else {
+        format!("{v:.1} {}", units[u])
+    }
+}
+
 /// Writes recorded steps of a run to a temporary file, renamed on success.
 pub struct Trajectory {
     format: Format,
@@ -260,4 +336,46 @@ pub fn brains_json(scene: &animats_scene::Scene) -> Option<String> {
         sensor_map,
         actuator_map
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use animats_engine::DVec3;
+
+    /// [`least_bytes`] is a lower bound, and a tight one: particles at
+    /// rest at the origin at t = 0 (every number `0.0`, the shortest
+    /// there is) take exactly that in CSV, after the header, and more in
+    /// JSON Lines. Were it one byte a particle too high, a trajectory
+    /// that fits could be refused.
+    #[test]
+    fn least_bytes_is_the_size_of_the_shortest_trajectory() {
+        let names: Vec<String> = ["a", "hip_f", "jelly.tentacle2.3"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let state = State {
+            pos: vec![DVec3::ZERO; 3],
+            vel: vec![DVec3::ZERO; 3],
+        };
+        let dir = std::env::temp_dir().join(format!("animats-least-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        for (file, exact) in [("t.csv", true), ("t.jsonl", false)] {
+            let path = dir.join(file);
+            let mut t = Trajectory::create(&path, &names).unwrap();
+            for step in 0..5 {
+                t.record(0.0, step, &state).unwrap();
+            }
+            t.finish().unwrap();
+            let text = std::fs::read_to_string(&path).unwrap();
+            let body = text.strip_prefix("t,particle,x,y,z,vx,vy,vz\n").unwrap_or(&text);
+            let bound = least_bytes(5, &names);
+            if exact {
+                assert_eq!(body.len() as f64, bound, "{body}");
+            } else {
+                assert!(body.len() as f64 > bound, "{} <= {bound}", body.len());
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

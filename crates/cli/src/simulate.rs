@@ -78,7 +78,12 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let (mut scene, dt, steps) = prepare(&args)?;
     let limit = scene.world.step_limit(scene.world.integrator());
     let mut trajectory = match &args.output {
-        Some(path) => Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?),
+        Some(path) => {
+            // t = 0, every --every-th step and the last.
+            let frames = 1 + steps / args.every + u64::from(!steps.is_multiple_of(args.every));
+            crate::output::check_room(path, frames, &scene.names).map_err(Failure::Input)?;
+            Some(Trajectory::create(path, &scene.names).map_err(Failure::Input)?)
+        }
         None => None,
     };
     let conservative = scene.world.is_conservative();

@@ -617,3 +617,54 @@ fn every_vector_instruction_set_writes_the_same_trajectory() {
         );
     }
 }
+
+/// A trajectory that cannot fit on the disk is refused before anything
+/// is simulated: 10¹¹ recorded steps of the walker (at least 29 bytes a
+/// particle a step: over 10 TB) exit 2 at once, naming the file, the
+/// size and the free space, and leave no file. Without the check the
+/// run would write for days; the test gives it 60 s.
+#[test]
+fn a_trajectory_too_big_for_the_disk_is_refused_before_the_run() {
+    let dir = scratch("no-room");
+    let out = dir.join("huge.csv");
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/walker.toml");
+    let mut child = command()
+        .args([
+            "simulate",
+            scene.to_str().unwrap(),
+            "--dt",
+            "1e-6",
+            "--duration",
+            "1e5",
+        ])
+        .arg("--output")
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let began = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if began.elapsed().as_secs() > 60 {
+            let _ = child.kill();
+            let _ = child.wait();
+            let _ = std::fs::remove_dir_all(&dir);
+            panic!("still writing after 60 s: the trajectory's size was not checked");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("huge.csv: the trajectory would take at least"),
+        "{err}"
+    );
+    assert!(err.contains("100000000001 recorded steps of"), "{err}");
+    assert!(
+        err.contains(" free there") && err.contains("--every"),
+        "{err}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert!(left.is_empty(), "files left: {left:?}");
+}
