@@ -368,7 +368,9 @@ mod tests {
             }
             t.finish().unwrap();
             let text = std::fs::read_to_string(&path).unwrap();
-            let body = text.strip_prefix("t,particle,x,y,z,vx,vy,vz\n").unwrap_or(&text);
+            let body = text
+                .strip_prefix("t,particle,x,y,z,vx,vy,vz\n")
+                .unwrap_or(&text);
             let bound = least_bytes(5, &names);
             if exact {
                 assert_eq!(body.len() as f64, bound, "{body}");

@@ -253,6 +253,16 @@ fn shoot(
     times: &[f64],
 ) -> Result<Vec<Snapshot>, Failure> {
     let dt = stage.dt();
+    // As `simulate` and `evaluate`: at most 1e12 steps.
+    let last = times.last().copied().unwrap_or(0.0);
+    let steps = last / dt;
+    if steps > animats_scene::evaluate::MAX_STEPS {
+        return Err(Failure::Input(format!(
+            "{}: {last} s at dt = {dt} s is {steps:.1e} steps, more than {:e}: lower --seconds",
+            args.scene.display(),
+            animats_scene::evaluate::MAX_STEPS
+        )));
+    }
     // A world that splits its work over threads enters the pool once for
     // all the frames' steps, not at every step (the same bits).
     let pooled = stage.scene().world.steps_on_pool();

@@ -6,7 +6,7 @@ mod common;
 use animats_engine::DVec3;
 use animats_render::camera::View;
 use animats_render::{Camera, Image};
-use common::{animats, scratch, text, write, STIFF_SCENE};
+use common::{animats, animats_within, scratch, text, write, STIFF_SCENE};
 
 fn decode_png(path: &std::path::Path) -> Image {
     let file = std::fs::File::open(path).expect("open png");
@@ -448,4 +448,36 @@ fn the_pile_renders_its_rocks_where_they_came_to_lie() {
             "the rock at {rock}, pixel ({x:.0}, {y:.0}): {p:?}"
         );
     }
+}
+
+/// A picture more than 10¹² steps away is refused, as `simulate` and
+/// `evaluate` refuse such runs, before a step is taken: `--seconds 1e9`
+/// of the walker (dt 0.5 ms: 2×10¹² steps) exits 2 naming the scene and
+/// the count, and writes nothing. Without the check it would step for
+/// weeks; the test gives it 60 s.
+#[test]
+fn a_render_too_many_steps_away_is_refused() {
+    let dir = scratch("render-far");
+    let out = dir.join("far.png");
+    let o = animats_within(
+        &[
+            "render",
+            "scenes/walker.toml",
+            "--seconds",
+            "1e9",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        60,
+    )
+    .expect("still stepping after 60 s: the step count was not checked");
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(
+            "scenes/walker.toml: 1000000000 s at dt = 0.0005 s is 2.0e12 steps, more than 1e12"
+        ),
+        "{err}"
+    );
+    assert!(!out.exists());
 }

@@ -628,32 +628,23 @@ fn a_trajectory_too_big_for_the_disk_is_refused_before_the_run() {
     let dir = scratch("no-room");
     let out = dir.join("huge.csv");
     let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/walker.toml");
-    let mut child = command()
-        .args([
+    let o = animats_within(
+        &[
             "simulate",
             scene.to_str().unwrap(),
             "--dt",
             "1e-6",
             "--duration",
             "1e5",
-        ])
-        .arg("--output")
-        .arg(&out)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let began = std::time::Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if began.elapsed().as_secs() > 60 {
-            let _ = child.kill();
-            let _ = child.wait();
-            let _ = std::fs::remove_dir_all(&dir);
-            panic!("still writing after 60 s: the trajectory's size was not checked");
-        }
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    }
-    let o = child.wait_with_output().unwrap();
+            "--output",
+            out.to_str().unwrap(),
+        ],
+        60,
+    );
+    let Some(o) = o else {
+        let _ = std::fs::remove_dir_all(&dir);
+        panic!("still writing after 60 s: the trajectory's size was not checked");
+    };
     let (_, err) = text(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(

@@ -69,3 +69,24 @@ b = "wobbly"
 stiffness = 1e6
 rest_length = 1.0
 "#;
+
+/// Runs `animats` with `args` for at most `seconds`: its output, or
+/// `None` (the run killed) if it had not ended by then.
+pub fn animats_within(args: &[&str], seconds: u64) -> Option<Output> {
+    let mut child = command()
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("run animats");
+    let began = std::time::Instant::now();
+    while child.try_wait().expect("wait for animats").is_none() {
+        if began.elapsed().as_secs() > seconds {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    Some(child.wait_with_output().expect("animats's output"))
+}
