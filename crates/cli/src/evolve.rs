@@ -7,6 +7,7 @@
 use crate::Failure;
 use animats_evolve::{checkpoint, Choices, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
+use animats_scene::evaluate::Evaluation;
 use animats_scene::morphology::MorphologyProblem;
 use animats_viewer::{BestBrain, Exhibition};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -135,12 +136,33 @@ const CANDIDATES: usize = 16;
 
 /// A run's candidate for `checked.toml`: what it is (`the best`, `lane
 /// 2`, `elite 37`), the file the run writes it to, its logged fitness and
-/// its whole scene.
-struct Candidate {
+/// where its whole scene comes from (made only for the candidates tried).
+struct Candidate<'a> {
     label: String,
     file: String,
     fitness: f64,
-    text: String,
+    source: Source<'a>,
+}
+
+/// Where a candidate's scene comes from.
+enum Source<'a> {
+    Best,
+    Lane(usize),
+    Elite(&'a animats_evolve::archive::Elite),
+}
+
+impl Candidate<'_> {
+    fn text(&self, state: &State) -> Result<String, String> {
+        match &self.source {
+            Source::Best => state
+                .best_toml()?
+                .ok_or_else(|| "the run has no best yet".into()),
+            Source::Lane(l) => state
+                .lane_toml(*l)?
+                .ok_or_else(|| format!("lane {l} has no best")),
+            Source::Elite(e) => state.elite_toml(e),
+        }
+    }
 }
 
 /// The shares of the logged fitness the checks kept, as `98.1 % and
@@ -153,32 +175,26 @@ fn shares_text(shares: &[Option<f64>]) -> String {
     kept.join(" and ")
 }
 
-/// Each check of `c` (`animats_scene::evaluate::checks_finer`: a quarter
-/// of the step, with the scene's own integrator and with another), with
-/// the share of its logged fitness kept (`None` where the logged fitness
-/// is not above 0: no share to judge).
-#[allow(clippy::type_complexity)]
+/// Each check of `text`, `c`'s scene (`animats_scene::evaluate::checks_finer`:
+/// a quarter of the step, with the scene's own integrator and with another).
 fn run_checks(
     c: &Candidate,
-) -> Result<
-    Vec<(
-        animats_engine::IntegratorKind,
-        f64,
-        animats_scene::evaluate::Evaluation,
-        Option<f64>,
-    )>,
-    String,
-> {
-    let runs = animats_scene::evaluate::checks_finer(|| {
-        animats_scene::parse(&c.text, &c.file).map_err(|e| e.to_string())
-    })?;
-    Ok(runs
-        .into_iter()
-        .map(|(kind, dt, e)| {
-            let share = (c.fitness > 0.0).then(|| e.fitness / c.fitness);
-            (kind, dt, e, share)
-        })
-        .collect())
+    text: &str,
+) -> Result<Vec<(animats_engine::IntegratorKind, f64, Evaluation)>, String> {
+    animats_scene::evaluate::checks_finer(|| {
+        animats_scene::parse(text, &c.file).map_err(|e| e.to_string())
+    })
+}
+
+/// The share of `c`'s logged fitness each check kept (`None` where the
+/// logged fitness is not above 0: no share to judge).
+fn shares(
+    c: &Candidate,
+    runs: &[(animats_engine::IntegratorKind, f64, Evaluation)],
+) -> Vec<Option<f64>> {
+    runs.iter()
+        .map(|(_, _, e)| (c.fitness > 0.0).then(|| e.fitness / c.fitness))
+        .collect()
 }
 
 /// Whether every check kept at least [`BELIEVED`] of the logged fitness.
@@ -187,46 +203,39 @@ fn believed(shares: &[Option<f64>]) -> bool {
 }
 
 /// The run's other candidates, best first: each other lane's best and
-/// each elite of a quality-diversity archive, without the best's genome.
-fn other_candidates(state: &State, best: &[f64]) -> Result<Vec<Candidate>, String> {
-    let same = |g: &[f64]| {
-        g.len() == best.len() && g.iter().zip(best).all(|(a, b)| a.to_bits() == b.to_bits())
-    };
+/// each elite of a quality-diversity archive, each genome once and not
+/// the best's.
+fn other_candidates<'a>(state: &'a State, best: &'a [f64]) -> Vec<Candidate<'a>> {
     let mut out = Vec::new();
-    let mut seen: Vec<&[f64]> = Vec::new();
+    let mut seen: Vec<&[f64]> = vec![best];
     for l in &state.lanes {
         let Some(b) = &l.best else { continue };
-        if same(&b.genome) || seen.contains(&b.genome.as_slice()) {
+        if seen.contains(&b.genome.as_slice()) {
             continue;
         }
-        if let Some(text) = state.lane_toml(l.lane)? {
-            seen.push(&b.genome);
-            out.push(Candidate {
-                label: format!("lane {}", l.lane),
-                file: format!("lanes/{}.toml", l.lane),
-                fitness: b.fitness,
-                text,
-            });
-        }
+        seen.push(&b.genome);
+        out.push(Candidate {
+            label: format!("lane {}", l.lane),
+            file: format!("lanes/{}.toml", l.lane),
+            fitness: b.fitness,
+            source: Source::Lane(l.lane),
+        });
     }
-    if let Some(archive) = state.archive() {
-        let texts = state.elite_tomls()?;
-        for (e, (index, text)) in archive.elites().iter().zip(texts) {
-            if same(&e.genome) || seen.contains(&e.genome.as_slice()) {
-                continue;
-            }
-            out.push(Candidate {
-                label: format!("elite {index}"),
-                file: format!("elites/{index}.toml"),
-                fitness: e.objective,
-                text,
-            });
+    for e in state.archive().map_or(&[][..], |a| a.elites()) {
+        if seen.contains(&e.genome.as_slice()) {
+            continue;
         }
+        out.push(Candidate {
+            label: format!("elite {}", e.index),
+            file: format!("elites/{}.toml", e.index),
+            fitness: e.objective,
+            source: Source::Elite(e),
+        });
     }
     // Best first; NaN last; equal fitness in the order found.
     let key = |f: f64| if f.is_nan() { f64::NEG_INFINITY } else { f };
     out.sort_by(|a, b| key(b.fitness).total_cmp(&key(a.fitness)));
-    Ok(out)
+    out
 }
 
 /// Prints the checks a winner must pass before it is believed: the best
@@ -238,22 +247,17 @@ fn other_candidates(state: &State, best: &[f64]) -> Result<Vec<Candidate>, Strin
 /// the next [`CANDIDATES`] (other lanes' bests and the archive's elites,
 /// best first). Returns whether it wrote `checked.toml`.
 fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
-    let (Some(text), Some(lane)) = (
-        state.best_toml().map_err(Failure::Other)?,
-        state.best_lane(),
-    ) else {
-        return Ok(false);
-    };
-    let Some(best) = lane.best.as_ref() else {
+    let Some(best) = state.best_lane().and_then(|l| l.best.as_ref()) else {
         return Ok(false);
     };
     let first = Candidate {
         label: "the best".into(),
         file: "best.toml".into(),
         fitness: best.fitness,
-        text,
+        source: Source::Best,
     };
-    let runs = match run_checks(&first) {
+    let text = first.text(state).map_err(Failure::Other)?;
+    let runs = match run_checks(&first, &text) {
         Ok(c) => c,
         Err(e) => {
             say!("  check: the best at a quarter of the step could not be run: {e}");
@@ -261,7 +265,8 @@ fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
         }
     };
     let logged = best.fitness;
-    for (kind, dt, e, share) in &runs {
+    let kept = shares(&first, &runs);
+    for ((kind, dt, e), share) in runs.iter().zip(&kept) {
         let kept = match share {
             Some(share) => format!(
                 " ({:.1} % of {logged}){}",
@@ -281,8 +286,7 @@ fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
             e.distance
         );
     }
-    let shares: Vec<Option<f64>> = runs.iter().map(|r| r.3).collect();
-    let write = |c: &Candidate, shares: &[Option<f64>]| -> Result<bool, Failure> {
+    let write = |c: &Candidate, text: &str, shares: &[Option<f64>]| -> Result<bool, Failure> {
         let head = format!(
             "# checked.toml: the best of this run that keeps at least 80 % of its\n# fitness at a quarter of the step with its own integrator and with\n# another ({}: {}); docs/BODIES.md, Honest evaluation.\n",
             c.label,
@@ -290,31 +294,34 @@ fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
         );
         animats_files::write_atomically(
             &dir.join("checked.toml"),
-            format!("{head}{}", c.text).as_bytes(),
+            format!("{head}{text}").as_bytes(),
         )
         .map_err(Failure::Other)?;
         Ok(true)
     };
-    if believed(&shares) {
-        return write(&first, &shares);
+    if believed(&kept) {
+        return write(&first, &text, &kept);
     }
     if logged.is_nan() || logged <= 0.0 {
         return Ok(false);
     }
-    let others = other_candidates(state, &best.genome).map_err(Failure::Other)?;
+    let others = other_candidates(state, &best.genome);
     let tried = others.len().min(CANDIDATES);
     for c in others.iter().take(CANDIDATES) {
-        let Ok(runs) = run_checks(c) else { continue };
-        let shares: Vec<Option<f64>> = runs.iter().map(|r| r.3).collect();
-        if believed(&shares) {
+        let Ok(text) = c.text(state) else { continue };
+        let Ok(runs) = run_checks(c, &text) else {
+            continue;
+        };
+        let kept = shares(c, &runs);
+        if believed(&kept) {
             say!(
                 "  check: the best that keeps 80 % in each check is {} (fitness {}; {}): wrote {}",
                 c.label,
                 c.fitness,
-                shares_text(&shares),
+                shares_text(&kept),
                 dir.join("checked.toml").display()
             );
-            return write(c, &shares);
+            return write(c, &text, &kept);
         }
     }
     if tried == 0 {

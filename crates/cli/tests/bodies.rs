@@ -28,6 +28,13 @@ fn evolve(scene: &str, dir: &std::path::Path, extra: &[&str]) -> std::process::O
     animats(&args)
 }
 
+/// The best fitness `dir/log.csv` logged last (its `best_fitness`).
+fn logged_best(dir: &std::path::Path) -> f64 {
+    let log = std::fs::read_to_string(dir.join("log.csv")).unwrap();
+    let last = log.lines().last().unwrap();
+    last.split(',').nth(4).unwrap().parse().unwrap()
+}
+
 /// `animats evaluate FILE --json`'s fitness, and the JSON.
 fn evaluated(file: &str) -> (f64, String) {
     let e = animats(&["evaluate", file, "--json"]);
@@ -180,16 +187,7 @@ fn bodies_evolve_and_best_toml_reproduces_the_logged_fitness() {
         other.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o).1);
-    let other_log = std::fs::read_to_string(other.join("log.csv")).unwrap();
-    let other_best: f64 = other_log
-        .lines()
-        .last()
-        .unwrap()
-        .split(',')
-        .nth(4)
-        .unwrap()
-        .parse()
-        .unwrap();
+    let other_best = logged_best(&other);
     let z = animats(&[
         "render",
         out.to_str().unwrap(),
@@ -447,16 +445,7 @@ fn checked_toml_is_the_best_candidate_that_passes_both_checks() {
         ]);
         let (stdout, err) = text(&o);
         assert!(o.status.success(), "{err}");
-        let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
-        let best: f64 = log
-            .lines()
-            .last()
-            .unwrap()
-            .split(',')
-            .nth(4)
-            .unwrap()
-            .parse()
-            .unwrap();
+        let best = logged_best(&out);
         let checked = out.join("checked.toml");
         if !stdout.contains("not to be believed yet") {
             // The best passes: checked.toml is the best.

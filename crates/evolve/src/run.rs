@@ -867,33 +867,55 @@ impl State {
         archive
             .elites()
             .iter()
-            .map(|e| {
-                let cell: Vec<String> =
-                    archive.unravel(e.index).iter().map(|c| c.to_string()).collect();
-                let measures: Vec<String> = archive
-                    .grid
-                    .names
-                    .iter()
-                    .zip(&e.measures)
-                    .map(|(n, m)| format!("{n} = {m}"))
-                    .collect();
-                let comment = format!(
-                    "{} with elite {} (cell [{}]) of `animats evolve` ({}, seed {}, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}; measures: {}.\nReproduce it with `animats evaluate FILE --json`; watch it with `animats view FILE`.",
-                    self.config.problem.file,
-                    e.index,
-                    cell.join(", "),
-                    self.config.optimiser.name(),
-                    self.config.seed,
-                    self.generation(),
-                    e.objective,
-                    e.distance,
-                    e.time,
-                    e.ended,
-                    measures.join(", ")
-                );
-                Ok((e.index, problem.scene_toml(&e.genome, &comment)?))
-            })
+            .map(|e| Ok((e.index, self.elite_scene(problem.as_ref(), archive, e)?)))
             .collect()
+    }
+
+    /// One elite of the archive as a whole scene, as [`State::elite_tomls`]
+    /// writes it.
+    pub fn elite_toml(&self, elite: &crate::archive::Elite) -> Result<String, String> {
+        let archive = self
+            .archive()
+            .ok_or("the run keeps no archive: it has no elites")?;
+        let problem = self.config.problem.build()?;
+        self.elite_scene(problem.as_ref(), archive, elite)
+    }
+
+    /// `e` as a whole scene of `problem`, its comment naming its cell,
+    /// measures and scores.
+    fn elite_scene(
+        &self,
+        problem: &dyn Problem,
+        archive: &crate::archive::GridArchive,
+        e: &crate::archive::Elite,
+    ) -> Result<String, String> {
+        let cell: Vec<String> = archive
+            .unravel(e.index)
+            .iter()
+            .map(|c| c.to_string())
+            .collect();
+        let measures: Vec<String> = archive
+            .grid
+            .names
+            .iter()
+            .zip(&e.measures)
+            .map(|(n, m)| format!("{n} = {m}"))
+            .collect();
+        let comment = format!(
+            "{} with elite {} (cell [{}]) of `animats evolve` ({}, seed {}, generation {}):\nfitness {}, distance {} m, time {} s, ended: {}; measures: {}.\nReproduce it with `animats evaluate FILE --json`; watch it with `animats view FILE`.",
+            self.config.problem.file,
+            e.index,
+            cell.join(", "),
+            self.config.optimiser.name(),
+            self.config.seed,
+            self.generation(),
+            e.objective,
+            e.distance,
+            e.time,
+            e.ended,
+            measures.join(", ")
+        );
+        problem.scene_toml(&e.genome, &comment)
     }
 
     /// `archive.csv`: one row per occupied cell, in cell order, with
