@@ -110,12 +110,16 @@ pub fn run(args: Args) -> Result<(), Failure> {
     let stage =
         SceneStage::following(scene.clone(), args.follow.as_deref()).map_err(Failure::Input)?;
     crate::warn(&scene, stage.warnings());
-    let server = args.serving.bind(args.speed)?;
+    // The handler before the address is printed: a Ctrl-C that comes as
+    // soon as the address does stops the view cleanly. (Before it, a
+    // process started with SIGINT ignored, as a shell's background jobs
+    // are, lost that Ctrl-C and served on.)
     let stop = Arc::new(AtomicBool::new(false));
     {
         let stop = stop.clone();
         let _ = ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst));
     }
+    let server = args.serving.bind(args.speed)?;
     let s = server
         .serve(Box::new(stage), stop)
         .map_err(Failure::Other)?;
