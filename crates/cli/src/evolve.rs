@@ -7,7 +7,6 @@
 use crate::Failure;
 use animats_evolve::{checkpoint, Choices, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
-use animats_scene::evaluate::Evaluation;
 use animats_scene::morphology::MorphologyProblem;
 use animats_viewer::{BestBrain, Exhibition};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -126,210 +125,26 @@ fn writable(dir: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The share of its logged fitness a candidate must keep in each check
-/// at a quarter of the step to be believed (issue 39's rule).
-const BELIEVED: f64 = 0.8;
-
-/// How many candidates after the best the checks try, best first, when
-/// the best fails them (`checked.toml`).
-const CANDIDATES: usize = 16;
-
-/// A run's candidate for `checked.toml`: what it is (`the best`, `lane
-/// 2`, `elite 37`), the file the run writes it to, its logged fitness and
-/// where its whole scene comes from (made only for the candidates tried).
-struct Candidate<'a> {
-    label: String,
-    file: String,
-    fitness: f64,
-    source: Source<'a>,
-}
-
-/// Where a candidate's scene comes from.
-enum Source<'a> {
-    Best,
-    Lane(usize),
-    Elite(&'a animats_evolve::archive::Elite),
-}
-
-impl Candidate<'_> {
-    fn text(&self, state: &State) -> Result<String, String> {
-        match &self.source {
-            Source::Best => state
-                .best_toml()?
-                .ok_or_else(|| "the run has no best yet".into()),
-            Source::Lane(l) => state
-                .lane_toml(*l)?
-                .ok_or_else(|| format!("lane {l} has no best")),
-            Source::Elite(e) => state.elite_toml(e),
-        }
-    }
-}
-
-/// The shares of the logged fitness the checks kept, as `98.1 % and
-/// 99.4 %`.
-fn shares_text(shares: &[Option<f64>]) -> String {
-    let kept: Vec<String> = shares
-        .iter()
-        .map(|s| format!("{:.1} %", 100.0 * s.unwrap_or(f64::NAN)))
-        .collect();
-    kept.join(" and ")
-}
-
-/// Each check of `text`, `c`'s scene (`animats_scene::evaluate::checks_finer`:
-/// a quarter of the step, with the scene's own integrator and with another).
-fn run_checks(
-    c: &Candidate,
-    text: &str,
-) -> Result<Vec<(animats_engine::IntegratorKind, f64, Evaluation)>, String> {
-    animats_scene::evaluate::checks_finer(|| {
-        animats_scene::parse(text, &c.file).map_err(|e| e.to_string())
-    })
-}
-
-/// The share of `c`'s logged fitness each check kept (`None` where the
-/// logged fitness is not above 0: no share to judge).
-fn shares(
-    c: &Candidate,
-    runs: &[(animats_engine::IntegratorKind, f64, Evaluation)],
-) -> Vec<Option<f64>> {
-    runs.iter()
-        .map(|(_, _, e)| (c.fitness > 0.0).then(|| e.fitness / c.fitness))
-        .collect()
-}
-
-/// Whether every check kept at least [`BELIEVED`] of the logged fitness.
-fn believed(shares: &[Option<f64>]) -> bool {
-    !shares.is_empty() && shares.iter().all(|s| s.is_some_and(|s| s >= BELIEVED))
-}
-
-/// The run's other candidates, best first: each other lane's best and
-/// each elite of a quality-diversity archive, each genome once and not
-/// the best's.
-fn other_candidates<'a>(state: &'a State, best: &'a [f64]) -> Vec<Candidate<'a>> {
-    let mut out = Vec::new();
-    let mut seen: Vec<&[f64]> = vec![best];
-    for l in &state.lanes {
-        let Some(b) = &l.best else { continue };
-        if seen.contains(&b.genome.as_slice()) {
-            continue;
-        }
-        seen.push(&b.genome);
-        out.push(Candidate {
-            label: format!("lane {}", l.lane),
-            file: format!("lanes/{}.toml", l.lane),
-            fitness: b.fitness,
-            source: Source::Lane(l.lane),
-        });
-    }
-    for e in state.archive().map_or(&[][..], |a| a.elites()) {
-        if seen.contains(&e.genome.as_slice()) {
-            continue;
-        }
-        out.push(Candidate {
-            label: format!("elite {}", e.index),
-            file: format!("elites/{}.toml", e.index),
-            fitness: e.objective,
-            source: Source::Elite(e),
-        });
-    }
-    // Best first; NaN last; equal fitness in the order found.
-    let key = |f: f64| if f.is_nan() { f64::NEG_INFINITY } else { f };
-    out.sort_by(|a, b| key(b.fitness).total_cmp(&key(a.fitness)));
-    out
-}
-
-/// Prints the checks a winner must pass before it is believed: the best
-/// (best.toml) at a quarter of the step with its own integrator and with
-/// another (`animats_scene::evaluate::checks_finer`), and whether each
-/// keeps 80 % of its fitness. It changes nothing written before; it
-/// writes `checked.toml`, the best candidate that keeps 80 % in both
-/// checks: the best itself, or where it fails, the first that passes of
-/// the next [`CANDIDATES`] (other lanes' bests and the archive's elites,
-/// best first). Returns whether it wrote `checked.toml`.
+/// Prints the checks a winner must pass before it is believed
+/// (`animats_evolve::check`: the best at a quarter of the step with its
+/// own integrator and with another, and whether each keeps 80 % of its
+/// fitness) and writes `checked.toml`, the best candidate that keeps 80 %
+/// in both: the best itself, or where it fails, the first that passes of
+/// the next 16. It changes nothing written before. Returns whether it
+/// wrote `checked.toml`.
 fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
-    let Some(best) = state.best_lane().and_then(|l| l.best.as_ref()) else {
+    let Some(report) = animats_evolve::check::check(state).map_err(Failure::Other)? else {
         return Ok(false);
     };
-    let first = Candidate {
-        label: "the best".into(),
-        file: "best.toml".into(),
-        fitness: best.fitness,
-        source: Source::Best,
-    };
-    let text = first.text(state).map_err(Failure::Other)?;
-    let runs = match run_checks(&first, &text) {
-        Ok(c) => c,
-        Err(e) => {
-            say!("  check: the best at a quarter of the step could not be run: {e}");
-            return Ok(false);
-        }
-    };
-    let logged = best.fitness;
-    let kept = shares(&first, &runs);
-    for ((kind, dt, e), share) in runs.iter().zip(&kept) {
-        let kept = match share {
-            Some(share) => format!(
-                " ({:.1} % of {logged}){}",
-                100.0 * share,
-                if share.is_nan() || *share < BELIEVED {
-                    ": under 80 %, not to be believed yet (docs/BODIES.md, Honest evaluation)"
-                } else {
-                    ""
-                }
-            ),
-            None => String::new(),
-        };
-        say!(
-            "  check: the best at a quarter of the step ({dt} s) with {}: fitness {}, distance {} m{kept}",
-            kind.name(),
-            e.fitness,
-            e.distance
-        );
+    let checked = report.checked_toml();
+    if let Some(text) = &checked {
+        animats_files::write_atomically(&dir.join("checked.toml"), text.as_bytes())
+            .map_err(Failure::Other)?;
     }
-    let write = |c: &Candidate, text: &str, shares: &[Option<f64>]| -> Result<bool, Failure> {
-        let head = format!(
-            "# checked.toml: the best of this run that keeps at least 80 % of its\n# fitness at a quarter of the step with its own integrator and with\n# another ({}: {}); docs/BODIES.md, Honest evaluation.\n",
-            c.label,
-            shares_text(shares)
-        );
-        animats_files::write_atomically(
-            &dir.join("checked.toml"),
-            format!("{head}{text}").as_bytes(),
-        )
-        .map_err(Failure::Other)?;
-        Ok(true)
-    };
-    if believed(&kept) {
-        return write(&first, &text, &kept);
+    for line in report.lines(dir) {
+        say!("  {line}");
     }
-    if logged.is_nan() || logged <= 0.0 {
-        return Ok(false);
-    }
-    let others = other_candidates(state, &best.genome);
-    let tried = others.len().min(CANDIDATES);
-    for c in others.iter().take(CANDIDATES) {
-        let Ok(text) = c.text(state) else { continue };
-        let Ok(runs) = run_checks(c, &text) else {
-            continue;
-        };
-        let kept = shares(c, &runs);
-        if believed(&kept) {
-            say!(
-                "  check: the best that keeps 80 % in each check is {} (fitness {}; {}): wrote {}",
-                c.label,
-                c.fitness,
-                shares_text(&kept),
-                dir.join("checked.toml").display()
-            );
-            return write(c, &text, &kept);
-        }
-    }
-    if tried == 0 {
-        say!("  check: the run has no other candidate to try: no checked.toml");
-    } else {
-        say!("  check: none of the {tried} next best keeps 80 % in each check either: no checked.toml");
-    }
-    Ok(false)
+    Ok(checked.is_some())
 }
 
 /// Writes log.csv, best.toml and the checkpoint; at the end of a run (or

@@ -13,12 +13,15 @@
 //!   ([`problem::SceneEvolution`] over `animats_scene::evaluate::SceneProblem`).
 //! - [`run::State`]: a run's lanes and log; `advance` moves it on.
 //! - [`checkpoint`]: save and load a run.
+//! - [`check`]: a winner checked at a quarter of the step, and
+//!   `checked.toml`, the best candidate that keeps its fitness there.
 //! - [`schedule`]: a run's work, recorded, and replayed on any number of
 //!   workers to predict its wall time.
 
 #![warn(missing_docs)]
 
 pub mod archive;
+pub mod check;
 pub mod checkpoint;
 pub mod optimiser;
 pub mod problem;

@@ -468,6 +468,82 @@ impl Evolution {
         self.state.best_toml().map_err(runtime_error)
     }
 
+    /// The checks `animats evolve` runs at the end of a run: the best at
+    /// a quarter of the step with its own integrator and with another, and
+    /// where it keeps less than 80 % of its fitness in either, the next 16
+    /// best (other lanes' bests, the archive's elites) until one keeps it
+    /// in both (docs/BODIES.md, Honest evaluation). Returns a dict:
+    /// `best`, a list of the best's checks (`integrator`, `dt`, `fitness`,
+    /// `distance`, `share` of the logged fitness or None); `checked`, the
+    /// candidate that passed (`label`, `file`, `fitness`, `shares`, `toml`:
+    /// `checked.toml`'s text) or None; `lines`, what `animats evolve`
+    /// prints of it. With `out`, writes `out/checked.toml` (created whole
+    /// or not at all) or, where none passed, removes an earlier one. None
+    /// before the first generation.
+    #[pyo3(signature = (out = None))]
+    fn check<'py>(
+        &self,
+        py: Python<'py>,
+        out: Option<PathBuf>,
+    ) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let state = &self.state;
+        let report = py
+            .detach(|| animats_evolve::check::check(state))
+            .map_err(runtime_error)?;
+        let Some(report) = report else {
+            return Ok(None);
+        };
+        let checked = report.checked_toml();
+        let dir = out.clone().unwrap_or_else(|| PathBuf::from("."));
+        if let Some(out) = &out {
+            let file = out.join("checked.toml");
+            match &checked {
+                Some(text) => {
+                    std::fs::create_dir_all(out).map_err(|e| {
+                        pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", out.display()))
+                    })?;
+                    animats_files::write_atomically(&file, text.as_bytes())
+                        .map_err(pyo3::exceptions::PyOSError::new_err)?;
+                }
+                None => match std::fs::remove_file(&file) {
+                    Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                        return Err(pyo3::exceptions::PyOSError::new_err(format!(
+                            "{}: {e}",
+                            file.display()
+                        )));
+                    }
+                    _ => {}
+                },
+            }
+        }
+        let d = PyDict::new(py);
+        let mut best = Vec::new();
+        for c in &report.best {
+            let e = PyDict::new(py);
+            e.set_item("integrator", c.integrator.name())?;
+            e.set_item("dt", c.dt)?;
+            e.set_item("fitness", c.evaluation.fitness)?;
+            e.set_item("distance", c.evaluation.distance)?;
+            e.set_item("share", c.share)?;
+            best.push(e);
+        }
+        d.set_item("best", best)?;
+        match (&report.verdict, checked) {
+            (animats_evolve::check::Verdict::Checked(c), Some(toml)) => {
+                let e = PyDict::new(py);
+                e.set_item("label", &c.label)?;
+                e.set_item("file", &c.file)?;
+                e.set_item("fitness", c.fitness)?;
+                e.set_item("shares", c.shares.clone())?;
+                e.set_item("toml", toml)?;
+                d.set_item("checked", e)?;
+            }
+            _ => d.set_item("checked", py.None())?,
+        }
+        d.set_item("lines", report.lines(&dir))?;
+        Ok(Some(d))
+    }
+
     /// Writes `log.csv` and `best.toml` into `directory` (created if
     /// needed), each file whole or not at all.
     fn save(&self, directory: PathBuf) -> PyResult<()> {

@@ -211,12 +211,22 @@ def test_python_m_animats_evolve_writes_the_command_lines_files(cli, crawler, tm
     import sys
 
     args = ["--optimiser", "ga", "--generations", "4", "--lanes", "2", "--seed", "6"]
-    cli("evolve", crawler, *args, "--out", tmp_path / "cli")
+    out = cli("evolve", crawler, *args, "--out", tmp_path / "cli")
     r = subprocess.run([sys.executable, "-m", "animats.evolve", str(crawler), *args,
                         "--out", str(tmp_path / "py")], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
-    for f in ("log.csv", "best.toml"):
+    for f in ("log.csv", "best.toml", "checked.toml"):
         assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes()
+    # The end's checks of the winner, printed as the command line prints them.
+    checks = [l for l in out.splitlines() if l.startswith("  check:")]
+    assert len(checks) == 2, out
+    assert [l for l in r.stdout.splitlines() if l.startswith("  check:")] == checks
+    assert "checked.toml" in r.stdout.splitlines()[-1]
+    # --no-check: none, and the one an earlier run wrote is removed.
+    r = subprocess.run([sys.executable, "-m", "animats.evolve", str(crawler), *args, "--no-check",
+                        "--out", str(tmp_path / "py")], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert "check:" not in r.stdout and not (tmp_path / "py" / "checked.toml").exists()
     bad = subprocess.run([sys.executable, "-m", "animats.evolve", str(tmp_path / "none.toml")],
                          capture_output=True, text=True)
     assert bad.returncode == 1 and "none.toml" in bad.stderr

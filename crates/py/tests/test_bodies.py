@@ -33,7 +33,7 @@ def small(tmp_path):
 
 
 def test_an_evolution_of_bodies_writes_the_command_lines_files(cli, small, tmp_path):
-    cli("evolve", small, "--population", 6, "--generations", 4, "--seed", 3, "--out", tmp_path / "cli")
+    out = cli("evolve", small, "--population", 6, "--generations", 4, "--seed", 3, "--out", tmp_path / "cli")
     run = animats.Evolution(str(small), population=6, generations=4, seed=3)
     assert run.config["optimiser"] == "body-ga"
     run.run()
@@ -63,6 +63,24 @@ def test_an_evolution_of_bodies_writes_the_command_lines_files(cli, small, tmp_p
         full.tell(evaluator.outcomes(genomes))
     assert elsewhere.log_csv() == run.log_csv()
     assert full.best_toml() == run.best_toml()
+    # The end's checks, as `animats evolve` ran them: the same lines and,
+    # where a candidate kept 80 % in both, the same checked.toml.
+    assert animats.Evolution(str(small), population=6, generations=4, seed=3).check() is None
+    report = run.check(tmp_path / "py")
+    lines = [l.strip() for l in out.splitlines() if l.startswith("  check:")]
+    assert [l.replace(str(tmp_path / "py"), str(tmp_path / "cli")) for l in report["lines"]] == lines
+    assert len(report["best"]) == 2 and {c["integrator"] for c in report["best"]} >= {"symplectic"}
+    for c in report["best"]:
+        assert c["dt"] == 0.00025 and c["share"] == c["fitness"] / run.best_fitness
+    checked = tmp_path / "py" / "checked.toml"
+    if report["checked"] is None:
+        assert not checked.exists() and not (tmp_path / "cli" / "checked.toml").exists()
+    else:
+        assert checked.read_text() == report["checked"]["toml"]
+        assert checked.read_bytes() == (tmp_path / "cli" / "checked.toml").read_bytes()
+        assert min(report["checked"]["shares"]) >= 0.8
+        e = animats.evaluate_scenes([checked.read_text()])
+        assert e["fitness"][0] == report["checked"]["fitness"]
     with pytest.raises(ValueError, match="2 screens for 6 genomes"):
         evaluator.outcomes(genomes, screens=screens[:2])
     with pytest.raises(ValueError, match="not a screen"):
@@ -127,3 +145,31 @@ def animats_root():
     import pathlib
 
     return pathlib.Path(__file__).resolve().parents[3]
+
+
+def test_check_picks_the_command_lines_candidate_where_the_best_fails(cli, tmp_path):
+    """A best tuned to the step's errors (a coarse step, not robust) fails
+    the end's checks; `Evolution.check` then tries the archive's elites as
+    `animats evolve` does and names and writes the same one."""
+    shipped = (animats_root() / "scenes" / "bodies_walk.toml").read_text()
+    lines = ["dt = 0.002" if l.startswith("dt = 0.0005") else l for l in shipped.splitlines()]
+    text = "\n".join(lines) + "\n"
+    text = text.replace('optimiser = "map-elites"\n', 'optimiser = "map-elites"\nrobust = false\n', 1)
+    assert "\ndt = 0.002\n" in text and "robust = false" in text
+    scene = tmp_path / "coarse.toml"
+    scene.write_text(text)
+    for seed in range(1, 7):
+        cli_dir, py_dir = tmp_path / f"cli{seed}", tmp_path / f"py{seed}"
+        out = cli("evolve", scene, "--generations", 15, "--seed", seed, "--out", cli_dir)
+        run = animats.Evolution(str(scene), generations=15, seed=seed)
+        run.run()
+        report = run.check(py_dir)
+        expected = [l.strip() for l in out.splitlines() if l.startswith("  check:")]
+        assert [l.replace(str(py_dir), str(cli_dir)) for l in report["lines"]] == expected
+        assert (py_dir / "checked.toml").exists() == (cli_dir / "checked.toml").exists()
+        if report["checked"] is not None:
+            assert (py_dir / "checked.toml").read_bytes() == (cli_dir / "checked.toml").read_bytes()
+        if any(c["share"] < 0.8 for c in report["best"]):
+            assert report["checked"] is None or report["checked"]["label"].startswith("elite ")
+            return
+    pytest.fail("no seed of 1 to 6 gave a best that fails the checks")

@@ -1,7 +1,7 @@
 """Type stubs of the compiled core (crates/py/src)."""
 
 from os import PathLike
-from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -137,6 +137,7 @@ class Evolution:
     def problem_text(self) -> Tuple[str, str]: ...
     def log_csv(self) -> str: ...
     def best_toml(self) -> Optional[str]: ...
+    def check(self, out: Optional[Union[str, PathLike[str]]] = None) -> Optional[Dict[str, Any]]: ...
     def save(self, directory: Union[str, PathLike[str]]) -> None: ...
 
 class Env:

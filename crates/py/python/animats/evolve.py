@@ -1,12 +1,14 @@
 """``python -m animats.evolve [SCENE] [--ray ADDRESS] ...``: ``animats
-evolve`` from Python, here or spread over a Ray cluster; the same log.csv
-and best.toml, bit for bit, for the same arguments."""
+evolve`` from Python, here or spread over a Ray cluster; the same log.csv,
+best.toml and checked.toml, bit for bit, for the same arguments, and the
+same checks of the winner at the end (``--no-check`` skips them)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 import time
+from pathlib import Path
 
 from . import _animats
 from .distributed import DEVICES
@@ -38,6 +40,11 @@ def main(argv: "list[str] | None" = None) -> int:
         default="cpu",
         help="where evaluations run: cpu (default), cuda or cuda-fast (here, or one GPU a Ray actor)",
     )
+    p.add_argument(
+        "--no-check",
+        action="store_true",
+        help="skip the end's checks of the winner at a quarter of the step (and checked.toml)",
+    )
     a = p.parse_args(argv)
     start = time.perf_counter()
     # `animats evolve`'s arguments, the same here and on Ray.
@@ -68,13 +75,25 @@ def main(argv: "list[str] | None" = None) -> int:
                 progress=True,
             )
             how = f"on Ray, {a.actors} actors, {stats.retries} shares retried"
+        took = time.perf_counter() - start
+        # The winner checked at a quarter of the step, as `animats evolve`
+        # does at its end: checked.toml, or an earlier one removed.
+        checked = False
+        if a.no_check:
+            Path(a.out, "checked.toml").unlink(missing_ok=True)
+        else:
+            report = run.check(a.out)
+            if report is not None:
+                for line in report["lines"]:
+                    print(f"  {line}")
+                checked = report["checked"] is not None
     except (ValueError, OSError, RuntimeError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 1
     print(
         f"{run.generation} generations, {run.evaluations} evaluations {how} in "
-        f"{time.perf_counter() - start:.2f} s; best fitness {run.best_fitness}; "
-        f"wrote {a.out}/log.csv, best.toml"
+        f"{took:.2f} s; best fitness {run.best_fitness}; "
+        f"wrote {a.out}/log.csv, best.toml{', checked.toml' if checked else ''}"
     )
     return 0
 
