@@ -32,6 +32,11 @@ def test_a_ray_evolution_writes_the_command_lines_log(cluster, cli, crawler, tmp
         assert stats.generations == 6 and stats.retries == 0
         for f in ("log.csv", "best.toml"):
             assert (tmp_path / f"ray{actors}" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), (actors, f)
+        # The end's checks, run where the driver runs: the command line's checked.toml.
+        run.check(tmp_path / f"ray{actors}")
+        f = "checked.toml"
+        assert (tmp_path / "cli" / f).exists()
+        assert (tmp_path / f"ray{actors}" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), actors
 
 
 def test_a_worker_killed_mid_generation_costs_time_not_results(cluster, cli, tmp_path):
