@@ -3,8 +3,8 @@
 `animats_gpu::Device::open` does (the same headers in the same order, the
 same strict options) for a GPU architecture, with no GPU: NVRTC only needs
 its own libraries, which the PyPI package nvidia-cuda-nvrtc provides. Prints
-ptxas's registers, stack and spills for each entry of both kernels (the
-flat floor's and terrain's); exit 1 if NVRTC refuses
+ptxas's registers, stack and spills for each entry of the three kernels
+(the flat floor's, terrain's and sphere contact's); exit 1 if NVRTC refuses
 the kernel (its log printed), 2 if NVRTC cannot be found.
 
     python3 -m venv target/venv-nvrtc
@@ -22,7 +22,7 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 KERNEL = os.path.join(ROOT, "crates", "gpu", "kernel")
 # In the order of crates/gpu/src/cuda.rs's `source`.
-PARTS = ["libm.h", "terrain.h", "trig.h", "exp.h", "step.h", "eval.h", "kernel.cu"]
+PARTS = ["libm.h", "terrain.h", "spheres.h", "trig.h", "exp.h", "step.h", "eval.h", "kernel.cu"]
 # As crates/gpu/src/cuda.rs's `options`, with ptxas's report.
 OPTIONS = ["--fmad=false", "--prec-div=true", "--prec-sqrt=true", "--ftz=false", "--ptxas-options=-v"]
 
@@ -79,9 +79,14 @@ def main():
     src = source()
     failed = False
     for arch in sys.argv[1:] or ["sm_90"]:
-        # As crates/gpu/src/cuda.rs's two kernels: the flat floor's, and
-        # terrain's.
-        for kernel, extra in [("flat floor", ["-DAN_FLAT_ONLY"]), ("terrain", [])]:
+        # As crates/gpu/src/cuda.rs's three kernels: the flat floor's,
+        # terrain's and sphere contact's (on the flat floor).
+        kinds = [
+            ("flat floor", ["-DAN_FLAT_ONLY"]),
+            ("terrain", []),
+            ("sphere contact", ["-DAN_FLAT_ONLY", "-DAN_SPHERES"]),
+        ]
+        for kernel, extra in kinds:
             ok, log = compile_for(lib, arch, src, extra)
             print(f"NVRTC {major.value}.{minor.value}, {arch}, {kernel}: {'compiled' if ok else 'REFUSED'}")
             for line in log.splitlines():

@@ -10,6 +10,7 @@ fn main() {
     println!("cargo:rerun-if-changed=kernel/fast.c");
     println!("cargo:rerun-if-changed=kernel/libm.h");
     println!("cargo:rerun-if-changed=kernel/terrain.h");
+    println!("cargo:rerun-if-changed=kernel/spheres.h");
     println!("cargo:rerun-if-changed=kernel/trig.h");
     println!("cargo:rerun-if-changed=kernel/eval.h");
     println!("cargo:rerun-if-changed=kernel/exp.h");

@@ -21,7 +21,11 @@
 //! heightfield, the kernel compiled with terrain), its evolved gait and
 //! random ones.
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|rough] [COUNT] [SECONDS]
+//! `rocks`: the walker among rocks (`scenes/walker_rocks.toml`: sphere
+//! contact, the event, in a kernel of its own), gaits about its own, each
+//! gene moved by up to 5 % of its range.
+//!
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|rough|rocks] [COUNT] [SECONDS]
 //!
 //! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too.
 //!
@@ -41,6 +45,7 @@ const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
 const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml");
 const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
 const WALKER_ROUGH: &str = include_str!("../../../scenes/walker_rough_evolved.toml");
+const WALKER_ROCKS: &str = include_str!("../../../scenes/walker_rocks.toml");
 
 fn fail(e: impl std::fmt::Display) -> ! {
     eprintln!("gpu_evaluate: {e}");
@@ -67,13 +72,16 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
             .map(|&(lo, hi)| rng.between(lo, hi))
             .collect();
         problem.scene(&g)
-    } else if kind == "quadruped" || kind == "roobot" {
+    } else if kind == "quadruped" || kind == "roobot" || kind == "rocks" {
         let (text, file, spread) = if kind == "quadruped" {
             (
                 QUADRUPED_WALK.to_string(),
                 "scenes/quadruped3_walk.toml",
                 0.05,
             )
+        } else if kind == "rocks" {
+            // Gaits about the walker's, which walk into the rocks.
+            (duration(WALKER_ROCKS), "scenes/walker_rocks.toml", 0.05)
         } else {
             let evolved = HOP_EVOLVER.replace("params = \"initial\"", "params = \"evolved\"");
             (evolved, "scenes/hop_evolver.toml", 0.02)
@@ -120,10 +128,10 @@ fn main() {
         .unwrap_or_else(|_| fail("SECONDS: a number"));
     if !matches!(
         kind,
-        "walker" | "bodies" | "neural" | "quadruped" | "roobot" | "rough"
+        "walker" | "bodies" | "neural" | "quadruped" | "roobot" | "rough" | "rocks"
     ) || !(1..=10_000_000).contains(&count)
     {
-        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot|rough] [COUNT 1 to 10,000,000] [SECONDS]");
+        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot|rough|rocks] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");

@@ -15,7 +15,8 @@
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
  * constant forces, fluids (still or in a uniform current) on every particle and their drag across springs ([fluid]
- * springs), soft (penalty) contact between spheres, the
+ * springs), soft (penalty) contact between spheres, sphere contact, the
+ * event (spheres.h), the
  * floor, flat or on terrain (terrain.h: its located collisions with backtracking, and its contact force), and the explicit integrators
  * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
@@ -31,6 +32,7 @@
 #endif
 #include "libm.h"
 #include "terrain.h"
+#include "spheres.h"
 
 /* Integrators, as IntegratorKind's order in the engine. */
 enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
@@ -179,6 +181,12 @@ typedef struct {
     const double *terrain_param;  /* the floor's shape (terrain.h): its numbers */
     const double *terrain_height; /* a heightfield's heights */
     int terrain;                  /* AN_T_FLAT ... (terrain.h) */
+    const long long *first_excluded; /* per creature: its sphere contact's excluded pairs */
+    const long long *excluded;    /* sorted keys, min << 32 | max (spheres.h) */
+    const double *contact_param;  /* 4 per creature: 1 if it has sphere contact, its
+                                     envelope, rest speed, restitution (NaN: the spheres') */
+    const long long *first_slot;  /* per creature: its room in contact_slot */
+    long long *contact_slot;      /* 4 n + n (n - 1) / 2 a creature with sphere contact */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -901,6 +909,17 @@ AN_FN int an_finite(const double *x, long long m3) {
     return 1;
 }
 
+/* Whether a creature with these contact numbers has sphere contact. On a
+ * GPU its code is in a kernel of its own, compiled with AN_SPHERES for
+ * the batches that have it (src/cuda.rs): in the others it took the flat
+ * floor's evaluation from 168 registers to 224 (bench/nvrtc.py). The C
+ * compiled for the CPU always has it. */
+#if defined(__CUDACC_RTC__) && !defined(AN_SPHERES)
+#define AN_HAS_SPHERES(cp) 0
+#else
+#define AN_HAS_SPHERES(cp) ((cp)[0] != 0.0)
+#endif
+
 /* One step of creature c (world/step.rs: a trial of the whole step;
  * after a missed collision, the step again in pieces, halved while one is
  * missed down to 1/1024 of the step, and grown back once they line up).
@@ -916,13 +935,41 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     double dt = b->dt;
     const long long total = 1LL << 10; /* MAX_BACKTRACK_DEPTH */
     long long done = 0, piece = total;
+    /* Sphere contact (spheres.h), after the floor among the world's events. */
+    const double *cp = b->contact_param + 4 * c;
+    int contact = AN_HAS_SPHERES(cp);
+    an_spheres sp = {0};
+    if (contact) {
+        long long e0 = b->first_excluded[c];
+        sp.r = st.r;
+        sp.w = st.w;
+        sp.e = b->restitution + p0;
+        sp.mu_s = b->mu_s + p0;
+        sp.mu_k = b->mu_k + p0;
+        sp.excluded = b->excluded + e0;
+        sp.n_excluded = b->first_excluded[c + 1] - e0;
+        sp.envelope = cp[1];
+        sp.rest_speed = cp[2];
+        sp.restitution = cp[3];
+        sp.step = dt;
+        sp.held = b->floor != 0;
+        sp.slots = b->contact_slot + b->first_slot[c];
+        sp.pair = sp.slots + 4 * n;
+        sp.pairs = 0;
+    }
     while (done < total) {
         double h = piece == total ? dt : dt * ((double)piece / (double)total);
         an_integrate(b, st, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
         int state = !b->floor                  ? AN_NONE
                     : AN_ON_TERRAIN(b) ? an_terrain_check(b, st, n, x1)
                                               : an_floor_check(b, st, n, x1);
-        if (state == AN_MISSED) {
+        /* (A trial the floor missed is taken again in pieces whatever the
+         * spheres say, unless it cannot be split.) */
+        int spheres = AN_NONE;
+        if (contact && (state != AN_MISSED || piece == 1)) {
+            spheres = an_spheres_check(&sp, n, x, x1);
+        }
+        if (state == AN_MISSED || spheres == AN_MISSED) {
             if (piece == total) {
                 piece = total / 2; /* the step again, in pieces */
                 continue;
@@ -931,7 +978,8 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
                 piece /= 2;
                 continue;
             }
-            state = AN_OCCURRING; /* cannot split further */
+            /* Cannot split further: each handled as if occurring. */
+            state = state == AN_MISSED ? AN_OCCURRING : state;
         }
         /* Every event checks the trial before any handles it, then each
          * handles it in the world's order. */
@@ -948,6 +996,9 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
             an_terrain_handle(b, st, p0, n, h, dt, v, x1, v1); /* (no planes on terrain) */
         } else if (state != AN_NONE) {
             an_floor_handle(b, st, p0, n, h, dt, v, x1, v1, rec);
+        }
+        if (spheres != AN_NONE) {
+            an_spheres_handle(&sp, x1, v1); /* (no planes with sphere contact) */
         }
         an_planes_handle(b, c, off, 0, x1, v1);
         if (!an_finite(x1, m3) || !an_finite(v1, m3)) {

@@ -27,6 +27,7 @@ fn source() -> String {
     [
         include_str!("../kernel/libm.h"),
         include_str!("../kernel/terrain.h"),
+        include_str!("../kernel/spheres.h"),
         include_str!("../kernel/trig.h"),
         include_str!("../kernel/exp.h"),
         include_str!("../kernel/step.h"),
@@ -49,6 +50,9 @@ pub struct Device {
     flat: Kernels,
     /// The kernel with terrain, compiled when a batch on terrain first comes.
     terrain: std::sync::OnceLock<Result<Kernels, String>>,
+    /// The kernel with sphere contact (on the flat floor, `AN_SPHERES`),
+    /// compiled when a batch with it first comes.
+    spheres: std::sync::OnceLock<Result<Kernels, String>>,
     name: String,
     arch: (i32, i32),
     mode: Mode,
@@ -114,12 +118,13 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let flat = kernels(&ctx, arch, &name, true, mode)?;
+        let flat = kernels(&ctx, arch, &name, Variant::Flat, mode)?;
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
             flat,
             terrain: std::sync::OnceLock::new(),
+            spheres: std::sync::OnceLock::new(),
             name,
             arch,
             mode,
@@ -127,14 +132,17 @@ impl Device {
         })
     }
 
-    /// The kernel for `batch`: the flat floor's, or terrain's (compiled
-    /// now if it was not yet).
+    /// The kernel for `batch`: the flat floor's, terrain's or sphere
+    /// contact's (compiled now if it was not yet).
     fn kernels(&self, batch: &Batch) -> Result<&Kernels, String> {
-        if !batch.on_terrain() {
+        let (cell, variant) = if batch.sphere_contact() {
+            (&self.spheres, Variant::Spheres)
+        } else if batch.on_terrain() {
+            (&self.terrain, Variant::Terrain)
+        } else {
             return Ok(&self.flat);
-        }
-        self.terrain
-            .get_or_init(|| kernels(&self.ctx, self.arch, &self.name, false, self.mode))
+        };
+        cell.get_or_init(|| kernels(&self.ctx, self.arch, &self.name, variant, self.mode))
             .as_ref()
             .map_err(Clone::clone)
     }
@@ -240,20 +248,35 @@ impl Device {
     }
 }
 
-/// The kernel compiled for `arch` in `mode` (`flat`: with `AN_FLAT_ONLY`), from
-/// the disk's cache where an earlier run kept it (src/cache.rs), else by
-/// NVRTC now, and kept.
+/// Which of the kernels: each holds only the code its batches need, so
+/// that the commonest hold the fewest registers.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Variant {
+    /// The flat floor (or none): `AN_FLAT_ONLY`.
+    Flat,
+    /// Terrain.
+    Terrain,
+    /// Sphere contact on the flat floor: `AN_FLAT_ONLY` and `AN_SPHERES`.
+    Spheres,
+}
+
+/// The kernel `variant` compiled for `arch` in `mode`, from the disk's
+/// cache where an earlier run kept it (src/cache.rs), else by NVRTC now,
+/// and kept.
 fn kernels(
     ctx: &Arc<CudaContext>,
     arch: (i32, i32),
     name: &str,
-    flat: bool,
+    variant: Variant,
     mode: Mode,
 ) -> Result<Kernels, String> {
     let src = source();
     let mut options = options(arch, mode);
-    if flat {
+    if variant != Variant::Terrain {
         options.push("-DAN_FLAT_ONLY".into());
+    }
+    if variant == Variant::Spheres {
+        options.push("-DAN_SPHERES".into());
     }
     let kept = crate::cache::folder()
         .map(|dir| crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch));

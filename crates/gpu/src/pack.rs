@@ -3,7 +3,8 @@
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
 use animats_engine::{
-    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, Terrain, World,
+    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, SphereContact,
+    Terrain, World,
 };
 use std::os::raw::{c_double, c_int, c_longlong};
 use std::sync::Arc;
@@ -138,6 +139,11 @@ pub(crate) struct Raw {
     terrain_param: *const c_double,
     terrain_height: *const c_double,
     terrain: c_int,
+    first_excluded: *const c_longlong,
+    excluded: *const c_longlong,
+    contact_param: *const c_double,
+    first_slot: *const c_longlong,
+    contact_slot: *mut c_longlong,
 }
 
 extern "C" {
@@ -272,6 +278,16 @@ pub struct Batch {
     terrain: c_int,
     terrain_param: Vec<f64>,
     terrain_height: Vec<f64>,
+    /// Sphere contact (events/sphere_contact, `kernel/spheres.h`): per
+    /// creature its excluded pairs as sorted keys (`min << 32 | max`), 4
+    /// numbers (1 if it has sphere contact, the envelope, the rest speed,
+    /// the restitution or NaN for the spheres' own) and its room for the
+    /// check's sorting and pairs (`4 n + n (n − 1) / 2`).
+    first_excluded: Vec<i64>,
+    excluded: Vec<i64>,
+    contact_param: Vec<f64>,
+    first_slot: Vec<i64>,
+    contact_slot: Vec<i64>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -282,8 +298,9 @@ impl Batch {
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
     /// torques, constant forces, fluids about every particle (still or in a uniform current), soft
-    /// contact, the flat floor under every particle): anything else is refused with a message naming the
-    /// world and what it holds.
+    /// contact, the floor under every particle, flat or shaped, plane
+    /// constraints, sphere contact among every particle): anything else is
+    /// refused with a message naming the world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(format!(
@@ -360,6 +377,11 @@ impl Batch {
             plane_param: Vec::new(),
             plane_first_particle: vec![0],
             plane_particle: Vec::new(),
+            first_excluded: vec![0],
+            excluded: Vec::new(),
+            contact_param: Vec::new(),
+            first_slot: vec![0],
+            contact_slot: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         if let Some(f) = &b.floor {
@@ -489,6 +511,41 @@ impl Batch {
             b.first_pair.push(b.pair_a.len() as i64);
             b.first_rod.push(b.rod_a.len() as i64);
             b.first_plane.push(b.plane_first_particle.len() as i64 - 1);
+            // Sphere contact ([`supported`]: one, after the floor, every
+            // particle, no sleeping).
+            let n = props.radius.len();
+            let contact = w
+                .events()
+                .iter()
+                .find_map(|e| e.as_any().downcast_ref::<SphereContact>());
+            match contact.map(SphereContact::def) {
+                Some(d) => {
+                    let mut keys: Vec<i64> = d
+                        .excluded
+                        .iter()
+                        .map(|(a, e)| {
+                            let (lo, hi) = (a.index().min(e.index()), a.index().max(e.index()));
+                            ((lo as i64) << 32) | hi as i64
+                        })
+                        .collect();
+                    keys.sort_unstable();
+                    keys.dedup();
+                    b.excluded.extend(keys);
+                    b.contact_param.extend([
+                        1.0,
+                        d.envelope,
+                        d.rest_speed,
+                        d.restitution.unwrap_or(f64::NAN),
+                    ]);
+                    b.contact_slot.resize(
+                        b.contact_slot.len() + 4 * n + n * n.saturating_sub(1) / 2,
+                        0,
+                    );
+                }
+                None => b.contact_param.extend([0.0; 4]),
+            }
+            b.first_excluded.push(b.excluded.len() as i64);
+            b.first_slot.push(b.contact_slot.len() as i64);
             b.ev.fixed.extend(props.fixed.iter().map(|&f| i32::from(f)));
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
@@ -499,6 +556,11 @@ impl Batch {
     /// Whether the batch's floor has a shape (`[terrain]`).
     pub fn on_terrain(&self) -> bool {
         self.terrain != 0
+    }
+
+    /// Whether a creature of the batch has sphere contact (the event).
+    pub fn sphere_contact(&self) -> bool {
+        self.contact_param.chunks(4).any(|p| p[0] != 0.0)
     }
 
     /// Creatures in the batch.
@@ -589,6 +651,7 @@ impl Batch {
             Array::NetScratch => self.ev.net_scratch.as_mut_ptr() as u64,
             Array::NeuronState => self.ev.neuron_state.as_mut_ptr() as u64,
             Array::MuscleWork => self.ev.muscle_work.as_mut_ptr() as u64,
+            Array::ContactSlot => self.contact_slot.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -712,6 +775,11 @@ impl Batch {
             Array::PlaneParticle => I32(&self.plane_particle),
             Array::TerrainParam => F64(&self.terrain_param),
             Array::TerrainHeight => F64(&self.terrain_height),
+            Array::FirstExcluded => I64(&self.first_excluded),
+            Array::Excluded => I64(&self.excluded),
+            Array::ContactParam => F64(&self.contact_param),
+            Array::FirstSlot => I64(&self.first_slot),
+            Array::ContactSlot => I64(&self.contact_slot),
         }
     }
 
@@ -884,6 +952,11 @@ impl Batch {
             terrain_param: c(Array::TerrainParam),
             terrain_height: c(Array::TerrainHeight),
             terrain: self.terrain,
+            first_excluded: l(Array::FirstExcluded),
+            excluded: l(Array::Excluded),
+            contact_param: c(Array::ContactParam),
+            first_slot: l(Array::FirstSlot),
+            contact_slot: at(Array::ContactSlot) as *mut c_longlong,
         }
     }
 }
@@ -907,13 +980,35 @@ fn supported(w: &World) -> Result<(), String> {
     }
     let mut planes = 0;
     let mut floors = 0;
+    let mut contacts = 0;
     for e in w.events() {
         let any = e.as_any();
         planes += usize::from(any.is::<PlaneConstraint>());
         floors += usize::from(any.is::<FloorCollision>());
-        if !any.is::<FloorCollision>() && !any.is::<PlaneConstraint>() {
+        if let Some(c) = any.downcast_ref::<SphereContact>() {
+            contacts += 1;
+            let d = c.def();
+            if d.sleep_speed > 0.0 {
+                return refuse("sphere contact with sleeping (`sleep_speed` > 0)");
+            }
+            if d.targets != Targets::All {
+                return refuse("sphere contact among some particles only");
+            }
+            if floors == 0 && w.events().iter().any(|e| e.as_any().is::<FloorCollision>()) {
+                return refuse("sphere contact before the floor among the world's events");
+            }
+        } else if !any.is::<FloorCollision>() && !any.is::<PlaneConstraint>() {
             return refuse(&format!("the event `{}`", e.name()));
         }
+    }
+    if contacts > 1 {
+        return refuse("a second sphere contact");
+    }
+    if contacts > 0 && planes > 0 {
+        return refuse("sphere contact with plane constraints");
+    }
+    if contacts > 0 && w.terrain().is_some_and(|t| !t.is_flat()) {
+        return refuse("sphere contact on terrain");
     }
     if floors > 1 {
         return refuse("a second floor");
@@ -1092,11 +1187,16 @@ pub(crate) enum Array {
     PlaneParticle,
     TerrainParam,
     TerrainHeight,
+    FirstExcluded,
+    Excluded,
+    ContactParam,
+    FirstSlot,
+    ContactSlot,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 111] = [
+    pub(crate) const ALL: [Array; 116] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1208,6 +1308,11 @@ impl Array {
         Array::PlaneParticle,
         Array::TerrainParam,
         Array::TerrainHeight,
+        Array::FirstExcluded,
+        Array::Excluded,
+        Array::ContactParam,
+        Array::FirstSlot,
+        Array::ContactSlot,
     ];
 }
 

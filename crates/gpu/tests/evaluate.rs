@@ -464,6 +464,64 @@ ranges = [[0.0, 1.0], [0.0, 6.0]]
     }
 }
 
+/// `n` scenes of `text`: its own genome, then genomes about it (each gene
+/// moved by up to 5 % of its range), gaits that walk.
+fn near(text: &str, n: usize, seed: u64) -> Vec<Scene> {
+    let problem = SceneProblem::parse(text, "walker.toml").unwrap();
+    let mut rng = Random::for_entry(seed, 0);
+    let mut scenes = vec![problem.fresh().unwrap()];
+    while scenes.len() < n {
+        let g: Vec<f64> = problem
+            .start()
+            .iter()
+            .zip(problem.bounds())
+            .map(|(&x, &(lo, hi))| (x + rng.between(-0.05, 0.05) * (hi - lo)).clamp(lo, hi))
+            .collect();
+        scenes.push(problem.scene(&g).unwrap());
+    }
+    scenes
+}
+
+/// `scenes/walker_rocks.toml` and its evolved gait: the walker bumping
+/// into rocks and pushing them aside (`[contacts]`: sphere contact, the
+/// event, located by backtracking), its gait and random ones, the whole
+/// 10 s.
+#[test]
+fn walkers_among_rocks_are_the_engine_s_to_the_bit() {
+    for (name, text) in [
+        (
+            "walker_rocks",
+            include_str!("../../../scenes/walker_rocks.toml"),
+        ),
+        (
+            "walker_rocks_evolved",
+            include_str!("../../../scenes/walker_rocks_evolved.toml"),
+        ),
+    ] {
+        assert!(text.contains("[contacts]"), "{name}");
+        let got = assert_same(near(text, 12, 11), name);
+        assert!(distinct_distances(&got) > 8, "{name}: {got:?}");
+        // The rocks are felt: without [contacts] the same walkers go
+        // elsewhere (but for the evolved gait, which learned to go round
+        // them).
+        let bare = text.replace("[contacts]", "");
+        let through: Vec<Evaluation> = near(&bare, 12, 11)
+            .into_iter()
+            .map(|s| animats_scene::evaluate::evaluate(s).unwrap())
+            .collect();
+        let differ = got
+            .iter()
+            .zip(&through)
+            .filter(|(a, b)| a.distance != b.distance)
+            .count();
+        eprintln!("{name}: the rocks changed {differ} of 12 walks");
+        assert!(
+            differ >= 8 || name == "walker_rocks_evolved",
+            "{name}: the rocks changed {differ} of 12 walks"
+        );
+    }
+}
+
 #[test]
 fn ctrnn_brains_are_the_engine_s_to_the_bit() {
     // The walker's CTRNN (its recurrent neurons' states carried from step

@@ -472,6 +472,121 @@ fn bodies_whose_spheres_touch_each_other_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Spheres that collide with each other as the discrete event
+/// (events/sphere_contact: `[contacts]`, the walker among its rocks): free
+/// spheres of mixed sizes, masses, restitutions and frictions thrown at
+/// each other above the floor, some fast enough to pass deeper than the
+/// envelope inside a step (backtracked) or through another (the swept
+/// test), some joined by springs (never colliding), some fixed, some with
+/// one restitution for every contact, with a floor and without; and random
+/// bodies among rocks. The C's pairs, passes and floor that holds spheres
+/// up are the engine's, to the bit.
+#[test]
+fn spheres_colliding_as_events_are_the_engine_s_to_the_bit() {
+    let mut rng = Random::for_entry(23, 0);
+    for (kind, floor) in INTEGRATORS
+        .into_iter()
+        .flat_map(|k| [(k, true), (k, false)])
+    {
+        let make = |rng: &mut Random, contact: bool| -> Vec<World> {
+            (0..24)
+                .map(|k| {
+                    let mut w = if k % 3 == 2 {
+                        // A body among rocks, as walker_rocks.toml.
+                        let n = 2 + (rng.uniform() * 14.0) as usize;
+                        let mut w = random_body(rng, n, true, k % 2 == 0, kind).unwrap();
+                        for p in w.particle_ids().collect::<Vec<_>>() {
+                            let x = w.position(p) + DVec3::new(0.0, 2.2, 0.0);
+                            w.set_position(p, x).unwrap();
+                        }
+                        for _ in 0..1 + (rng.uniform() * 12.0) as usize {
+                            let at = DVec3::new(
+                                rng.between(-2.0, 2.0),
+                                rng.between(0.05, 0.3),
+                                rng.between(-2.0, 2.0),
+                            );
+                            w.add_particle(
+                                ParticleDef::new(rng.between(0.2, 5.0))
+                                    .with_radius(rng.between(0.05, 0.3))
+                                    .at(at),
+                            )
+                            .unwrap();
+                        }
+                        w
+                    } else {
+                        let mut w = World::new();
+                        w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+                        w.set_integrator(kind);
+                        let n = 2 + (rng.uniform() * 29.0) as usize;
+                        let ids: Vec<_> = (0..n)
+                            .map(|i| {
+                                // Some small and fast at the middle of the
+                                // heap: 6 to 12 cm a step, more than their
+                                // radius (the swept test's).
+                                let fast = rng.uniform() < 0.15;
+                                let at = random_vec(rng, 0.6) + DVec3::new(0.0, 0.8, 0.0);
+                                let v = if fast {
+                                    (DVec3::new(0.0, 0.8, 0.0) - at).normalize_or_zero()
+                                        * rng.between(60.0, 120.0)
+                                } else {
+                                    random_vec(rng, 2.0)
+                                };
+                                let r = if fast { 0.03 } else { rng.between(0.03, 0.15) };
+                                let mut def = ParticleDef::new(rng.between(0.1, 3.0))
+                                    .with_radius(r)
+                                    .at(at)
+                                    .with_velocity(v);
+                                def.restitution = rng.between(0.0, 0.95);
+                                def.mu_s = rng.between(0.0, 1.0);
+                                def.mu_k = def.mu_s * rng.between(0.3, 1.0);
+                                def.fixed = i == 0 && k % 4 == 1;
+                                w.add_particle(def).unwrap()
+                            })
+                            .collect();
+                        for _ in 0..n / 4 {
+                            let a = (rng.uniform() * n as f64) as usize;
+                            let b = (a + 1 + (rng.uniform() * (n - 1) as f64) as usize) % n;
+                            if a != b {
+                                let rest = (w.position(ids[a]) - w.position(ids[b])).length();
+                                w.add_spring(SpringDef::new(ids[a], ids[b], 200.0, rest))
+                                    .unwrap();
+                            }
+                        }
+                        w
+                    };
+                    if floor {
+                        w.add_floor(FloorDef::default()).unwrap();
+                    }
+                    if contact {
+                        let def = animats_engine::SphereContactDef {
+                            restitution: (k % 4 == 3).then_some(0.3),
+                            ..Default::default()
+                        };
+                        w.add_sphere_contact(def).unwrap();
+                    }
+                    w
+                })
+                .collect()
+        };
+        let mut again = rng.clone();
+        let mut worlds = make(&mut rng, true);
+        let mut plain = make(&mut again, false);
+        let what = format!("spheres colliding, {kind:?}, floor {floor}");
+        assert_same(&mut worlds, 1e-3, 400, 3, &what);
+        let backtracked: u64 = worlds.iter().map(|w| w.stats().backtracks).sum();
+        let moved = ending_elsewhere(&worlds, &mut plain);
+        eprintln!("{what}: {backtracked} backtracks; {moved} of 24 worlds end elsewhere without their contacts");
+        assert!(
+            moved >= 16,
+            "{what}: the contacts changed only {moved} worlds"
+        );
+        assert!(
+            backtracked > 0,
+            "{what}: no contact was located by backtracking"
+        );
+    }
+}
+
 /// Bodies in water dragged across their springs (`[fluid] springs`,
 /// forces/rod_drag.rs), their spheres touching each other too (the C
 /// applies soft contact, then rod drag, as the engine's list of user forces
@@ -672,6 +787,70 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     floors.add_floor(FloorDef::default()).unwrap();
     let err = Batch::pack(&[&floors], 1e-3).unwrap_err();
     assert_eq!(err, "world 0: a second floor is not in the GPU step yet");
+
+    // Sphere contact: once, after the floor, among every particle, without
+    // sleeping, on the flat floor, without planes.
+    let spheres = |def: animats_engine::SphereContactDef, floor: bool| {
+        let mut w = plain();
+        if floor {
+            w.add_floor(FloorDef::default()).unwrap();
+        }
+        w.add_sphere_contact(def).unwrap();
+        w
+    };
+    assert!(Batch::pack(&[&spheres(Default::default(), true)], 1e-3).is_ok());
+    assert!(Batch::pack(&[&spheres(Default::default(), false)], 1e-3).is_ok());
+    let sleepy = animats_engine::SphereContactDef {
+        sleep_speed: 0.01,
+        ..Default::default()
+    };
+    let err = Batch::pack(&[&spheres(sleepy, true)], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact with sleeping (`sleep_speed` > 0) is not in the GPU step yet"
+    );
+    let some = animats_engine::SphereContactDef {
+        targets: animats_engine::Targets::Only(vec![animats_engine::ParticleId::from_index(0)]),
+        ..Default::default()
+    };
+    let err = Batch::pack(&[&spheres(some, true)], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact among some particles only is not in the GPU step yet"
+    );
+    let mut late = spheres(Default::default(), false);
+    late.add_floor(FloorDef::default()).unwrap();
+    let err = Batch::pack(&[&late], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact before the floor among the world's events is not in the GPU step yet"
+    );
+    let mut twice = spheres(Default::default(), true);
+    twice.add_sphere_contact(Default::default()).unwrap();
+    let err = Batch::pack(&[&twice], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: a second sphere contact is not in the GPU step yet"
+    );
+    let mut planed = spheres(Default::default(), true);
+    let ids: Vec<_> = planed.particle_ids().collect();
+    planed.add_event(Box::new(animats_engine::PlaneConstraint::new(
+        DVec3::ZERO,
+        DVec3::Z,
+        ids,
+    )));
+    let err = Batch::pack(&[&planed], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact with plane constraints is not in the GPU step yet"
+    );
+    let mut rough = sloped(0.2);
+    rough.add_sphere_contact(Default::default()).unwrap();
+    let err = Batch::pack(&[&rough], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact on terrain is not in the GPU step yet"
+    );
 
     let mut implicit = plain();
     implicit.set_integrator(IntegratorKind::Implicit);
