@@ -3,8 +3,8 @@
 //! log, optimiser state and best to the bit: CMA-ES on the soft walker
 //! with robust evaluation (a batch at the step, then one at half of it for
 //! the candidates that need it) and with perturbed trials, the body GA on
-//! random bodies, and MAP-Elites over bodies (its archive in the lanes'
-//! state).
+//! random bodies, MAP-Elites over bodies (its archive in the lanes'
+//! state), and CMA-ES on the walker among rocks (sphere contact).
 
 use animats_evolve::run::{Choices, Config, ProblemSpec, State};
 use animats_evolve::OptimiserKind;
@@ -12,6 +12,7 @@ use animats_scene::evaluate::Batches;
 
 const WALKER: &str = include_str!("../../../scenes/walker.toml");
 const BODIES_WALK: &str = include_str!("../../../scenes/bodies_walk.toml");
+const WALKER_ROCKS: &str = include_str!("../../../scenes/walker_rocks.toml");
 
 /// `generations` of `text` with `choices`, on the engine or in the C's
 /// batches: (log.csv, best.toml, the optimisers' states).
@@ -69,6 +70,23 @@ fn cma_es_on_the_walker_in_batches_writes_the_engine_s_log() {
         choices,
         "perturbed trials",
     );
+}
+
+/// The walker among its rocks (sphere contact, the event): CMA-ES in the
+/// C's batches writes the engine's log.
+#[test]
+fn cma_es_on_the_walker_among_rocks_in_batches_writes_the_engine_s_log() {
+    let choices = Choices {
+        generations: Some(3),
+        population: Some(8),
+        seed: Some(5),
+        lanes: Some(1),
+        optimiser: Some(OptimiserKind::CmaEs),
+        ..Choices::default()
+    };
+    let text = WALKER_ROCKS.replace("duration = 10.0", "duration = 3.0");
+    assert!(text.contains("duration = 3.0") && text.contains("[contacts]"));
+    assert_same(&text, choices, "walker among rocks");
 }
 
 #[test]
