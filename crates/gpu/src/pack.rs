@@ -961,6 +961,11 @@ impl Batch {
     }
 }
 
+/// The most particles a world with sphere contact may hold for the C (each
+/// creature's room for the pairs a check finds: `n (n − 1) / 2` numbers,
+/// 16 MiB at this size).
+const MAX_SPHERES: usize = 2048;
+
 /// The most plane constraints a world may hold for the C (it notes which
 /// of them a trial leaves, before handling any event, in one 64-bit word).
 const MAX_PLANES: usize = 64;
@@ -1003,6 +1008,12 @@ fn supported(w: &World) -> Result<(), String> {
     }
     if contacts > 1 {
         return refuse("a second sphere contact");
+    }
+    // (Its room for pairs grows as the square of the particles.)
+    if contacts > 0 && w.len() > MAX_SPHERES {
+        return refuse(&format!(
+            "sphere contact among more than {MAX_SPHERES} particles"
+        ));
     }
     if contacts > 0 && planes > 0 {
         return refuse("sphere contact with plane constraints");

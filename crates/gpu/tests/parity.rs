@@ -844,6 +844,17 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         err,
         "world 0: sphere contact with plane constraints is not in the GPU step yet"
     );
+    let mut crowd = plain();
+    for k in 0..2047 {
+        let at = DVec3::new(k as f64, 1.0, 0.0);
+        crowd.add_particle(ParticleDef::new(1.0).at(at)).unwrap();
+    }
+    crowd.add_sphere_contact(Default::default()).unwrap();
+    let err = Batch::pack(&[&crowd], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: sphere contact among more than 2048 particles is not in the GPU step yet"
+    );
     let mut rough = sloped(0.2);
     rough.add_sphere_contact(Default::default()).unwrap();
     let err = Batch::pack(&[&rough], 1e-3).unwrap_err();
