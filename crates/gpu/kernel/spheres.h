@@ -113,6 +113,29 @@ AN_FN int an_run_of(const long long *key, long long count, const long long *want
     return end > lo;
 }
 
+/* grid.rs `test` of spheres a and b at x: whether they are a pair (both
+ * not fixed, within reach and the margin, not excluded), deepening
+ * *deepest by their overlap where they are. */
+AN_FN int an_sphere_test(const an_spheres *s, const double *x, long long a, long long b,
+                         double margin, double *deepest) {
+    if (s->w[a] == 0.0 && s->w[b] == 0.0) {
+        return 0;
+    }
+    double reach = s->r[a] + s->r[b];
+    double dx = x[3 * b] - x[3 * a], dy = x[3 * b + 1] - x[3 * a + 1],
+           dz = x[3 * b + 2] - x[3 * a + 2];
+    double d2 = dx * dx + dy * dy + dz * dz;
+    double outer = reach + margin;
+    if (d2 >= outer * outer) {
+        return 0;
+    }
+    if (s->n_excluded > 0 && an_excluded(s, a, b)) {
+        return 0;
+    }
+    *deepest = an_max(*deepest, reach - sqrt(d2));
+    return 1;
+}
+
 /* The deepest overlap of the trial's spheres at x (grid.rs `find`), the
  * pairs found kept in s->pair. */
 AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
@@ -176,8 +199,57 @@ AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
     }
     double margin = s->rest_speed * s->step;
     double deepest = 0.0;
+    if (dense) {
+        /* Each sphere against those after it whose cell is its own or one
+         * of its 13 forward neighbours (the slots are in cell order, so
+         * the scan ends at the first two cells further along x); the pairs
+         * of each run of one cell then put in the grid's order: by
+         * neighbour (its own cell first), then sphere, then sphere. The
+         * test of a pair does not depend on when it is made, so these are
+         * the engine's pairs in the engine's order. */
+        long long start = 0;
+        while (start < count) {
+            long long end = start + 1;
+            while (end < count && key[3 * end] == key[3 * start] &&
+                   key[3 * end + 1] == key[3 * start + 1] &&
+                   key[3 * end + 2] == key[3 * start + 2]) {
+                end++;
+            }
+            long long first = s->pairs;
+            for (long long qa = start; qa < end; qa++) {
+                const long long *ka = key + 3 * qa;
+                for (long long qb = qa + 1; qb < count; qb++) {
+                    const long long *kb = key + 3 * qb;
+                    long long d0 = kb[0] - ka[0], d1 = kb[1] - ka[1], d2 = kb[2] - ka[2];
+                    if (d0 > 1) {
+                        break;
+                    }
+                    if (d1 < -1 || d1 > 1 || d2 < -1 || d2 > 1) {
+                        continue;
+                    }
+                    /* The neighbour's place in grid.rs FORWARD: 0 its own
+                     * cell, then 1 .. 13. */
+                    long long o = (d0 + 1) * 9 + (d1 + 1) * 3 + (d2 + 1) - 13;
+                    if (an_sphere_test(s, x, who[qa], who[qb], margin, &deepest)) {
+                        long long k = (o << 40) | (qa << 20) | qb;
+                        long long at = s->pairs++;
+                        while (at > first && pair[at - 1] > k) {
+                            pair[at] = pair[at - 1];
+                            at--;
+                        }
+                        pair[at] = k;
+                    }
+                }
+            }
+            for (long long q = first; q < s->pairs; q++) {
+                long long qa = (pair[q] >> 20) & 0xfffff, qb = pair[q] & 0xfffff;
+                pair[q] = an_pair_key(who[qa], who[qb]);
+            }
+            start = end;
+        }
+        return deepest;
+    }
     long long start = 0;
-    long long next[13] = {0};
     while (start < count) {
         long long i0 = who[start];
         long long c[3] = {an_sphere_cell(x[3 * i0], size), an_sphere_cell(x[3 * i0 + 1], size),
@@ -190,64 +262,24 @@ AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
         for (int o = -1; o < 13; o++) {
             long long rs = start, re = end;
             if (o >= 0) {
-                long long want[3];
-                int out = 0;
                 /* grid.rs FORWARD[1..]: the offsets after (0, 0, 0) in
                  * the order of (dx, dy, dz), 27 cells numbered from
-                 * (-1, -1, -1). */
+                 * (-1, -1, -1); a sparse grid's keys clamped. */
                 int cell = 14 + o;
                 int off[3] = {cell / 9 - 1, (cell / 3) % 3 - 1, cell % 3 - 1};
+                long long want[3];
                 for (int k = 0; k < 3; k++) {
-                    want[k] = c[k] + off[k];
-                    if (dense) {
-                        out |= want[k] < lo[k] || want[k] > hi[k];
-                    } else {
-                        want[k] = an_key_part(want[k]);
-                    }
+                    want[k] = an_key_part(c[k] + off[k]);
                 }
-                if (out) {
-                    continue;
-                }
-                if (dense) {
-                    /* The runs come in the order of their cells, and so do
-                     * their neighbours at one offset: each offset's search
-                     * goes on from where its last one ended. */
-                    long long q = next[o];
-                    while (q < count && an_slot_before(key + 3 * q, 1, want, 0)) {
-                        q++;
-                    }
-                    next[o] = q;
-                    for (re = q; re < count && key[3 * re] == want[0] &&
-                                 key[3 * re + 1] == want[1] && key[3 * re + 2] == want[2];
-                         re++) {
-                    }
-                    rs = q;
-                    if (re == rs) {
-                        continue;
-                    }
-                } else if (!an_run_of(key, count, want, &rs, &re)) {
+                if (!an_run_of(key, count, want, &rs, &re)) {
                     continue;
                 }
             }
             for (long long qa = start; qa < end; qa++) {
                 for (long long qb = o < 0 ? qa + 1 : rs; qb < re; qb++) {
-                    long long a = who[qa], b = who[qb];
-                    if (s->w[a] == 0.0 && s->w[b] == 0.0) {
-                        continue;
+                    if (an_sphere_test(s, x, who[qa], who[qb], margin, &deepest)) {
+                        pair[s->pairs++] = an_pair_key(who[qa], who[qb]);
                     }
-                    double reach = s->r[a] + s->r[b];
-                    double dx = x[3 * b] - x[3 * a], dy = x[3 * b + 1] - x[3 * a + 1],
-                           dz = x[3 * b + 2] - x[3 * a + 2];
-                    double d2 = dx * dx + dy * dy + dz * dz;
-                    double outer = reach + margin;
-                    if (d2 >= outer * outer) {
-                        continue;
-                    }
-                    if (s->n_excluded > 0 && an_excluded(s, a, b)) {
-                        continue;
-                    }
-                    deepest = an_max(deepest, reach - sqrt(d2));
-                    pair[s->pairs++] = an_pair_key(a, b);
                 }
             }
         }
