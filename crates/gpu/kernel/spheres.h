@@ -11,8 +11,11 @@
  * then y, then z; a dense grid's linear index and a sparse grid's packed
  * key both order them so), the spheres of a cell by index, each cell
  * against itself and then its 13 forward neighbours. Here the spheres are
- * sorted by (cell, index) and each neighbour's run found by its cell: the
- * same pairs in the same order, with no grid. */
+ * sorted by (cell, index); on a dense grid each is tested against those
+ * after it in its own and its forward neighbours' cells and each cell's
+ * pairs put in the grid's order, on a sparse one (whose keys are clamped)
+ * each neighbour's run is searched for: the same pairs in the same order,
+ * with no grid. */
 
 #ifndef ANIMATS_SPHERES_H
 #define ANIMATS_SPHERES_H
