@@ -1,4 +1,9 @@
-//! Steps the built-in nbody5 world N times (for a profiler).
+//! Steps the built-in nbody5 world N times, or with `reference` the
+//! reference program's `advance`, and prints the energy: a workload for a
+//! profiler (`valgrind --tool=callgrind target/release/examples/nbody5_steps
+//! 200000 [reference]`; docs/PERFORMANCE.md).
+//!
+//!     cargo build --release -p animats-bench --example nbody5_steps
 fn main() {
     let n: usize = std::env::args()
         .nth(1)

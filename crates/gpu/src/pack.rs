@@ -189,7 +189,8 @@ pub(crate) const CHUNK: usize = 64;
 pub(crate) struct Shared(pub(crate) Raw);
 
 // SAFETY: the threads read the shared arrays and write only the positions,
-// velocities and scratch of their own creatures: disjoint ranges.
+// velocities, scratch (sphere contact's room among it) and evaluation state
+// of their own creatures: disjoint ranges.
 unsafe impl Sync for Shared {}
 
 impl Shared {
