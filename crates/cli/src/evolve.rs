@@ -141,7 +141,7 @@ fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
         animats_files::write_atomically(&dir.join("checked.toml"), text.as_bytes())
             .map_err(Failure::Other)?;
     }
-    for line in report.lines(dir) {
+    for line in report.lines(Some(dir)) {
         say!("  {line}");
     }
     Ok(checked.is_some())

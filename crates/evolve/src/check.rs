@@ -99,8 +99,8 @@ impl Report {
     }
 
     /// The lines that tell what the checks found, `dir` being where
-    /// `checked.toml` is written.
-    pub fn lines(&self, dir: &Path) -> Vec<String> {
+    /// `checked.toml` was written (`None`: nowhere, and no line says so).
+    pub fn lines(&self, dir: Option<&Path>) -> Vec<String> {
         let logged = self.fitness;
         let mut out = Vec::new();
         for c in &self.best {
@@ -129,11 +129,14 @@ impl Report {
                 "check: the best at a quarter of the step could not be run: {e}"
             )),
             Verdict::Checked(c) if c.label != BEST => out.push(format!(
-                "check: the best that keeps 80 % in each check is {} (fitness {}; {}): wrote {}",
+                "check: the best that keeps 80 % in each check is {} (fitness {}; {}){}",
                 c.label,
                 c.fitness,
                 shares_text(&c.shares),
-                dir.join("checked.toml").display()
+                dir.map_or(String::new(), |d| format!(
+                    ": wrote {}",
+                    d.join("checked.toml").display()
+                ))
             )),
             Verdict::Checked(_) | Verdict::NotPositive => {}
             Verdict::NoOther => {

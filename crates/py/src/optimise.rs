@@ -477,9 +477,10 @@ impl Evolution {
     /// `distance`, `share` of the logged fitness or None); `checked`, the
     /// candidate that passed (`label`, `file`, `fitness`, `shares`, `toml`:
     /// `checked.toml`'s text) or None; `lines`, what `animats evolve`
-    /// prints of it. With `out`, writes `out/checked.toml` (created whole
-    /// or not at all) or, where none passed, removes an earlier one. None
-    /// before the first generation.
+    /// prints of it (without `out`, no line says where the file went).
+    /// With `out`, writes `out/checked.toml` (created whole or not at all)
+    /// or, where none passed, removes an earlier one. None before the
+    /// first generation.
     #[pyo3(signature = (out = None))]
     fn check<'py>(
         &self,
@@ -494,7 +495,6 @@ impl Evolution {
             return Ok(None);
         };
         let checked = report.checked_toml();
-        let dir = out.clone().unwrap_or_else(|| PathBuf::from("."));
         if let Some(out) = &out {
             let file = out.join("checked.toml");
             match &checked {
@@ -540,7 +540,7 @@ impl Evolution {
             }
             _ => d.set_item("checked", py.None())?,
         }
-        d.set_item("lines", report.lines(&dir))?;
+        d.set_item("lines", report.lines(out.as_deref()))?;
         Ok(Some(d))
     }
 

@@ -171,5 +171,10 @@ def test_check_picks_the_command_lines_candidate_where_the_best_fails(cli, tmp_p
             assert (py_dir / "checked.toml").read_bytes() == (cli_dir / "checked.toml").read_bytes()
         if any(c["share"] < 0.8 for c in report["best"]):
             assert report["checked"] is None or report["checked"]["label"].startswith("elite ")
+            # Without a directory nothing is written, and no line says so.
+            alone = run.check()
+            wrote = f": wrote {py_dir / 'checked.toml'}"
+            assert alone["lines"] == [l.replace(wrote, "") for l in report["lines"]]
+            assert all("wrote" not in l for l in alone["lines"])
             return
     pytest.fail("no seed of 1 to 6 gave a best that fails the checks")
