@@ -32,11 +32,20 @@ def test_a_ray_evolution_writes_the_command_lines_log(cluster, cli, crawler, tmp
         assert stats.generations == 6 and stats.retries == 0
         for f in ("log.csv", "best.toml"):
             assert (tmp_path / f"ray{actors}" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), (actors, f)
-        # The end's checks, run where the driver runs: the command line's checked.toml.
-        run.check(tmp_path / f"ray{actors}")
+        # The end's checks, run where the driver runs: the command line's
+        # checked.toml, and the report of `run.check`.
         f = "checked.toml"
         assert (tmp_path / "cli" / f).exists()
         assert (tmp_path / f"ray{actors}" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), actors
+        again = run.check()
+        assert stats.check is not None and stats.check["checked"] is not None
+        assert stats.check["best"] == again["best"] and stats.check["checked"] == again["checked"]
+        assert stats.check["checked"]["toml"] == (tmp_path / f"ray{actors}" / f).read_text()
+    # Without the checks (`--no-check`), an earlier checked.toml goes.
+    run, stats = distributed.evolve(str(crawler), actors=1, out=tmp_path / "ray1", check=False, **args)
+    assert stats.check is None
+    assert not (tmp_path / "ray1" / "checked.toml").exists()
+    assert (tmp_path / "ray1" / "log.csv").read_bytes() == (tmp_path / "cli" / "log.csv").read_bytes()
 
 
 def test_a_worker_killed_mid_generation_costs_time_not_results(cluster, cli, tmp_path):

@@ -84,6 +84,9 @@ class Stats:
     compute: float = 0.0
     #: Each actor's process id at the start.
     pids: List[int] = field(default_factory=list)
+    #: The end's checks of the winner (``Evolution.check``'s report), when
+    #: ``evolve`` wrote into a directory and checked; else ``None``.
+    check: Optional[dict] = None
 
 
 _LOST = None  # filled with Ray's exception types on first use
@@ -272,10 +275,15 @@ def evolve(
     out: Optional[str] = None,
     on_generation: Optional[Callable[[int, Pool], None]] = None,
     progress: bool = False,
+    check: bool = True,
 ) -> "tuple[_animats.Evolution, Stats]":
     """An ``animats evolve`` run whose evaluations are spread over Ray
-    actors; the same arguments and defaults, and the same ``log.csv`` and
-    ``best.toml`` (written into ``out`` if given). ``address``: the cluster
+    actors; the same arguments and defaults, and the same ``log.csv``,
+    ``best.toml`` and ``checked.toml`` (written into ``out`` if given: the
+    winner checked at a quarter of the step where the driver runs, as
+    ``animats evolve`` does at its end, the report in ``Stats.check``;
+    ``check=False`` skips that, as ``--no-check``, and removes an earlier
+    ``checked.toml``). ``address``: the cluster
     (``"auto"`` on a machine that ran ``ray start``); without it, Ray starts
     a local one unless one is already initialised. ``device``: where the
     actors evaluate (``Pool``'s; on ``"cuda"`` the same bytes again).
@@ -313,4 +321,11 @@ def evolve(
             run.save(out)
     finally:
         pool.shutdown()
+    if out is not None:
+        if check:
+            pool.stats.check = run.check(out)
+        else:
+            stale = os.path.join(out, "checked.toml")
+            if os.path.exists(stale):
+                os.remove(stale)
     return run, pool.stats
