@@ -5,7 +5,8 @@
 //!
 //! ```sh
 //! cargo run --release -p animats --example runs_curve -- docs/img/bodies_walk_curve.png \
-//!     "Five seeds of scenes/bodies_walk.toml, 10 minutes each" "distance in 10 s, m" \
+//!     "Best body of scenes/bodies_walk.toml, five seeds, 10 minutes each on 2 cores" \
+//!     "best distance in 10 s, m" \
 //!     "seed 1=walk1/log.csv" "seed 2=walk2/log.csv" "seed 3=walk3/log.csv" \
 //!     "seed 4=walk4/log.csv" "seed 5=walk5/log.csv" \
 //!     --line "the evolved walker, 4.31 m=4.31" --line "1.5 times it, 6.465 m=6.465"
