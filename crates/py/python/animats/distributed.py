@@ -24,6 +24,7 @@ from __future__ import annotations
 import os
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, Callable, List, Optional
 
 import numpy as np
@@ -325,7 +326,5 @@ def evolve(
         if check:
             pool.stats.check = run.check(out)
         else:
-            stale = os.path.join(out, "checked.toml")
-            if os.path.exists(stale):
-                os.remove(stale)
+            Path(out, "checked.toml").unlink(missing_ok=True)
     return run, pool.stats
