@@ -2,7 +2,8 @@
 //! binary: the log's body columns and the refusals' summary; `evaluate`
 //! on `best.toml` reproduces the logged fitness bit for bit; 1 and 2
 //! threads and a run killed and resumed write the same log and best; bad
-//! `[morphology]` keys exit 2 naming the field, and write nothing.
+//! `[morphology]` keys exit 2 naming the field, and write nothing; a body
+//! whose run blew up enters no cell.
 
 mod common;
 use common::*;
@@ -513,4 +514,67 @@ fn checked_toml_is_the_best_candidate_that_passes_both_checks() {
         passed && failed,
         "a seed whose best passes, and one whose best fails: seeds 1 to 6"
     );
+}
+
+/// A body whose run blew up enters no cell of the archive: at a step of
+/// 10 ms, past symplectic Euler's stability for the stiffest spring the
+/// budgets allow (800 N/m between particles of 20 g: ω ≈ 283 rad/s,
+/// stable below 2/ω ≈ 7 ms), some of `scenes/bodies_swim.toml`'s random
+/// bodies blow up, their distance read from a state on its way to
+/// infinity (−10²³⁰ m). Such elites filled 4 of this run's 19 cells and
+/// swamped its QD score (−1.9 × 10²³⁰) before they were refused.
+#[test]
+fn a_body_that_blew_up_enters_no_cell() {
+    let dir = scratch("bodies-blow-up");
+    let shipped = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bodies_swim.toml"),
+    )
+    .unwrap();
+    assert!(shipped.contains("\ndt = 0.0005\n"));
+    let scene = write(
+        &dir,
+        "coarse_swim.toml",
+        &shipped.replacen("\ndt = 0.0005\n", "\ndt = 0.01\n", 1),
+    );
+    let out = dir.join("run");
+    let o = animats(&[
+        "evolve",
+        &scene,
+        "--generations",
+        "3",
+        "--seed",
+        "1",
+        "--no-check",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (_, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let csv = std::fs::read_to_string(out.join("archive.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (objective, ended) = (col("objective"), col("ended"));
+    let mut elites = 0;
+    for line in csv.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_ne!(f[ended], "blow-up", "{line}");
+        // A swimmer's 20 s at these budgets: metres, not 10²³⁰.
+        let o: f64 = f[objective].parse().unwrap();
+        assert!(o.abs() < 100.0, "{line}");
+        elites += 1;
+    }
+    assert!(elites > 0, "{csv}");
+    // The log's QD score (Σ objective over elites) is as sane.
+    let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let qd = log
+        .lines()
+        .next()
+        .unwrap()
+        .split(',')
+        .position(|h| h == "qd_score")
+        .unwrap();
+    for line in log.lines().skip(1) {
+        let q: f64 = line.split(',').nth(qd).unwrap().parse().unwrap();
+        assert!(q.abs() < 100.0 * 64.0, "{line}");
+    }
 }

@@ -24,8 +24,8 @@
 //! `qd_score` (Σ (objective − `qd_offset`) over elites), `norm_qd_score`
 //! (qd_score / cells), `obj_max` and `obj_mean`.
 //!
-//! A candidate with a non-finite objective or measure, or one that survived
-//! less than `min_time`, enters no cell (status 0).
+//! A candidate with a non-finite objective or measure, one that survived
+//! less than `min_time`, or one whose run blew up, enters no cell (status 0).
 
 use crate::optimiser::Random;
 use animats_scene::archive::Grid;
@@ -279,6 +279,10 @@ impl GridArchive {
         // whether each candidate can enter.
         let mut answers = Vec::with_capacity(batch.len());
         let mut entering: BTreeMap<u64, Vec<usize>> = BTreeMap::new();
+        // A run that blew up describes no behaviour: its measures and its
+        // objective were read from a state on its way to infinity (a
+        // distance of −10²³⁰ m, which would swamp the QD score).
+        let blow_up = crate::problem::Ended::BlowUp.to_string();
         let eligible: Vec<bool> = batch
             .iter()
             .map(|c| {
@@ -286,6 +290,7 @@ impl GridArchive {
                     && c.measures.len() == k
                     && c.measures.iter().all(|m| m.is_finite())
                     && c.time >= self.grid.min_time
+                    && c.ended != blow_up
             })
             .collect();
         for (i, c) in batch.iter().enumerate() {
@@ -552,8 +557,14 @@ mod tests {
         assert_eq!(s.qd_score, 6.0);
         assert_eq!(s.norm_qd_score, 0.6);
         assert_eq!(s.obj_max, Some(4.0));
-        // NaN objective, NaN measure: not added.
-        let r = a.add(&[cand(&g, f64::NAN, &[0.5]), cand(&g, 9.0, &[f64::NAN])]);
+        // NaN objective, NaN measure, a blow-up: not added.
+        let mut blown = cand(&g, 9.0, &[0.5]);
+        blown.ended = "blow-up".into();
+        let r = a.add(&[
+            cand(&g, f64::NAN, &[0.5]),
+            cand(&g, 9.0, &[f64::NAN]),
+            blown,
+        ]);
         assert!(r.iter().all(|x| x.status == 0));
         assert_eq!(a.len(), 2);
     }
