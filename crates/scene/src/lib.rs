@@ -269,7 +269,8 @@ pub fn read(path: &Path) -> Result<String, SceneError> {
 
 /// Parses and builds a scene from its text; `file` names it in errors. A
 /// `[morphology]` scene is built with its starting body (the `start`
-/// scene's, or the first random body of seed 1) developed into it.
+/// scene's, or the first random body of seed 1) developed into it, and
+/// warns of a step too long for the bodies its budgets allow.
 pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
     let src = Source { file, text };
     let def = parse_def(&src)?;
@@ -284,7 +285,10 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         let developed = problem
             .develop(&genes, "")
             .map_err(|m| SceneError::file(file, m))?;
-        return parse(&developed, file);
+        let mut scene = parse(&developed, file)?;
+        let kind = scene.world.integrator();
+        scene.warnings.extend(problem.step_warning(scene.dt, kind));
+        return Ok(scene);
     }
     build::build(&def, &src)
 }

@@ -126,9 +126,23 @@ impl MorphologyProblem {
         };
         if let Some(g) = &problem.start {
             problem.check(g).map_err(|r| {
+                // A settle that blew up at a step past the body's own
+                // stability limit: say so.
+                let why = match r {
+                    Refusal::SettleBlowUp => problem
+                        .develop(g, "")
+                        .ok()
+                        .and_then(|t| crate::parse(&t, file).ok())
+                        .and_then(|s| crate::build::step_warning(&s.world, &s.names, s.dt))
+                        .map(|w| format!(" ({w})")),
+                    _ => None,
+                };
                 here.err(
                     "start",
-                    format!("the starting body fails its own checks: {r}"),
+                    format!(
+                        "the starting body fails its own checks: {r}{}",
+                        why.unwrap_or_default()
+                    ),
                 )
             })?;
         }
@@ -174,6 +188,32 @@ impl MorphologyProblem {
     /// The `[archive]` table's grid and settings, if the scene has one.
     pub fn grid(&self) -> Option<&crate::archive::Grid> {
         self.grid.as_ref()
+    }
+
+    /// A warning when `dt` is past the step at which `kind` keeps stable
+    /// the stiffest spring the budgets allow between two of their lightest
+    /// particles (`ω = √(2k/m)`, the pair's own mode: a body that has one
+    /// vibrates at least that fast): then some bodies will blow up, at
+    /// any seed. The base scene's own check cannot see this (it has no
+    /// body), nor does one developed body speak for the rest.
+    pub fn step_warning(&self, dt: f64, kind: animats_engine::IntegratorKind) -> Option<String> {
+        let m = &self.morphology;
+        let (lightest, what) = match (&m.lattice, m.encoding) {
+            (Some(shape), EncodingName::Lattice) => (
+                m.total_mass / (8.0 * shape.len() as f64),
+                "two corners of one cell",
+            ),
+            _ => (m.mass.0, "two of the lightest particles they allow"),
+        };
+        let k = m.stiffness.1;
+        let omega = (2.0 * k / lightest).sqrt();
+        let limit = kind.stable_omega_h() / omega;
+        (dt > limit && limit.is_finite()).then(|| {
+            format!(
+                "dt = {dt} s is {:.1} times the step at which {kind} keeps stable the stiffest spring the budgets allow ({k} N/m) between {what} ({lightest} kg each): ω = {omega:.1} rad/s, stable below {limit:.3e} s; expect some bodies to blow up (they keep none of their forward distance and enter no archive cell)",
+                dt / limit
+            )
+        })
     }
 
     /// The starting body's genes, if the scene names one.
