@@ -22,6 +22,8 @@ pub struct Scene {
     actuators: Vec<String>,
     sensors: Vec<String>,
     controllers: Vec<String>,
+    /// What `animats simulate` would warn of.
+    warnings: Vec<String>,
     /// The `[evolve]` controller's start and bounds.
     evolve: Option<Genome>,
 }
@@ -72,27 +74,42 @@ impl Scene {
                 .iter()
                 .map(|c| c.name.clone())
                 .collect(),
+            warnings: s.warnings.clone(),
             evolve,
             file,
             text,
         })
     }
+
+    /// Issues each of the scene's warnings as a Python `RuntimeWarning`
+    /// ("FILE: message", as `animats simulate` prints them).
+    fn warn(self, py: Python<'_>) -> PyResult<Scene> {
+        let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+        for w in &self.warnings {
+            let text = std::ffi::CString::new(format!("{}: {w}", self.file))
+                .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+            PyErr::warn(py, &category, &text, 1)?;
+        }
+        Ok(self)
+    }
 }
 
 /// Reads and checks the scene file at `path`. Raises `animats.SceneError`
-/// (a `ValueError`) naming the file, line, entry and field of a mistake.
+/// (a `ValueError`) naming the file, line, entry and field of a mistake;
+/// what is allowed but probably a mistake (a step past the springs'
+/// stability limit) is a `RuntimeWarning`, and in `Scene.warnings`.
 #[pyfunction]
-pub fn load(path: PathBuf) -> PyResult<Scene> {
+pub fn load(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
     let file = path.display().to_string();
     let text = animats_scene::read(&path).map_err(scene_error)?;
-    Scene::from_text(text, file)
+    Scene::from_text(text, file)?.warn(py)
 }
 
 /// Checks a scene given as text; `file` names it in messages.
 #[pyfunction]
 #[pyo3(signature = (text, file = "<string>".to_string()))]
-pub fn parse(text: String, file: String) -> PyResult<Scene> {
-    Scene::from_text(text, file)
+pub fn parse(py: Python<'_>, text: String, file: String) -> PyResult<Scene> {
+    Scene::from_text(text, file)?.warn(py)
 }
 
 #[pymethods]
@@ -191,6 +208,16 @@ impl Scene {
     }
 
     /// True when the scene has an `[evolve]` table.
+    /// What `animats simulate` would warn of: a step past the springs'
+    /// (or, for a `[morphology]` scene, the budgets') stability limit, a
+    /// particle that starts inside the floor, an actuator whose built value
+    /// lies outside its range. `load` and `parse` issue each as a
+    /// `RuntimeWarning`.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
     #[getter]
     fn evolvable(&self) -> bool {
         self.evolve.is_some()

@@ -3,6 +3,7 @@ evaluations (to the bit), the same evolution logs."""
 
 import json
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -199,7 +200,8 @@ def test_a_blow_up_raises_runtime_error_naming_the_particle(tmp_path):
         "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
         "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
     )
-    w = animats.load(s).world()
+    with pytest.warns(RuntimeWarning, match="expect a blow-up"):
+        w = animats.load(s).world()
     with pytest.raises(RuntimeError) as e:
         w.step(100_000)
     assert "diverged" in str(e.value) and "particle #0" in str(e.value), str(e.value)
@@ -258,3 +260,37 @@ def test_a_cpu_without_the_build_s_instructions_is_refused_at_import():
     else:
         # A baseline build (RUSTFLAGS="-C target-cpu=x86-64") needs nothing.
         assert r.returncode == 0 and "imported" in r.stdout, r
+
+
+def test_a_step_past_the_stability_limit_is_a_runtime_warning(root, tmp_path):
+    # Two 10 g particles joined by 1e6 N/m: the pair's mode is
+    # ω = √(2k/m) = 14,142 rad/s; explicit Euler is given symplectic
+    # Euler's ω h ≤ 2, so 1.414e-4 s, and 0.01 s is 70.7 times that.
+    s = tmp_path / "stiff.toml"
+    s.write_text(
+        "[world]\ndt = 0.01\nintegrator = \"euler\"\n"
+        "[[particle]]\nname = \"a\"\nmass = 0.01\nposition = [0.0, 1.0, 0.0]\nradius = 0.01\n"
+        "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
+        "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
+    )
+    with pytest.warns(RuntimeWarning) as caught:
+        scene = animats.load(s)
+    assert len(caught) == 1 and len(scene.warnings) == 1
+    w = scene.warnings[0]
+    assert str(caught[0].message) == f"{s}: {w}"
+    assert w.startswith("dt = 0.01 s is 70.7 times the step at which euler") and "stable below 1.414e-4 s" in w, w
+    # The same text through `parse`, named as given.
+    with pytest.warns(RuntimeWarning, match="^mine.toml: dt = 0.01 s"):
+        animats.parse(s.read_text(), "mine.toml")
+    # A [morphology] scene at 10 ms: 800 N/m between two 20 g particles,
+    # ω = 282.8 rad/s, symplectic Euler stable below 7.071e-3 s.
+    swim = (root / "scenes" / "bodies_swim.toml").read_text()
+    assert "\ndt = 0.0005\n" in swim
+    with pytest.warns(RuntimeWarning, match="expect some bodies to blow up"):
+        coarse = animats.parse(swim.replace("\ndt = 0.0005\n", "\ndt = 0.01\n", 1), "coarse.toml")
+    assert any("stable below 7.071e-3 s" in x for x in coarse.warnings), coarse.warnings
+    # The shipped scenes load without a word.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in ("bodies_swim.toml", "bodies_walk.toml", "walker.toml"):
+            assert animats.load(root / "scenes" / name).warnings == []

@@ -36,6 +36,9 @@ class Scene:
     actuators: List[str]
     sensors: List[str]
     controllers: List[str]
+    #: What `animats simulate` would warn of; `load` and `parse` issue each
+    #: as a RuntimeWarning.
+    warnings: List[str]
     evolvable: bool
     def world(self, genome: Optional[Sequence[float]] = None) -> World: ...
     def best_toml(self, genome: Sequence[float]) -> str: ...
