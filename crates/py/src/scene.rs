@@ -207,7 +207,6 @@ impl Scene {
         self.controllers.clone()
     }
 
-    /// True when the scene has an `[evolve]` table.
     /// What `animats simulate` would warn of: a step past the springs'
     /// (or, for a `[morphology]` scene, the budgets') stability limit, a
     /// particle that starts inside the floor, an actuator whose built value
@@ -218,6 +217,7 @@ impl Scene {
         self.warnings.clone()
     }
 
+    /// True when the scene has an `[evolve]` table.
     #[getter]
     fn evolvable(&self) -> bool {
         self.evolve.is_some()
