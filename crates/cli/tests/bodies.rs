@@ -375,13 +375,27 @@ fn bad_morphology_exits_2_naming_the_field_and_writes_nothing() {
     assert!(text(&o).1.contains("body-ga"), "{}", text(&o).1);
 }
 
+/// The shipped scene `scenes/NAME`'s text.
+fn shipped(name: &str) -> String {
+    std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../scenes")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// The shipped scene `scenes/NAME` (whose step is 0.5 ms) at step `dt`.
+fn shipped_at(name: &str, dt: &str) -> String {
+    let text = shipped(name);
+    assert!(text.contains("\ndt = 0.0005\n"), "{name}");
+    text.replacen("\ndt = 0.0005\n", &format!("\ndt = {dt}\n"), 1)
+}
+
 /// `scenes/bodies_walk.toml` at a coarse step (2 ms) and scored once, not
 /// robust: its early bests are often tuned to the step's errors.
 fn coarse_walk() -> String {
-    let shipped = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bodies_walk.toml"),
-    )
-    .unwrap();
+    let shipped = shipped("bodies_walk.toml");
     // The step's line whole (its comment speaks of 0.5 ms).
     let coarse: String = shipped
         .lines()
@@ -526,15 +540,10 @@ fn checked_toml_is_the_best_candidate_that_passes_both_checks() {
 #[test]
 fn a_body_that_blew_up_enters_no_cell() {
     let dir = scratch("bodies-blow-up");
-    let shipped = std::fs::read_to_string(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/bodies_swim.toml"),
-    )
-    .unwrap();
-    assert!(shipped.contains("\ndt = 0.0005\n"));
     let scene = write(
         &dir,
         "coarse_swim.toml",
-        &shipped.replacen("\ndt = 0.0005\n", "\ndt = 0.01\n", 1),
+        &shipped_at("bodies_swim.toml", "0.01"),
     );
     let out = dir.join("run");
     let o = animats(&[
@@ -614,12 +623,10 @@ fn the_step_is_checked_against_the_budgets_stiffest_mode() {
         );
     }
     let dir = scratch("bodies-lattice-step");
-    let lattice = std::fs::read_to_string(root.join("bodies_lattice.toml")).unwrap();
-    assert!(lattice.contains("\ndt = 0.0005\n"));
     let scene = write(
         &dir,
         "coarse_lattice.toml",
-        &lattice.replacen("\ndt = 0.0005\n", "\ndt = 0.0023\n", 1),
+        &shipped_at("bodies_lattice.toml", "0.0023"),
     );
     let o = animats(&["simulate", &scene, "--duration", "0.01"]);
     let (_, err) = text(&o);
@@ -634,7 +641,7 @@ fn the_step_is_checked_against_the_budgets_stiffest_mode() {
     let scene = write(
         &dir,
         "coarser_lattice.toml",
-        &lattice.replacen("\ndt = 0.0005\n", "\ndt = 0.0025\n", 1),
+        &shipped_at("bodies_lattice.toml", "0.0025"),
     );
     let o = animats(&["simulate", &scene, "--duration", "0.01"]);
     let (_, err) = text(&o);

@@ -11,6 +11,15 @@ import pytest
 import animats
 
 
+# Two 10 g particles joined by 1e6 N/m, under explicit Euler at 10 ms.
+STIFF = (
+    "[world]\ndt = 0.01\nintegrator = \"euler\"\n"
+    "[[particle]]\nname = \"a\"\nmass = 0.01\nposition = [0.0, 1.0, 0.0]\nradius = 0.01\n"
+    "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
+    "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
+)
+
+
 def test_a_bad_scene_raises_scene_error_naming_file_line_entry_and_field(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(
@@ -194,12 +203,7 @@ def test_ask_and_tell_elsewhere_equal_run_here(crawler):
 def test_a_blow_up_raises_runtime_error_naming_the_particle(tmp_path):
     # A spring far too stiff for explicit Euler at this step diverges.
     s = tmp_path / "stiff.toml"
-    s.write_text(
-        "[world]\ndt = 0.01\nintegrator = \"euler\"\n"
-        "[[particle]]\nname = \"a\"\nmass = 0.01\nposition = [0.0, 1.0, 0.0]\nradius = 0.01\n"
-        "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
-        "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
-    )
+    s.write_text(STIFF)
     with pytest.warns(RuntimeWarning, match="expect a blow-up"):
         w = animats.load(s).world()
     with pytest.raises(RuntimeError) as e:
@@ -267,12 +271,7 @@ def test_a_step_past_the_stability_limit_is_a_runtime_warning(root, tmp_path):
     # ω = √(2k/m) = 14,142 rad/s; explicit Euler is given symplectic
     # Euler's ω h ≤ 2, so 1.414e-4 s, and 0.01 s is 70.7 times that.
     s = tmp_path / "stiff.toml"
-    s.write_text(
-        "[world]\ndt = 0.01\nintegrator = \"euler\"\n"
-        "[[particle]]\nname = \"a\"\nmass = 0.01\nposition = [0.0, 1.0, 0.0]\nradius = 0.01\n"
-        "[[particle]]\nname = \"b\"\nmass = 0.01\nposition = [0.2, 1.0, 0.0]\nradius = 0.01\n"
-        "[[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 1e6\nrest_length = 0.1\n"
-    )
+    s.write_text(STIFF)
     with pytest.warns(RuntimeWarning) as caught:
         scene = animats.load(s)
     assert len(caught) == 1 and len(scene.warnings) == 1

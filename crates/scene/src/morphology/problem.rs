@@ -198,17 +198,17 @@ impl MorphologyProblem {
     /// body), nor does one developed body speak for the rest.
     pub fn step_warning(&self, dt: f64, kind: animats_engine::IntegratorKind) -> Option<String> {
         let m = &self.morphology;
-        let (lightest, what) = match (&m.lattice, m.encoding) {
-            (Some(shape), EncodingName::Lattice) => (
+        let (lightest, what) = match &m.lattice {
+            Some(shape) => (
                 m.total_mass / (8.0 * shape.len() as f64),
                 "two corners of one cell",
             ),
-            _ => (m.mass.0, "two of the lightest particles they allow"),
+            None => (m.mass.0, "two of the lightest particles they allow"),
         };
         let k = m.stiffness.1;
         let omega = (2.0 * k / lightest).sqrt();
         let limit = kind.stable_omega_h() / omega;
-        (dt > limit && limit.is_finite()).then(|| {
+        (dt > limit).then(|| {
             format!(
                 "dt = {dt} s is {:.1} times the step at which {kind} keeps stable the stiffest spring the budgets allow ({k} N/m) between {what} ({lightest} kg each): ω = {omega:.1} rad/s, stable below {limit:.3e} s; expect some bodies to blow up (they keep none of their forward distance and enter no archive cell)",
                 dt / limit
