@@ -5,7 +5,9 @@
 #![allow(clippy::disallowed_methods)]
 
 use animats_creatures::brain::Brain;
-use animats_creatures::brains::{Condition, Fsm, FsmState, Neural, Oscillator, Transition};
+use animats_creatures::brains::{
+    Condition, Fsm, FsmState, Neural, Oscillator, OscillatorEntry, Transition,
+};
 use std::f64::consts::{PI, TAU};
 
 #[test]
@@ -15,6 +17,7 @@ fn the_oscillator_is_offset_plus_amplitude_times_sine() {
         amplitude: vec![0.4, 0.2],
         phase: vec![0.0, PI / 3.0],
         offset: vec![0.5, 0.3],
+        duty: None,
     };
     let mut out = [0.0; 2];
     for k in 0..200 {
@@ -40,6 +43,88 @@ fn the_oscillator_is_offset_plus_amplitude_times_sine() {
     for (x, (lo, hi)) in g.iter().zip(o.bounds()) {
         assert!(lo <= *x && *x <= hi);
     }
+}
+
+#[test]
+fn a_skewed_oscillator_rises_for_its_duty_and_half_is_the_sine() {
+    let (f, amp, off) = (1.25, 0.4, 0.5);
+    let mut o = Oscillator {
+        frequency: f,
+        amplitude: vec![amp, amp],
+        phase: vec![0.7, -2.0],
+        offset: vec![off, off],
+        duty: Some(vec![0.5, 0.2]),
+    };
+    let mut out = [0.0; 2];
+    // 1000 samples a cycle over two cycles: output 0 is the sine; output 1
+    // rises from trough to crest in 0.2 of a cycle and falls in 0.8.
+    let dt = 1.0 / (1000.0 * f);
+    let (mut rising, mut falling) = (0usize, 0usize);
+    let mut last = f64::NAN;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for k in 0..2000 {
+        let t = k as f64 * dt;
+        o.think(t, dt, &[], &mut out);
+        let sine = off + amp * (TAU * f * t + 0.7).sin();
+        assert!(
+            (out[0] - sine).abs() < 1e-12,
+            "duty 0.5 at t {t}: {} against {sine}",
+            out[0]
+        );
+        if last.is_finite() {
+            if out[1] > last {
+                rising += 1;
+            } else {
+                falling += 1;
+            }
+        }
+        last = out[1];
+        lo = lo.min(out[1]);
+        hi = hi.max(out[1]);
+    }
+    // 1999 intervals: 0.2 of them rising, to within the two turns a cycle.
+    assert!(
+        (rising as f64 - 0.2 * 1999.0).abs() <= 4.0,
+        "rising {rising} of 1999"
+    );
+    assert_eq!(rising + falling, 1999);
+    assert!((lo - (off - amp)).abs() < 1e-5 && (hi - (off + amp)).abs() < 1e-5);
+    // The trough is where the sine's is: at 2π f t + phase = −π/2.
+    let t_trough = (1.5 * PI + 2.0) / (TAU * f);
+    o.think(t_trough, dt, &[], &mut out);
+    assert!((out[1] - (off - amp)).abs() < 1e-12, "{}", out[1]);
+    // and the crest a fifth of a cycle later.
+    o.think(t_trough + 0.2 / f, dt, &[], &mut out);
+    assert!((out[1] - (off + amp)).abs() < 1e-12, "{}", out[1]);
+
+    // Genome: the duties after the offsets; each must stay inside (0, 1).
+    let g = o.genome();
+    assert_eq!(g.len(), 1 + 4 * 2);
+    assert_eq!(&g[7..], &[0.5, 0.2]);
+    let mut p = o.clone();
+    p.set_genome(&g).unwrap();
+    assert_eq!(p, o);
+    for bad in [0.0, 1.0, -0.3] {
+        let mut h = g.clone();
+        h[8] = bad;
+        assert!(p.set_genome(&h).unwrap_err().contains("duty"), "{bad}");
+    }
+    assert_eq!(o.bounds()[8], (0.1, 0.9));
+
+    // The entry: a duty per output, each strictly inside (0, 1).
+    let entry = |duty: Vec<f64>| OscillatorEntry {
+        name: "c".into(),
+        outputs: vec!["a".into(), "b".into()],
+        frequency: None,
+        amplitude: None,
+        phase: None,
+        offset: None,
+        duty: Some(duty),
+    };
+    assert!(entry(vec![0.3, 0.6]).build().is_ok());
+    assert!(entry(vec![0.3]).build().is_err());
+    let e = entry(vec![0.3, 1.0]).build().unwrap_err();
+    assert!(e.to_string().contains("duty"), "{e}");
 }
 
 #[test]

@@ -259,7 +259,13 @@ impl Rules {
             let kind = c.brain.kind();
             let g = c.brain.genome();
             let n = c.outputs.len();
-            if kind != "oscillator" || g.len() != 1 + 3 * n {
+            if kind == "oscillator" && g.len() != 1 + 3 * n {
+                return Err(format!(
+                    "the controller `{}` is a skewed oscillator (`duty`), which is not in the GPU evaluation yet: only sines are",
+                    c.name
+                ));
+            }
+            if kind != "oscillator" {
                 return Err(format!(
                     "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks, CTRNNs, FSMs and the roobot's hopping FSM are",
                     c.name

@@ -818,6 +818,18 @@ fn what_the_c_does_not_evaluate_is_refused_by_name() {
         animats_scene::parse(&WALKER[..WALKER.find("[evolve]").unwrap()], "walker.toml").unwrap();
     let err = Batch::pack_scenes(&[&plain]).unwrap_err();
     assert!(err.contains("[evolve]"), "{err}");
+    // A skewed oscillator (`duty`): the C has only sines.
+    let skewed = WALKER.replace(
+        "offset = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]\n",
+        "offset = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]\nduty = [0.3, 0.3, 0.3, 0.3, 0.3, 0.3]\n",
+    );
+    assert_ne!(skewed, WALKER);
+    let skewed = SceneProblem::parse(&skewed, "walker.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
+    let err = Batch::pack_scenes(&[&skewed]).unwrap_err();
+    assert!(err.contains("`gait`") && err.contains("duty"), "{err}");
     // Evaluated once.
     let walker = SceneProblem::parse(WALKER, "walker.toml")
         .unwrap()
