@@ -342,6 +342,47 @@ fn a_body_run_is_the_same_on_any_thread_count_and_after_a_kill() {
     assert_eq!(read(&killed, "best.toml"), read(&one, "best.toml"));
 }
 
+/// A small swim with `waveform = "skewed"`: each muscle's duty is a gene,
+/// written into best.toml as the oscillator's `duty`, and best.toml
+/// evaluates to the logged fitness bit for bit.
+#[test]
+fn skewed_swimmers_write_their_duties_and_reproduce() {
+    let dir = scratch("bodies-skewed");
+    let swim = SMALL
+        .replace("[floor]\n", "[fluid]\ndensity = 1000.0\n")
+        .replace("dt = 0.001\n", "dt = 0.001\ngravity = [0.0, 0.0, 0.0]\n")
+        .replace(
+            "max_springs = 30\n",
+            "max_springs = 30\nwaveform = \"skewed\"\n",
+        );
+    assert!(swim.contains("[fluid]") && swim.contains("skewed"));
+    let out = dir.join("run");
+    let o = evolve(
+        &write(&dir, "swim.toml", &swim),
+        &out,
+        &["--generations", "3", "--no-check"],
+    );
+    assert!(o.status.success(), "{}", text(&o).1);
+    let best = std::fs::read_to_string(out.join("best.toml")).unwrap();
+    let duty = best
+        .lines()
+        .find(|l| l.starts_with("duty = ["))
+        .unwrap_or_else(|| panic!("{best}"));
+    let duties: Vec<f64> = duty["duty = [".len()..duty.len() - 1]
+        .split(',')
+        .map(|x| x.trim().parse().unwrap())
+        .collect();
+    assert!(!duties.is_empty() && duties.iter().all(|d| (0.1..=0.9).contains(d)));
+    assert!(duties.iter().any(|&d| d != 0.5), "{duties:?}");
+    let (fitness, json) = evaluated(out.join("best.toml").to_str().unwrap());
+    let logged = logged_best(&out);
+    assert_eq!(
+        fitness.to_bits(),
+        logged.to_bits(),
+        "{json} against {logged}"
+    );
+}
+
 #[test]
 fn bad_morphology_exits_2_naming_the_field_and_writes_nothing() {
     let dir = scratch("bodies-bad");

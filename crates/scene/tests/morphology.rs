@@ -40,6 +40,7 @@ fn edge(a: usize, b: usize, muscle: bool) -> Edge {
             phase: 0.5,
             offset: 0.5,
             touch: [0.0; 2],
+            duty: 0.5,
         }),
     }
 }
@@ -64,6 +65,7 @@ fn tetra() -> Body {
         ],
         frequency: 2.0,
         neural: false,
+        skewed: false,
     }
 }
 
@@ -129,10 +131,12 @@ fn reflex(touch: [f64; 2], height: f64) -> f64 {
                 phase: 0.0,
                 offset: 0.5,
                 touch,
+                duty: 0.5,
             }),
         }],
         frequency: 1.0,
         neural: true,
+        skewed: false,
     };
     let genes = body.to_genes();
     assert_eq!(p.check(&genes), Ok(()), "a valid neural body");
@@ -255,6 +259,7 @@ fn a_lattice_grows_shared_corners_and_muscles_along_their_axis() {
                 phase: 0.0,
                 offset: 0.5,
                 touch: [0.0; 2],
+                duty: 0.5,
             };
             2
         ],
@@ -301,6 +306,7 @@ fn lattice_reflex(touch: [f64; 2], height: f64) -> f64 {
             phase: 0.0,
             offset: 0.5,
             touch,
+            duty: 0.5,
         }],
         frequency: 1.0,
         neural: true,
@@ -437,6 +443,7 @@ fn every_check_names_its_reason() {
         edges: vec![edge(0, 1, true), edge(1, 2, false), edge(0, 2, false)],
         frequency: 1.0,
         neural: false,
+        skewed: false,
     };
     assert_eq!(static_checks(&triangle, m), Ok(()));
     assert_eq!(p.check(&triangle.to_genes()), Err(Refusal::SettleFlat));
@@ -469,6 +476,15 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
             "morphology.structure",
         ),
         ("cells = [2, 2, 2]", "morphology.cells"),
+        ("waveform = \"square\"", "square"),
+        (
+            "waveform = \"skewed\"\ncontroller = \"neural\"",
+            "morphology.waveform",
+        ),
+        (
+            "waveform = \"skewed\"\nencoding = \"lattice\"\ncells = [2, 1, 1]",
+            "morphology.waveform",
+        ),
         ("start = \"nowhere.toml\"", "morphology.start"),
         ("size = 0.01", "morphology.size"),
         // (Far past a kilometre its built lengths overflowed: the error
@@ -561,6 +577,12 @@ fn a_hundred_thousand_random_variations_are_valid_or_refused_with_a_reason() {
                 .unwrap()
                 .replace("controller = \"oscillator\"", "controller = \"neural\""),
             "bodies_lattice.toml, neural".to_string(),
+        ),
+        (
+            std::fs::read_to_string(format!("{ROOT}/scenes/bodies_swim.toml"))
+                .unwrap()
+                .replace("[morphology]\n", "[morphology]\nwaveform = \"skewed\"\n"),
+            "bodies_swim.toml, skewed".to_string(),
         ),
     ];
     let per = 100_000 / scenes.len() + 1;

@@ -6,7 +6,7 @@
 //! its built length) that neither blows up nor collapses flat.
 
 use super::genome::Body;
-use super::{EncodingName, Morphology, AMPLITUDE, FREQUENCY, TOUCH};
+use super::{EncodingName, Morphology, AMPLITUDE, DUTY, FREQUENCY, TOUCH};
 use animats_engine::DVec3;
 use std::collections::HashSet;
 use std::fmt;
@@ -98,7 +98,7 @@ fn within(x: f64, (lo, hi): (f64, f64)) -> bool {
 
 /// The checks that need no simulation, cheapest first.
 pub fn static_checks(body: &Body, m: &Morphology) -> Result<(), Refusal> {
-    if body.neural != m.neural {
+    if body.neural != m.neural || body.skewed != m.skewed {
         return Err(Refusal::Malformed);
     }
     let n = body.nodes.len();
@@ -134,6 +134,7 @@ pub fn static_checks(body: &Body, m: &Morphology) -> Result<(), Refusal> {
                         && within(mu.phase, (-std::f64::consts::PI, std::f64::consts::PI))
                         && within(mu.offset, (0.0, 1.0))
                         && mu.touch.iter().all(|&w| within(w, TOUCH))
+                        && within(mu.duty, DUTY)
                 })
         });
     if !genes_ok {

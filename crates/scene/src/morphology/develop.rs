@@ -85,6 +85,7 @@ pub fn develop(
     let mut springs = Vec::with_capacity(body.edges.len());
     let mut actuators = Vec::new();
     let mut oscillator = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut duty = Vec::new();
     for (j, e) in body.edges.iter().enumerate() {
         let mut t = Table::new();
         t["name"] = value(format!("{NAME}.s{j}"));
@@ -106,6 +107,7 @@ pub fn develop(
             oscillator.1.push(mu.amplitude);
             oscillator.2.push(mu.phase);
             oscillator.3.push(mu.offset);
+            duty.push(mu.duty);
         }
     }
     append(&mut doc, "spring", springs)?;
@@ -126,6 +128,9 @@ pub fn develop(
                 c["amplitude"] = value(floats(&oscillator.1));
                 c["phase"] = value(floats(&oscillator.2));
                 c["offset"] = value(floats(&oscillator.3));
+                if body.skewed {
+                    c["duty"] = value(floats(&duty));
+                }
                 c
             };
             append(&mut doc, "controller", vec![c])?;

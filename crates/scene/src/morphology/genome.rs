@@ -17,6 +17,9 @@ pub const GRAPH_TAG: f64 = 1.0;
 /// The first gene of a graph genome whose muscles also feel touch
 /// (`controller = "neural"`).
 pub const NEURAL_TAG: f64 = 3.0;
+/// The first gene of a graph genome whose muscles each carry a duty
+/// (`waveform = "skewed"`).
+pub const SKEWED_TAG: f64 = 5.0;
 
 /// A particle of the body.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -30,7 +33,9 @@ pub struct Node {
 }
 
 /// A muscle's genes. Driven by an oscillator its level is
-/// `offset + amplitude sin(2π f t + phase)`; in a `neural` body it is
+/// `offset + amplitude sin(2π f t + phase)` (in a `skewed` body, that wave
+/// skewed to rise for the share `duty` of a cycle: the oscillator's
+/// `duty`); in a `neural` body it is
 /// `σ(4 (offset − ½) + 4 amplitude sin(2π f t + phase) + 2 touch[0] t_a +
 /// 2 touch[1] t_b)`, with `t_a`, `t_b` 1 while the spring's ends touch the
 /// floor, else 0, and σ the logistic function (near ½ the same slope).
@@ -45,6 +50,9 @@ pub struct Muscle {
     /// The weights of the touch sensors at the spring's ends `a` and `b`,
     /// each in [`super::TOUCH`] (a `neural` body's; 0 otherwise).
     pub touch: [f64; 2],
+    /// The share of a cycle the level rises, in [`super::DUTY`] (a
+    /// `skewed` body's; ½, the sine, otherwise).
+    pub duty: f64,
 }
 
 /// A spring between two particles; a muscle if it carries muscle genes.
@@ -73,6 +81,9 @@ pub struct Body {
     /// Its muscles feel touch (`controller = "neural"`): the genome carries
     /// every muscle's `touch` weights.
     pub neural: bool,
+    /// Its muscles' waves are skewed (`waveform = "skewed"`): the genome
+    /// carries every muscle's `duty`.
+    pub skewed: bool,
 }
 
 /// Genes a node takes.
@@ -80,6 +91,7 @@ const NODE_GENES: usize = 5;
 /// Genes an edge takes, and in a `neural` body.
 const EDGE_GENES: usize = 7;
 const NEURAL_EDGE_GENES: usize = 9;
+const SKEWED_EDGE_GENES: usize = 8;
 
 impl Body {
     /// Muscles in the body.
@@ -95,17 +107,26 @@ impl Body {
     /// The genes: `[1, particles, springs, frequency]`, then each particle's
     /// `x, y, z, mass, radius`, then each spring's `a, b, stiffness, muscle
     /// (0 or 1), amplitude, phase, offset`. A `neural` body starts with 3
-    /// and each spring adds `touch_a, touch_b`.
+    /// and each spring adds `touch_a, touch_b`; a `skewed` body starts
+    /// with 5 and each spring adds `duty`.
     pub fn to_genes(&self) -> Vec<f64> {
         let per_edge = if self.neural {
             NEURAL_EDGE_GENES
+        } else if self.skewed {
+            SKEWED_EDGE_GENES
         } else {
             EDGE_GENES
         };
         let mut g =
             Vec::with_capacity(4 + NODE_GENES * self.nodes.len() + per_edge * self.edges.len());
         g.extend([
-            if self.neural { NEURAL_TAG } else { GRAPH_TAG },
+            if self.neural {
+                NEURAL_TAG
+            } else if self.skewed {
+                SKEWED_TAG
+            } else {
+                GRAPH_TAG
+            },
             self.nodes.len() as f64,
             self.edges.len() as f64,
             self.frequency,
@@ -119,6 +140,7 @@ impl Body {
                 phase: 0.0,
                 offset: 0.5,
                 touch: [0.0; 2],
+                duty: 0.5,
             });
             g.extend([
                 e.a as f64,
@@ -132,6 +154,9 @@ impl Body {
             if self.neural {
                 g.extend(m.touch);
             }
+            if self.skewed {
+                g.push(m.duty);
+            }
         }
         g
     }
@@ -142,14 +167,17 @@ impl Body {
         if let Some(i) = g.iter().position(|x| !x.is_finite()) {
             return Err(format!("gene {i} is not finite: {}", g[i]));
         }
-        if g.len() < 4 || (g[0] != GRAPH_TAG && g[0] != NEURAL_TAG) {
+        if g.len() < 4 || (g[0] != GRAPH_TAG && g[0] != NEURAL_TAG && g[0] != SKEWED_TAG) {
             return Err(
-                "not a body genome: it must start [1, particles, springs, frequency] (3 for a neural body)".into(),
+                "not a body genome: it must start [1, particles, springs, frequency] (3 for a neural body, 5 for a skewed one)".into(),
             );
         }
         let neural = g[0] == NEURAL_TAG;
+        let skewed = g[0] == SKEWED_TAG;
         let per_edge = if neural {
             NEURAL_EDGE_GENES
+        } else if skewed {
+            SKEWED_EDGE_GENES
         } else {
             EDGE_GENES
         };
@@ -193,6 +221,7 @@ impl Body {
                         phase: c[5],
                         offset: c[6],
                         touch: if neural { [c[7], c[8]] } else { [0.0; 2] },
+                        duty: if skewed { c[7] } else { 0.5 },
                     }),
                     x => return Err(format!("spring {j}: muscle flag {x} is neither 0 nor 1")),
                 };
@@ -209,6 +238,7 @@ impl Body {
             edges,
             frequency: g[3],
             neural,
+            skewed,
         })
     }
 }
@@ -240,10 +270,12 @@ mod tests {
                     phase: -1.0,
                     offset: 0.4,
                     touch: [0.0; 2],
+                    duty: 0.5,
                 }),
             }],
             frequency: 1.5,
             neural: false,
+            skewed: false,
         }
     }
 
@@ -283,6 +315,25 @@ mod tests {
         assert_eq!(g.len(), 4 + 10 + 9);
         assert_eq!(Body::from_genes(&g).unwrap(), b);
         // The same genes read as an oscillator body's are the wrong length.
+        let mut as_graph = g;
+        as_graph[0] = GRAPH_TAG;
+        assert!(Body::from_genes(&as_graph)
+            .unwrap_err()
+            .contains("takes 21 genes"));
+    }
+
+    #[test]
+    fn a_skewed_body_carries_a_duty_per_spring() {
+        let mut b = two();
+        b.skewed = true;
+        if let Some(mu) = b.edges[0].muscle.as_mut() {
+            mu.duty = 0.2;
+        }
+        let g = b.to_genes();
+        assert_eq!(g[0], SKEWED_TAG);
+        assert_eq!(g.len(), 4 + 10 + 8);
+        assert_eq!(g[21], 0.2);
+        assert_eq!(Body::from_genes(&g).unwrap(), b);
         let mut as_graph = g;
         as_graph[0] = GRAPH_TAG;
         assert!(Body::from_genes(&as_graph)

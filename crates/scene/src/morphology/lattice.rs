@@ -237,6 +237,7 @@ impl Lattice {
                 phase: c[1],
                 offset: c[2],
                 touch: if neural { [c[3], c[4]] } else { [0.0; 2] },
+                duty: 0.5,
             })
             .collect();
         Ok(Lattice {
@@ -291,6 +292,7 @@ impl Lattice {
             edges: edges.into_values().collect(),
             frequency: self.frequency,
             neural: self.neural,
+            skewed: false,
         }
     }
 }

@@ -71,6 +71,12 @@ pub struct MorphologyEntry {
     /// only); default `oscillator`.
     #[serde(default)]
     pub controller: BrainName,
+    /// `sine` (each muscle's level a sine) or `skewed` (each muscle also
+    /// carries a duty gene in [`DUTY`]: the share of a cycle its level
+    /// spends rising, the oscillator's `duty`; oscillator graph bodies
+    /// only); default `sine`.
+    #[serde(default)]
+    pub waveform: WaveformName,
     /// The body's spheres that no spring joins collide with each other;
     /// default true.
     #[serde(default = "yes")]
@@ -117,6 +123,18 @@ pub enum EncodingName {
     Graph,
     /// A lattice of painted cells.
     Lattice,
+}
+
+/// `[morphology] waveform`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq, Eq, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum WaveformName {
+    /// Each muscle's level is a sine.
+    #[default]
+    Sine,
+    /// Each muscle's wave rises for its own share of a cycle (a duty gene)
+    /// and falls for the rest: a fast stroke and a slow return.
+    Skewed,
 }
 
 /// `[morphology] controller`.
@@ -226,6 +244,8 @@ pub struct Morphology {
     pub lattice: Option<lattice::Shape>,
     /// `controller = "neural"`: muscles feel touch.
     pub neural: bool,
+    /// `waveform = "skewed"`: each muscle carries a duty gene.
+    pub skewed: bool,
 }
 
 /// Frequency bounds of the muscles' shared oscillator, Hz.
@@ -234,6 +254,8 @@ pub const FREQUENCY: (f64, f64) = (0.2, 5.0);
 pub const AMPLITUDE: (f64, f64) = (0.0, 0.5);
 /// A `neural` muscle's touch weight bounds.
 pub const TOUCH: (f64, f64) = (-1.0, 1.0);
+/// A `skewed` muscle's duty bounds: the share of a cycle its level rises.
+pub const DUTY: (f64, f64) = (0.1, 0.9);
 
 impl Morphology {
     /// Checks every key, naming the field.
@@ -332,6 +354,13 @@ impl Morphology {
             }
             EncodingName::Lattice => Some(lattice::Shape::from_entry(at, e)?),
         };
+        let skewed = e.waveform == WaveformName::Skewed;
+        if skewed && (neural || lattice.is_some()) {
+            return Err(at.err(
+                "waveform",
+                "`skewed` is for encoding = \"graph\" bodies driven by controller = \"oscillator\"",
+            ));
+        }
         Ok(Morphology {
             encoding: e.encoding,
             max_particles: e.max_particles,
@@ -351,6 +380,7 @@ impl Morphology {
             origin: at.vec3("origin", e.origin)?,
             lattice,
             neural,
+            skewed,
         })
     }
 }

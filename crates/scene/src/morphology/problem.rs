@@ -7,7 +7,7 @@ use super::check::{self, Refusal};
 use super::develop::{self, Brain, NAME};
 use super::genome::{Body, Edge, Muscle, Node};
 use super::lattice::Lattice;
-use super::{vary, EncodingName, Morphology};
+use super::{vary, EncodingName, Morphology, DUTY};
 use crate::build::at;
 use crate::error::SceneError;
 use crate::evaluate::{Evaluation, EvolveSpec, SceneProblem};
@@ -94,6 +94,7 @@ impl MorphologyProblem {
                                 phase: 0.0,
                                 offset: 0.5,
                                 touch: [0.0; 2],
+                                duty: 0.5,
                             };
                             s.len()
                         ],
@@ -106,6 +107,13 @@ impl MorphologyProblem {
             (path, EncodingName::Graph) => {
                 let mut body = start_body(file, path).map_err(|m| here.err("start", m))?;
                 body.neural = morphology.neural;
+                body.skewed = morphology.skewed;
+                if !body.skewed {
+                    // A start scene's skewed oscillator: its sines.
+                    for mu in body.edges.iter_mut().filter_map(|e| e.muscle.as_mut()) {
+                        mu.duty = 0.5;
+                    }
+                }
                 Some(body.to_genes())
             }
             (_, EncodingName::Lattice) => {
@@ -443,6 +451,7 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
                 phase: vary::wrap(pick(&o.and_then(|o| o.phase.clone()), 0.0)),
                 offset: pick(&o.and_then(|o| o.offset.clone()), 0.5),
                 touch: [0.0; 2],
+                duty: pick(&o.and_then(|o| o.duty.clone()), 0.5).clamp(DUTY.0, DUTY.1),
             }
         });
         edges.push(Edge {
@@ -458,5 +467,6 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
         edges,
         frequency,
         neural: false,
+        skewed: false,
     })
 }

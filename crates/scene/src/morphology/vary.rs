@@ -21,7 +21,7 @@
 
 use super::genome::{Body, Edge, Muscle, Node};
 use super::lattice::{Lattice, Material, Shape};
-use super::{Morphology, AMPLITUDE, FREQUENCY, TOUCH};
+use super::{Morphology, AMPLITUDE, DUTY, FREQUENCY, TOUCH};
 use animats_creatures::random::Random;
 use animats_engine::DVec3;
 use std::f64::consts::PI;
@@ -59,34 +59,58 @@ fn log_between(rng: &mut Random, (lo, hi): (f64, f64)) -> f64 {
     .clamp(lo, hi)
 }
 
+/// What a body's muscles carry besides amplitude, phase and offset.
+#[derive(Clone, Copy)]
+struct Extra {
+    neural: bool,
+    skewed: bool,
+}
+
+impl Extra {
+    fn of(body: &Body) -> Extra {
+        Extra {
+            neural: body.neural,
+            skewed: body.skewed,
+        }
+    }
+}
+
 /// A muscle with random genes; a `neural` one's touch weights start small
-/// (a reflex evolution grows).
-fn random_muscle(rng: &mut Random, neural: bool) -> Muscle {
+/// (a reflex evolution grows); a `skewed` one's duty is uniform in
+/// [`DUTY`].
+fn random_muscle(rng: &mut Random, extra: Extra) -> Muscle {
     let mut mu = Muscle {
         amplitude: rng.between(AMPLITUDE.0, AMPLITUDE.1),
         phase: rng.between(-PI, PI),
         offset: rng.between(0.2, 0.8),
         touch: [0.0; 2],
+        duty: 0.5,
     };
-    if neural {
+    if extra.neural {
         mu.touch = [
             rng.between(0.25 * TOUCH.0, 0.25 * TOUCH.1),
             rng.between(0.25 * TOUCH.0, 0.25 * TOUCH.1),
         ];
+    }
+    if extra.skewed {
+        mu.duty = rng.between(DUTY.0, DUTY.1);
     }
     mu
 }
 
 /// `mu`'s genes nudged by normal steps of `scale` of their ranges (the
 /// phase by `phase_step` rad).
-fn nudge_muscle(rng: &mut Random, mu: &mut Muscle, scale: f64, phase_step: f64, neural: bool) {
+fn nudge_muscle(rng: &mut Random, mu: &mut Muscle, scale: f64, phase_step: f64, extra: Extra) {
     mu.amplitude = nudge(rng, mu.amplitude, AMPLITUDE, scale);
     mu.phase = wrap(mu.phase + phase_step * normal(rng));
     mu.offset = nudge(rng, mu.offset, (0.0, 1.0), scale);
-    if neural {
+    if extra.neural {
         for w in &mut mu.touch {
             *w = nudge(rng, *w, TOUCH, scale);
         }
+    }
+    if extra.skewed {
+        mu.duty = nudge(rng, mu.duty, DUTY, scale);
     }
 }
 
@@ -125,7 +149,15 @@ fn spring(rng: &mut Random, m: &Morphology, a: usize, b: usize) -> Edge {
         a,
         b,
         stiffness: log_between(rng, m.stiffness),
-        muscle: (rng.uniform() < 0.5).then(|| random_muscle(rng, m.neural)),
+        muscle: (rng.uniform() < 0.5).then(|| {
+            random_muscle(
+                rng,
+                Extra {
+                    neural: m.neural,
+                    skewed: m.skewed,
+                },
+            )
+        }),
     }
 }
 
@@ -143,6 +175,7 @@ pub fn random_body(m: &Morphology, rng: &mut Random) -> Body {
         edges: Vec::new(),
         frequency: rng.between(0.5, 3.0),
         neural: m.neural,
+        skewed: m.skewed,
     };
     for _ in 0..n {
         let radius = rng.between(m.radius.0, r_hi);
@@ -182,7 +215,7 @@ pub fn random_body(m: &Morphology, rng: &mut Random) -> Body {
     }
     if body.muscles() == 0 {
         let k = int(rng, 0, body.edges.len() - 1);
-        body.edges[k].muscle = Some(random_muscle(rng, m.neural));
+        body.edges[k].muscle = Some(random_muscle(rng, Extra::of(&body)));
     }
     body
 }
@@ -248,19 +281,20 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
         }
         8 => {
             if let Some(k) = edge {
+                let extra = Extra::of(body);
                 let e = &mut body.edges[k];
                 e.muscle = match e.muscle {
                     Some(_) => None,
-                    None => Some(random_muscle(rng, body.neural)),
+                    None => Some(random_muscle(rng, extra)),
                 };
             }
         }
         9 => {
             let muscles: Vec<usize> = (0..s).filter(|&k| body.edges[k].muscle.is_some()).collect();
             if let Some(&k) = muscles.get(int(rng, 0, muscles.len().max(1) - 1)) {
-                let neural = body.neural;
+                let extra = Extra::of(body);
                 if let Some(mu) = body.edges[k].muscle.as_mut() {
-                    nudge_muscle(rng, mu, 0.1, 0.2 * PI, neural);
+                    nudge_muscle(rng, mu, 0.1, 0.2 * PI, extra);
                 }
             }
         }
@@ -268,10 +302,10 @@ fn mutate_once(body: &mut Body, m: &Morphology, rng: &mut Random) {
         _ => {
             // The whole brain at once, a little: every muscle's genes and
             // the frequency (a local search of the gait on a fixed body).
-            let neural = body.neural;
+            let extra = Extra::of(body);
             for e in &mut body.edges {
                 if let Some(mu) = e.muscle.as_mut() {
-                    nudge_muscle(rng, mu, 0.03, 0.05 * PI, neural);
+                    nudge_muscle(rng, mu, 0.03, 0.05 * PI, extra);
                 }
             }
             body.frequency = nudge(rng, body.frequency, FREQUENCY, 0.01);
@@ -346,6 +380,7 @@ pub fn cross_bodies(a: &Body, b: &Body, rng: &mut Random) -> Body {
             b.frequency
         },
         neural: a.neural,
+        skewed: a.skewed,
     };
     let mut index_a = vec![usize::MAX; a.nodes.len()];
     for (i, n) in a.nodes.iter().enumerate().filter(|(i, _)| keep_a[*i]) {
@@ -404,7 +439,15 @@ pub fn random_lattice(shape: &Shape, neural: bool, rng: &mut Random) -> Lattice 
         })
         .collect();
     let muscles = (0..shape.len())
-        .map(|_| random_muscle(rng, neural))
+        .map(|_| {
+            random_muscle(
+                rng,
+                Extra {
+                    neural,
+                    skewed: false,
+                },
+            )
+        })
         .collect();
     Lattice {
         materials,
@@ -431,7 +474,16 @@ pub fn mutate_lattice(parent: &Lattice, rng: &mut Random) -> Lattice {
     }
     for _ in 0..int(rng, 0, 2) {
         let mu = &mut l.muscles[int(rng, 0, n - 1)];
-        nudge_muscle(rng, mu, 0.1, 0.2 * PI, parent.neural);
+        nudge_muscle(
+            rng,
+            mu,
+            0.1,
+            0.2 * PI,
+            Extra {
+                neural: parent.neural,
+                skewed: false,
+            },
+        );
     }
     if rng.uniform() < 0.2 {
         l.frequency = nudge(rng, l.frequency, FREQUENCY, 0.05);
