@@ -547,8 +547,15 @@ fn every_brain_kind_writes_its_genes_back_where_it_reads_them() {
         1,
     ) + "\n[evolve]\ncontroller = \"osc\"\nduration = 0.5\n";
     let raibert = animats_scene::HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
+    let skewed = COAST.replacen(
+        "outputs = [\"m\"]\n[evolve]",
+        "outputs = [\"m\"]\nduty = [0.3]\n[evolve]",
+        1,
+    );
+    assert_ne!(skewed, COAST);
     let cases = [
         ("fsm", pogo.as_str()),
+        ("oscillator", skewed.as_str()),
         ("neural", neural.as_str()),
         ("ctrnn", ctrnn.as_str()),
         ("oscillator", COAST),
