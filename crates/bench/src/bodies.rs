@@ -1,7 +1,9 @@
 //! `bodies` (on request; issue 39): evolving bodies, for the land and the
 //! water tasks (`scenes/bodies_walk.toml`, `scenes/bodies_swim.toml`, and
-//! `scenes/bodies_swim_rods.toml`: the same bodies with drag across their
-//! springs, whose row against swim's is what that drag costs). A
+//! `swim-rods`: `scenes/bodies_swim.toml` with `[fluid] springs` as
+//! `scenes/bodies_swim_rods.toml` gives it, so the same bodies at the same
+//! step with drag across their springs, whose row against swim's is what
+//! that drag costs). A
 //! population of 16 checked random bodies (the body GA's first generation,
 //! seed 1):
 //!
@@ -27,12 +29,21 @@ const POPULATION: usize = 16;
 pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
     let runs = if quick { runs.min(5) } else { runs };
     let mut rows = Vec::new();
-    for (name, path) in [
-        ("walk", "scenes/bodies_walk.toml"),
-        ("swim", "scenes/bodies_swim.toml"),
-        ("swim-rods", "scenes/bodies_swim_rods.toml"),
+    let read = |path: &str| std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"));
+    let swim = read("scenes/bodies_swim.toml")?;
+    let still = "drag_coefficient = 0.47\n";
+    if !swim.contains(still) {
+        return Err(format!(
+            "scenes/bodies_swim.toml: no `{}` line to add drag across springs after",
+            still.trim()
+        ));
+    }
+    let rods = swim.replacen(still, &format!("{still}springs = {{ diameter = 0.02 }}\n"), 1);
+    for (name, path, text) in [
+        ("walk", "scenes/bodies_walk.toml", read("scenes/bodies_walk.toml")?),
+        ("swim", "scenes/bodies_swim.toml", swim.clone()),
+        ("swim-rods", "scenes/bodies_swim.toml with [fluid] springs", rods),
     ] {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{path}: {e}"))?;
         rows.extend(task(name, path, &text, runs)?);
     }
     Ok(rows)
