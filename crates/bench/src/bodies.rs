@@ -38,11 +38,23 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
             still.trim()
         ));
     }
-    let rods = swim.replacen(still, &format!("{still}springs = {{ diameter = 0.02 }}\n"), 1);
+    let rods = swim.replacen(
+        still,
+        &format!("{still}springs = {{ diameter = 0.02 }}\n"),
+        1,
+    );
     for (name, path, text) in [
-        ("walk", "scenes/bodies_walk.toml", read("scenes/bodies_walk.toml")?),
+        (
+            "walk",
+            "scenes/bodies_walk.toml",
+            read("scenes/bodies_walk.toml")?,
+        ),
         ("swim", "scenes/bodies_swim.toml", swim.clone()),
-        ("swim-rods", "scenes/bodies_swim.toml with [fluid] springs", rods),
+        (
+            "swim-rods",
+            "scenes/bodies_swim.toml with [fluid] springs",
+            rods,
+        ),
     ] {
         rows.extend(task(name, path, &text, runs)?);
     }

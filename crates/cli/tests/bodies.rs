@@ -429,7 +429,9 @@ fn shipped(name: &str) -> String {
 /// The shipped scene `scenes/NAME` (whose step is 0.5 ms) at step `dt`.
 fn shipped_at(name: &str, dt: &str) -> String {
     let text = shipped(name);
-    let at = text.find("\ndt = ").unwrap_or_else(|| panic!("{name}: no dt"));
+    let at = text
+        .find("\ndt = ")
+        .unwrap_or_else(|| panic!("{name}: no dt"));
     let end = at + 1 + text[at + 1..].find('\n').unwrap();
     format!("{}\ndt = {dt}{}", &text[..at], &text[end..])
 }
