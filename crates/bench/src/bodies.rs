@@ -49,7 +49,7 @@ pub fn run(quick: bool, runs: usize) -> Result<Vec<Row>, String> {
             "scenes/bodies_walk.toml",
             read("scenes/bodies_walk.toml")?,
         ),
-        ("swim", "scenes/bodies_swim.toml", swim.clone()),
+        ("swim", "scenes/bodies_swim.toml", swim),
         (
             "swim-rods",
             "scenes/bodies_swim.toml with [fluid] springs",

@@ -88,10 +88,18 @@ pub struct Body {
 
 /// Genes a node takes.
 const NODE_GENES: usize = 5;
-/// Genes an edge takes, and in a `neural` body.
-const EDGE_GENES: usize = 7;
-const NEURAL_EDGE_GENES: usize = 9;
-const SKEWED_EDGE_GENES: usize = 8;
+
+/// A graph genome's first gene and the genes each edge takes: 7, two more
+/// touch weights in a `neural` body, a duty more in a `skewed` one.
+fn layout(neural: bool, skewed: bool) -> (f64, usize) {
+    if neural {
+        (NEURAL_TAG, 9)
+    } else if skewed {
+        (SKEWED_TAG, 8)
+    } else {
+        (GRAPH_TAG, 7)
+    }
+}
 
 impl Body {
     /// Muscles in the body.
@@ -110,23 +118,11 @@ impl Body {
     /// and each spring adds `touch_a, touch_b`; a `skewed` body starts
     /// with 5 and each spring adds `duty`.
     pub fn to_genes(&self) -> Vec<f64> {
-        let per_edge = if self.neural {
-            NEURAL_EDGE_GENES
-        } else if self.skewed {
-            SKEWED_EDGE_GENES
-        } else {
-            EDGE_GENES
-        };
+        let (tag, per_edge) = layout(self.neural, self.skewed);
         let mut g =
             Vec::with_capacity(4 + NODE_GENES * self.nodes.len() + per_edge * self.edges.len());
         g.extend([
-            if self.neural {
-                NEURAL_TAG
-            } else if self.skewed {
-                SKEWED_TAG
-            } else {
-                GRAPH_TAG
-            },
+            tag,
             self.nodes.len() as f64,
             self.edges.len() as f64,
             self.frequency,
@@ -172,15 +168,8 @@ impl Body {
                 "not a body genome: it must start [1, particles, springs, frequency] (3 for a neural body, 5 for a skewed one)".into(),
             );
         }
-        let neural = g[0] == NEURAL_TAG;
-        let skewed = g[0] == SKEWED_TAG;
-        let per_edge = if neural {
-            NEURAL_EDGE_GENES
-        } else if skewed {
-            SKEWED_EDGE_GENES
-        } else {
-            EDGE_GENES
-        };
+        let (neural, skewed) = (g[0] == NEURAL_TAG, g[0] == SKEWED_TAG);
+        let (_, per_edge) = layout(neural, skewed);
         let count = |x: f64, what: &str| -> Result<usize, String> {
             if x >= 0.0 && x.fract() == 0.0 && x <= 1e6 {
                 Ok(x as usize)

@@ -108,12 +108,7 @@ impl MorphologyProblem {
                 let mut body = start_body(file, path).map_err(|m| here.err("start", m))?;
                 body.neural = morphology.neural;
                 body.skewed = morphology.skewed;
-                if !body.skewed {
-                    // A start scene's skewed oscillator: its sines.
-                    for mu in body.edges.iter_mut().filter_map(|e| e.muscle.as_mut()) {
-                        mu.duty = 0.5;
-                    }
-                }
+                // (A sine body's genes carry no duty: a start scene's is dropped.)
                 Some(body.to_genes())
             }
             (_, EncodingName::Lattice) => {
