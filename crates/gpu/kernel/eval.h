@@ -202,14 +202,33 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
     return an_unit((reading - param[3]) / (param[4] - param[3]));
 }
 
+/* The phase of a skewed wave u cycles past its trough, rising for the
+ * share duty of a cycle (brains/oscillator.rs `skewed_angle`). */
+AN_FN double an_skewed_angle(double u, double duty) {
+    if (u < duty) {
+        return -1.5707963267948966 + 3.141592653589793 * (u / duty);
+    }
+    return 1.5707963267948966 + 3.141592653589793 * ((u - duty) / (1.0 - duty));
+}
+
 /* Oscillator o (over the batch) of creature c at time t
- * (brains/oscillator.rs: level = offset + amplitude sin(2 pi f t + phase)). */
+ * (brains/oscillator.rs: level = offset + amplitude sin(2 pi f t + phase),
+ * or with a duty, offset + amplitude sin(psi), psi the skewed angle of
+ * frac(f t + (phase + pi/2) / 2 pi)). */
 AN_FN void an_oscillator(const an_batch *b, long long c, long long o, double t, double dt) {
     long long u0 = b->first_muscle[c];
-    double w = (6.283185307179586 * b->osc_frequency[o]) * t;
+    double f = b->osc_frequency[o];
+    double w = (6.283185307179586 * f) * t;
+    double ft = f * t;
     for (long long k = b->first_output[o]; k < b->first_output[o + 1]; k++) {
-        const double *g = b->output_gene + 4 * k;
-        double l = g[2] + g[0] * an_sin(w + g[1]);
+        const double *g = b->output_gene + 5 * k;
+        double l;
+        if (g[4] == g[4]) {
+            double cy = ft + (g[1] + 0.5 * 3.141592653589793) / 6.283185307179586;
+            l = g[2] + g[0] * an_sin(an_skewed_angle(cy - floor(cy), g[4]));
+        } else {
+            l = g[2] + g[0] * an_sin(w + g[1]);
+        }
         if (g[3] == g[3]) {
             l = l + g[3];
         }

@@ -110,7 +110,7 @@ typedef struct {
     const double *osc_frequency;
     const long long *first_output; /* per oscillator, over the batch: its outputs */
     const int *output_muscle;      /* the muscle driven, within the creature */
-    const double *output_gene;     /* 4 per output: amplitude, phase, offset, shift (NaN: none) */
+    const double *output_gene;     /* 5 per output: amplitude, phase, offset, shift (NaN: none), duty (NaN: a sine) */
     const long long *first_centre; /* per creature: the particles whose centre counts */
     const int *centre_particle;
     const long long *first_touch;  /* per creature: fail_on_touch */

@@ -9,7 +9,7 @@
 //! the roobot's own (foot clearance, time till touchdown, leg angle, hip
 //! speed), actuators (a spring's rest length, an angle joint's rest angle, a
 //! torque joint's torque, a constant force's scale; with or without a
-//! `rate`, gated or not) and the positive work they do, oscillator, neural,
+//! `rate`, gated or not) and the positive work they do, oscillator (sine or skewed), neural,
 //! CTRNN and FSM brains and the roobot's hopping FSM, the centre of the particles that count,
 //! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
 //! scene, the `[archive]` measures and `[evolve] terms`, and every term of
@@ -259,12 +259,6 @@ impl Rules {
             let kind = c.brain.kind();
             let g = c.brain.genome();
             let n = c.outputs.len();
-            if kind == "oscillator" && g.len() != 1 + 3 * n {
-                return Err(format!(
-                    "the controller `{}` is a skewed oscillator (`duty`), which is not in the GPU evaluation yet: only sines are",
-                    c.name
-                ));
-            }
             if kind != "oscillator" {
                 return Err(format!(
                     "the controller `{}` ({kind}) is not in the GPU evaluation yet: only oscillators, neural networks, CTRNNs, FSMs and the roobot's hopping FSM are",
@@ -274,10 +268,14 @@ impl Rules {
             self.ctrl_kind.push(0);
             self.ctrl_index.push(self.osc_frequency.len() as i32);
             self.osc_frequency.push(g[0]);
+            // A sine's genome is `[f, amplitude.., phase.., offset..]`; a
+            // skewed wave's appends its duties (brains/oscillator.rs).
+            let skewed = g.len() == 1 + 4 * n;
             for (j, &o) in c.outputs.iter().enumerate() {
                 self.output_muscle.push(o as i32);
+                let duty = if skewed { g[1 + 3 * n + j] } else { f64::NAN };
                 self.output_gene
-                    .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift(o)]);
+                    .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift(o), duty]);
             }
             self.first_output.push(self.output_muscle.len() as i64);
         }
