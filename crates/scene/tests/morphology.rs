@@ -533,6 +533,44 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
         e.contains("morphology.start") && e.contains("fails its own checks: particles"),
         "{e}"
     );
+    // A start whose oscillator has `duty`: refused by a sine body, which
+    // would drop it; a skewed body takes it, and a duty outside its genes'
+    // range fails the start's checks rather than being moved.
+    let walker = std::fs::read_to_string(format!("{ROOT}/scenes/walker.toml")).unwrap();
+    let offsets = "offset = [0.5, 0.5, 0.5, 0.5, 0.5, 0.5]\n";
+    assert!(walker.contains(offsets));
+    for (duty, waveform, expect) in [
+        ("0.3", "", Some("add `waveform = \"skewed\"`")),
+        ("0.3", "waveform = \"skewed\"", None),
+        (
+            "0.95",
+            "waveform = \"skewed\"",
+            Some("fails its own checks: range"),
+        ),
+    ] {
+        let skewed = walker.replace(
+            offsets,
+            &format!("{offsets}duty = [{duty}, 0.5, 0.5, 0.5, 0.5, 0.5]\n"),
+        );
+        std::fs::write(dir.join("skewed.toml"), skewed).unwrap();
+        let got = MorphologyProblem::parse(
+            &with(&format!("start = \"skewed.toml\"\n{waveform}")),
+            dir.join("m.toml").to_str().unwrap(),
+        );
+        match (got, expect) {
+            (Ok(p), None) => {
+                // The first muscle's duty is the start's, to the bit.
+                let body = p.body(p.start().unwrap()).unwrap();
+                let first = body.edges.iter().find_map(|e| e.muscle.as_ref()).unwrap();
+                assert_eq!(first.duty, 0.3);
+            }
+            (Err(e), Some(expect)) => {
+                let e = e.to_string();
+                assert!(e.contains("morphology.start") && e.contains(expect), "{e}");
+            }
+            (got, _) => panic!("duty {duty}, `{waveform}`: {:?}", got.err()),
+        }
+    }
     let _ = std::fs::remove_dir_all(&dir);
     // A scene with [morphology] is not built as it is.
     let e = animats_scene::build::build(

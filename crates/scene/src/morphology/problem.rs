@@ -7,7 +7,7 @@ use super::check::{self, Refusal};
 use super::develop::{self, Brain, NAME};
 use super::genome::{Body, Edge, Muscle, Node};
 use super::lattice::Lattice;
-use super::{vary, EncodingName, Morphology, DUTY};
+use super::{vary, EncodingName, Morphology};
 use crate::build::at;
 use crate::error::SceneError;
 use crate::evaluate::{Evaluation, EvolveSpec, SceneProblem};
@@ -106,9 +106,18 @@ impl MorphologyProblem {
             }),
             (path, EncodingName::Graph) => {
                 let mut body = start_body(file, path).map_err(|m| here.err("start", m))?;
+                // A start's skewed waves would be lost on a sine body (a
+                // neural body replaces the whole oscillator).
+                if body.skewed && !morphology.skewed && !morphology.neural {
+                    return Err(here.err(
+                        "start",
+                        format!(
+                            "`{path}`'s oscillator has `duty` (skewed waves), for which a sine body has no genes: add `waveform = \"skewed\"`"
+                        ),
+                    ));
+                }
                 body.neural = morphology.neural;
                 body.skewed = morphology.skewed;
-                // (A sine body's genes carry no duty: a start scene's is dropped.)
                 Some(body.to_genes())
             }
             (_, EncodingName::Lattice) => {
@@ -446,7 +455,8 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
                 phase: vary::wrap(pick(&o.and_then(|o| o.phase.clone()), 0.0)),
                 offset: pick(&o.and_then(|o| o.offset.clone()), 0.5),
                 touch: [0.0; 2],
-                duty: pick(&o.and_then(|o| o.duty.clone()), 0.5).clamp(DUTY.0, DUTY.1),
+                // (Outside `DUTY`, the start fails its checks, by name.)
+                duty: pick(&o.and_then(|o| o.duty.clone()), 0.5),
             }
         });
         edges.push(Edge {
@@ -456,12 +466,13 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
             muscle,
         });
     }
-    let frequency = oscillator.and_then(|o| o.frequency).unwrap_or(1.0);
+    let frequency = oscillator.as_ref().and_then(|o| o.frequency).unwrap_or(1.0);
     Ok(Body {
         nodes,
         edges,
         frequency,
         neural: false,
-        skewed: false,
+        // Whether the start's waves are skewed.
+        skewed: oscillator.is_some_and(|o| o.duty.is_some()),
     })
 }
