@@ -23,6 +23,86 @@ pub fn sin(x: f64) -> f64 {
     libm::sin(x)
 }
 
+/// Lanes of [`sin_lanes`].
+pub const LANES: usize = 4;
+
+/// [`sin`] of [`LANES`] arguments at once, each lane the bits of
+/// `sin(x[i])`.
+///
+/// musl's `sin` (the `libm` crate's port) with its branches turned into
+/// selections, for arguments past `9π/4` and below `2²⁰ π/2` whose
+/// reduction needs one round (musl's `rem_pio2` medium path; its
+/// cancellation check holds): each lane reduces its argument, computes
+/// both musl's `k_sin` and `k_cos` of the remainder and keeps the one its
+/// quadrant asks for, in musl's operations and order, with no branch, so
+/// the compiler computes the lanes side by side in vectors. Any other
+/// argument (small, huge, not finite, or a reduction that cancels) sends
+/// every lane to [`sin`]. (`tests/math.rs` holds every lane to
+/// `libm::sin` on 10⁷ arguments and the edges of the range.)
+#[inline]
+pub fn sin_lanes(x: [f64; LANES]) -> [f64; LANES] {
+    const TO_INT: f64 = 6_755_399_441_055_744.0; // 1.5·2⁵²
+    const INV_PIO2: f64 = f64::from_bits(0x3FE45F30_6DC9C883);
+    const PIO2_1: f64 = f64::from_bits(0x3FF921FB_54400000);
+    const PIO2_1T: f64 = f64::from_bits(0x3DD0B461_1A626331);
+    const S1: f64 = f64::from_bits(0xBFC55555_55555549);
+    const S2: f64 = f64::from_bits(0x3F811111_1110F8A6);
+    const S3: f64 = f64::from_bits(0xBF2A01A0_19C161D5);
+    const S4: f64 = f64::from_bits(0x3EC71DE3_57B1FE7D);
+    const S5: f64 = f64::from_bits(0xBE5AE5E6_8A2B9CEB);
+    const S6: f64 = f64::from_bits(0x3DE5D93A_5ACFD57C);
+    const C1: f64 = f64::from_bits(0x3FA55555_5555554C);
+    const C2: f64 = f64::from_bits(0xBF56C16C_16C15177);
+    const C3: f64 = f64::from_bits(0x3EFA01A0_19CB1590);
+    const C4: f64 = f64::from_bits(0xBE927E4F_809C52AD);
+    const C5: f64 = f64::from_bits(0x3E21EE9E_BDB4B1C4);
+    const C6: f64 = f64::from_bits(0xBDA8FAE9_BE8838D4);
+    let mut q = [0u64; LANES];
+    let (mut y0, mut y1) = ([0.0; LANES], [0.0; LANES]);
+    let mut general = true;
+    for i in 0..LANES {
+        let x = x[i];
+        let ix = (x.to_bits() >> 32) as u32 & 0x7fff_ffff;
+        // rem_pio2's medium path, its first round. `tmp` is 1.5·2⁵² + n
+        // exactly (its unit in the last place is 1), so its last two bits
+        // are musl's `n & 3`.
+        let tmp = x * INV_PIO2 + TO_INT;
+        q[i] = tmp.to_bits() & 3;
+        let f_n = tmp - TO_INT;
+        let r = x - f_n * PIO2_1;
+        let w = f_n * PIO2_1T;
+        y0[i] = r - w;
+        let ey = (y0[i].to_bits() >> 52) as i32 & 0x7ff;
+        let ex = (ix >> 20) as i32;
+        general &= (ix > 0x401c_463b) & (ix < 0x4139_21fb) & (ex - ey <= 16);
+        y1[i] = (r - y0[i]) - w;
+    }
+    if !general {
+        return std::array::from_fn(|i| sin(x[i]));
+    }
+    let mut out = [0.0; LANES];
+    for i in 0..LANES {
+        let (x, y) = (y0[i], y1[i]);
+        let z = x * x;
+        let w = z * z;
+        // k_sin(x, y, 1)
+        let r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+        let v = z * x;
+        let s = x - ((z * (0.5 * y - v * r) - y) - v * S1);
+        // k_cos(x, y)
+        let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+        let hz = 0.5 * z;
+        let w = 1.0 - hz;
+        let c = w + (((1.0 - w) - hz) + (z * r - x * y));
+        // Quadrant 0: k_sin; 1: k_cos; 2: −k_sin; 3: −k_cos, chosen by
+        // masks (a negation flips the sign bit).
+        let odd = 0u64.wrapping_sub(q[i] & 1);
+        let pick = (s.to_bits() & !odd) | (c.to_bits() & odd);
+        out[i] = f64::from_bits(pick ^ ((q[i] & 2) << 62));
+    }
+    out
+}
+
 /// `cos x`.
 #[inline]
 pub fn cos(x: f64) -> f64 {

@@ -124,11 +124,18 @@ impl Brain for Oscillator {
             }
             return;
         }
+        use animats_engine::math::{sin_lanes, LANES};
         let w = TAU * self.frequency * t;
-        for (i, out) in outputs.iter_mut().enumerate() {
-            // libm: the same bits on every platform (reproducible evolution).
-            *out =
-                self.offset[i] + self.amplitude[i] * animats_engine::math::sin(w + self.phase[i]);
+        // libm's sine (the same bits on every platform: reproducible
+        // evolution), a group of outputs at a time; lanes past the last
+        // output repeat the group's first.
+        for (g, group) in outputs.chunks_mut(LANES).enumerate() {
+            let at = |k: usize| w + self.phase[g * LANES + if k < group.len() { k } else { 0 }];
+            let s = sin_lanes(std::array::from_fn(at));
+            for (k, out) in group.iter_mut().enumerate() {
+                let i = g * LANES + k;
+                *out = self.offset[i] + self.amplitude[i] * s[k];
+            }
         }
     }
 

@@ -1,0 +1,123 @@
+//! `math::sin_lanes` against `math::sin` (the `libm` crate's musl port),
+//! bit for bit, lane by lane: the edges of musl's ranges and their
+//! neighbours, each in every lane beside ordinary arguments; the multiples
+//! of π/2 where its reduction cancels; 10⁷ random arguments, spread over
+//! every binade up to 2²⁴ and over an oscillator's phases; random bit
+//! patterns.
+
+use animats_engine::math::{sin, sin_lanes, LANES};
+
+/// Random 64-bit patterns (splitmix64).
+struct Bits(u64);
+
+impl Bits {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    /// A double of random sign and mantissa, exponent in `lo ..= hi`.
+    fn spread(&mut self, lo: i32, hi: i32) -> f64 {
+        let b = self.next();
+        let e = lo + (b % (hi - lo + 1) as u64) as i32;
+        let m = 1.0 + (b >> 12) as f64 / (1u64 << 52) as f64;
+        let v = m * 2f64.powi(e);
+        if b & 1 == 0 {
+            v
+        } else {
+            -v
+        }
+    }
+    /// Uniform in [0, 1).
+    fn unit(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// Asserts every lane of `sin_lanes(x)` has `sin`'s bits.
+fn check(x: [f64; LANES]) {
+    let got = sin_lanes(x);
+    for i in 0..LANES {
+        let want = sin(x[i]);
+        assert!(
+            got[i].to_bits() == want.to_bits() || (got[i].is_nan() && want.is_nan()),
+            "lane {i}: sin({:e}) ({:#x}) = {:e} ({:#x}), libm {:e} ({:#x})",
+            x[i],
+            x[i].to_bits(),
+            got[i],
+            got[i].to_bits(),
+            want,
+            want.to_bits()
+        );
+    }
+}
+
+#[test]
+fn edges_and_special_values_in_any_lane_are_libm_s() {
+    let pi = std::f64::consts::PI;
+    let mut v = vec![
+        0.0,
+        f64::INFINITY,
+        f64::NAN,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+        pi / 4.0,
+        9.0 * pi / 4.0,
+        2f64.powi(20) * pi / 2.0,
+        1e-300,
+        1e300,
+    ];
+    // musl's range edges, as high words, and multiples of π/2 (where the
+    // reduction cancels), with their neighbours.
+    for high in [0x401c_463bu64, 0x401c_463c, 0x4139_21fb, 0x4139_21fa] {
+        v.push(f64::from_bits(high << 32));
+        v.push(f64::from_bits((high << 32) | 0xffff_ffff));
+    }
+    for k in 1..2000 {
+        v.push(k as f64 * (pi / 2.0));
+    }
+    let edges = v.clone();
+    for e in edges {
+        if e.is_finite() && e > 0.0 {
+            for d in 1..4 {
+                v.push(f64::from_bits(e.to_bits() + d));
+                v.push(f64::from_bits(e.to_bits() - d));
+            }
+        }
+    }
+    let negated: Vec<f64> = v.iter().map(|e| -e).collect();
+    v.extend(negated);
+    let ordinary = [10.0, -123.25, 5000.5, 77.0];
+    for &x in &v {
+        check([x; LANES]);
+        for lane in 0..LANES {
+            let mut xs = ordinary;
+            xs[lane] = x;
+            check(xs);
+        }
+    }
+}
+
+#[test]
+fn ten_million_random_arguments_are_libm_s() {
+    let mut r = Bits(2026);
+    for k in 0..10_000_000 / LANES {
+        let x: [f64; LANES] = match k % 3 {
+            // An oscillator's 2π f t + phase: f up to 5 Hz, t up to 100 s.
+            0 => std::array::from_fn(|_| {
+                std::f64::consts::TAU * (5.0 * r.unit()) * (100.0 * r.unit())
+                    + (r.unit() - 0.5) * std::f64::consts::TAU
+            }),
+            // Every binade past 9π/4 to 2^24.
+            1 => std::array::from_fn(|_| r.spread(2, 24)),
+            _ => std::array::from_fn(|_| r.spread(-30, 30)),
+        };
+        check(x);
+    }
+    // Random bit patterns: every exponent, NaNs and infinities included.
+    for _ in 0..1_000_000 / LANES {
+        check(std::array::from_fn(|_| f64::from_bits(r.next())));
+    }
+}
