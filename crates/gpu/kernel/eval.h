@@ -819,7 +819,7 @@ AN_FN void an_evaluate_creature(const an_batch *b, an_state st, long long c) {
                 an_work_before(b, st, c);
             }
             an_act(b, st, c, t, dt); /* Scene::step: the nervous system first */
-            if (!an_step_once(b, st, c)) {
+            if (!an_step_once(b, st, c, t)) {
                 why = AN_BLOWUP;
                 break;
             }

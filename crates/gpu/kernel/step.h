@@ -14,7 +14,7 @@
  *
  * Covered today: particles, uniform gravity, damped springs, angle joints
  * (their atan2 ported from the `libm` crate, libm.h), torque joints,
- * constant forces, fluids (still or in a uniform current) on every particle and their drag across springs ([fluid]
+ * constant forces, fluids (still, in a uniform current or under a reef's waves) on every particle and their drag across springs ([fluid]
  * springs), soft (penalty) contact between spheres, sphere contact, the
  * event (spheres.h), the
  * floor, flat or on terrain (terrain.h: its located collisions with backtracking, and its contact force), and the explicit integrators
@@ -31,6 +31,8 @@
 #define AN_FN static inline
 #endif
 #include "libm.h"
+#include "trig.h"
+#include "exp.h"
 #include "terrain.h"
 #include "spheres.h"
 
@@ -172,7 +174,7 @@ typedef struct {
     const int *rod_a;           /* a rod's ends, within the creature */
     const int *rod_b;
     const double *rod_drag;     /* per rod: -0.5 C rho D, as forces/rod_drag.rs forms it */
-    const double *fluid_current; /* 3 per fluid: its uniform current (0 in still water) */
+    const double *fluid_current; /* AN_CURRENT per fluid: its current (an_current) */
     const double *rod_current;   /* 3 per rod: its fluid's uniform current (0 in still water) */
     const long long *first_plane; /* per creature: its plane constraints, in the world's order */
     const double *plane_param;    /* 7 per plane: point, unit normal, 1 if handled before the floor */
@@ -300,12 +302,40 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
     }
 }
 
-/* Fluids q0 .. q0 + nq - 1 on every particle of the creature, still or
- * in a uniform current (forces/fluid.rs, `force_on`): quadratic drag
- * against the velocity relative to the water, and buoyancy. In still
- * water the current is 0, and v - 0 is v to the bit (-0 included). */
+/* A fluid's current, AN_CURRENT numbers (src/pack.rs `current`): its
+ * uniform velocity (still water 0); then NaN, or a reef's (forces/current.rs
+ * `ReefWater`) surface, amplitude * omega, k, omega and direction (x, y, z,
+ * normalised, y 0), its drift in the first three. */
+#define AN_CURRENT 11
+
+/* The current's velocity at p at time t, into u (ReefWater::velocity,
+ * in its order: glam's dot and its vector sums written out). */
+AN_FN void an_current(const double *cur, const double *p, double t, double *u) {
+    if (cur[3] != cur[3]) {
+        u[0] = cur[0];
+        u[1] = cur[1];
+        u[2] = cur[2];
+        return;
+    }
+    const double *dir = cur + 8;
+    double depth = cur[4] - p[1];
+    depth = depth > 0.0 ? depth : 0.0; /* f64::max(depth, 0.0): NaN gives 0 */
+    double speed = cur[5] * an_exp(-cur[6] * depth);
+    double phase = cur[6] * ((dir[0] * p[0] + dir[1] * p[1]) + dir[2] * p[2]) - cur[7] * t;
+    double s = an_sin(phase), c = an_cos(phase);
+    double along = speed * c, up = speed * s;
+    u[0] = (dir[0] * along + 0.0 * up) + cur[0];
+    u[1] = (dir[1] * along + 1.0 * up) + cur[1];
+    u[2] = (dir[2] * along + 0.0 * up) + cur[2];
+}
+
+/* Fluids q0 .. q0 + nq - 1 on every particle of the creature, still, in
+ * a uniform current or under a reef's waves, at time t (forces/fluid.rs,
+ * `force_on`): quadratic drag against the velocity relative to the
+ * water, and buoyancy. In still water the current is 0, and v - 0 is v
+ * to the bit (-0 included). */
 AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, long long q0,
-                     long long nq, const double *v, double *f) {
+                     long long nq, const double *x, const double *v, double *f, double t) {
     double g[3] = {b->gx, b->gy, b->gz};
     if (!b->gravity) {
         g[0] = 0.0;
@@ -314,10 +344,11 @@ AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, 
     }
     for (long long q = q0; q < q0 + nq; q++) {
         double drag = b->fluid_drag[q], density = b->fluid_density[q];
-        const double *cur = b->fluid_current + 3 * q;
+        const double *cur = b->fluid_current + AN_CURRENT * q;
         for (long long i = 0; i < n; i++) {
-            double r = st.r[i];
-            double vr[3] = {v[3 * i] - cur[0], v[3 * i + 1] - cur[1], v[3 * i + 2] - cur[2]};
+            double r = st.r[i], u[3];
+            an_current(cur, x + 3 * i, t, u);
+            double vr[3] = {v[3 * i] - u[0], v[3 * i + 1] - u[1], v[3 * i + 2] - u[2]};
             double speed = sqrt(an_dot(vr, vr));
             double s = drag * r * r * speed;
             double lift = -b->volume[p0 + i] * density;
@@ -522,10 +553,10 @@ AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long lo
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
  * joints, torque joints, constant forces, fluids, soft contact and then
  * rod drag (user forces of the body stage), the floor's contact force. h: the step
- * of the trial. */
+ * of the trial, t: the time the forces are asked at. */
 AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, long long n,
                      long long s0, long long ns, const double *x, const double *v, double *f,
-                     double h) {
+                     double h, double t) {
     for (long long i = 0; i < n; i++) {
         if (b->gravity) {
             double m = st.m[i];
@@ -569,7 +600,7 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
         }
     }
     long long q0 = b->first_fluid[c];
-    an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, v, f);
+    an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, x, v, f, t);
     long long c0 = b->first_pair[c];
     an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
     long long r0 = b->first_rod[c];
@@ -581,16 +612,18 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     }
 }
 
-/* One integrator step of size h from (x0, v0) into (x1, v1)
- * (the files of integrators/); f, dx, dv: scratch. */
+/* One integrator step of size h from (x0, v0) at time t into (x1, v1)
+ * (the files of integrators/, each stage's forces at their times); f,
+ * dx, dv: scratch. */
 AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p0, long long n,
-                        long long s0, long long ns, double h, const double *x0, const double *v0,
-                        double *x1, double *v1, double *f, double *dx, double *dv) {
+                        long long s0, long long ns, double h, double t, const double *x0,
+                        const double *v0, double *x1, double *v1, double *f, double *dx,
+                        double *dv) {
     long long m3 = 3 * n;
     const double *w = st.w;
     switch (b->integrator) {
     case AN_EULER:
-        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {
             x1[k] = x0[k] + h * v0[k];
             v1[k] = v0[k] + (h * w[k / 3]) * f[k];
@@ -598,12 +631,12 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
         break;
     case AN_MIDPOINT: {
         double half = 0.5 * h;
-        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {
             x1[k] = x0[k] + half * v0[k];
             v1[k] = v0[k] + (half * w[k / 3]) * f[k];
         }
-        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h, t + half);
         for (long long k = 0; k < m3; k++) {
             double vm = v1[k];
             x1[k] = x0[k] + h * vm;
@@ -613,7 +646,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
     }
     case AN_RK4: {
         double half = 0.5 * h;
-        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {
             double a = f[k] * w[k / 3];
             dx[k] = v0[k];
@@ -623,7 +656,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
         }
         for (int stage = 0; stage < 2; stage++) {
             double to = stage == 0 ? half : h;
-            an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
+            an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h, t + half);
             for (long long k = 0; k < m3; k++) {
                 double a = f[k] * w[k / 3];
                 double vi = v1[k];
@@ -633,7 +666,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
                 v1[k] = v0[k] + a * to;
             }
         }
-        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x1, v1, f, h, t + h);
         double sixth = h / 6.0;
         for (long long k = 0; k < m3; k++) {
             double a = f[k] * w[k / 3];
@@ -645,7 +678,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
         break;
     }
     default: /* AN_SYMPLECTIC */
-        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h);
+        an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {
             double vk = v0[k] + f[k] * (h * w[k / 3]);
             v1[k] = vk;
@@ -925,7 +958,7 @@ AN_FN int an_finite(const double *x, long long m3) {
  * missed down to 1/1024 of the step, and grown back once they line up).
  * Returns 1; or 0 where the state would stop being finite, leaving it at
  * its last finite state, as the engine's step refuses it. */
-AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
+AN_FN int an_step_once(const an_batch *b, an_state st, long long c, double t0) {
     long long p0 = b->first_particle[c], n = b->first_particle[c + 1] - p0;
     long long s0 = b->first_spring[c], ns = b->first_spring[c + 1] - s0;
     long long m3 = 3 * n;
@@ -959,7 +992,9 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c) {
     }
     while (done < total) {
         double h = piece == total ? dt : dt * ((double)piece / (double)total);
-        an_integrate(b, st, c, p0, n, s0, ns, h, x, v, x1, v1, f, dx, dv);
+        /* (World::step: the whole step from t0, a piece from its start.) */
+        double t = piece == total ? t0 : t0 + dt * ((double)done / (double)total);
+        an_integrate(b, st, c, p0, n, s0, ns, h, t, x, v, x1, v1, f, dx, dv);
         int state = !b->floor                  ? AN_NONE
                     : AN_ON_TERRAIN(b) ? an_terrain_check(b, st, n, x1)
                                               : an_floor_check(b, st, n, x1);
@@ -1027,7 +1062,8 @@ AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long lo
         return;
     }
     for (long long step = 0; step < steps; step++) {
-        if (!an_step_once(b, st, c)) {
+        /* (No force of a world batch asks the time: src/pack.rs.) */
+        if (!an_step_once(b, st, c, 0.0)) {
             b->failed[c] = b->steps_before + step + 1;
             return;
         }

@@ -301,8 +301,16 @@ impl Batch {
     /// torques, constant forces, fluids about every particle (still or in a uniform current), soft
     /// contact, the floor under every particle, flat or shaped, plane
     /// constraints, sphere contact among every particle): anything else is
-    /// refused with a message naming the world and what it holds.
+    /// refused with a message naming the world and what it holds. (A
+    /// reef's waves, which ask the time, are stepped only in whole
+    /// evaluations, [`Batch::pack_scenes`], whose clock the C keeps.)
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
+        Batch::pack_timed(worlds, dt, false)
+    }
+
+    /// [`Batch::pack`]; `timed`: the C keeps each world's clock (a whole
+    /// evaluation), so forces that ask the time may be stepped.
+    pub(crate) fn pack_timed(worlds: &[&World], dt: f64, timed: bool) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(format!(
                 "dt = {dt}: the step must be a positive number of seconds"
@@ -389,7 +397,7 @@ impl Batch {
             (b.terrain, b.terrain_param, b.terrain_height) = terrain_arrays(&f.terrain);
         }
         for (k, w) in worlds.iter().enumerate() {
-            supported(w).map_err(|what| format!("world {k}: {what}"))?;
+            supported(w, timed).map_err(|what| format!("world {k}: {what}"))?;
             let same_gravity = w.forces().gravity().is_some() == gravity
                 && w.forces().g().to_array().map(f64::to_bits) == g.to_array().map(f64::to_bits);
             let floor = floor_of(w).map_err(|e| format!("world {k}: {e}"))?;
@@ -456,7 +464,7 @@ impl Batch {
                 b.fluid_drag
                     .push(-0.5 * fl.drag_coefficient * fl.density * std::f64::consts::PI);
                 b.fluid_density.push(fl.density);
-                b.fluid_current.extend(uniform(&fl.current).to_array());
+                b.fluid_current.extend(current(&fl.current));
             }
             for sc in w
                 .forces()
@@ -972,8 +980,9 @@ const MAX_SPHERES: usize = 2048;
 const MAX_PLANES: usize = 64;
 
 /// Whether the C steps world `w` as the engine does: `Err` names the first
-/// thing it holds that the C does not step.
-fn supported(w: &World) -> Result<(), String> {
+/// thing it holds that the C does not step; `timed` as for
+/// [`Batch::pack_timed`].
+fn supported(w: &World, timed: bool) -> Result<(), String> {
     use animats_engine::Targets;
     let f = w.forces();
     let refuse = |what: &str| Err(format!("{what} is not in the GPU step yet"));
@@ -1038,8 +1047,10 @@ fn supported(w: &World) -> Result<(), String> {
         if fl.targets != Targets::All {
             return refuse("a fluid about some particles only");
         }
-        if uniform_or_still(&fl.current).is_none() {
-            return refuse("a fluid's current other than a uniform one");
+        if uniform_or_still(&fl.current).is_none() && !timed {
+            return refuse(
+                "a fluid's current that varies (a reef's waves) outside a whole evaluation",
+            );
         }
     }
     if !f.nbody().is_empty() {
@@ -1061,6 +1072,39 @@ fn supported(w: &World) -> Result<(), String> {
         rods_seen |= rods;
     }
     Ok(())
+}
+
+/// A fluid's current as the C reads it (`kernel/step.h`, `an_current`):
+/// its uniform velocity (0 in still water), then NaN; or a reef's drift,
+/// then its surface, `amplitude × ω`, `k`, `ω` and its direction
+/// normalised (forces/current.rs, `ReefWater::velocity`, which forms each
+/// of them so).
+fn current(c: &animats_engine::Current) -> [f64; 11] {
+    use std::f64::consts::TAU;
+    match c {
+        animats_engine::Current::Reef(r) => {
+            let k = TAU / r.wavelength;
+            let omega = TAU / r.period;
+            let dir = DVec3::new(r.direction.x, 0.0, r.direction.z).normalize_or_zero();
+            [
+                r.drift.x,
+                r.drift.y,
+                r.drift.z,
+                1.0,
+                r.surface,
+                r.amplitude * omega,
+                k,
+                omega,
+                dir.x,
+                dir.y,
+                dir.z,
+            ]
+        }
+        other => {
+            let u = uniform(other);
+            [u.x, u.y, u.z, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+        }
+    }
 }
 
 /// A current's velocity where the C steps it: still water (0) or a

@@ -279,6 +279,47 @@ fn skewed_oscillators_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn creatures_under_a_reef_s_waves_are_the_engine_s_to_the_bit() {
+    // A current that asks the time, at each stage's time and each piece's:
+    // random swimmers under shallow waves with each integrator, 2 s, and
+    // the walker on its floor in them (its landings taken in pieces).
+    let reef = "current = { kind = \"reef\", surface = 0.4, amplitude = 0.1, wavelength = 1.5, direction = [1.0, 0.0, 0.3], drift = [0.05, 0.0, 0.0] }\n";
+    let swim = include_str!("../../../scenes/bodies_swim.toml");
+    for integrator in ["symplectic", "rk4", "midpoint", "euler"] {
+        let text = swim
+            .replace("duration = 20.0", "duration = 2.0")
+            .replace(
+                "drag_coefficient = 0.47\n",
+                &format!("drag_coefficient = 0.47\n{reef}"),
+            )
+            .replace(
+                "integrator = \"symplectic\"",
+                &format!("integrator = \"{integrator}\""),
+            );
+        assert!(text.contains("reef") && text.contains(integrator));
+        let problem = MorphologyProblem::parse(&text, "bodies_swim.toml").unwrap();
+        let got = assert_same(
+            random_bodies(&problem, 3, 8),
+            &format!("swimmers under waves, {integrator}"),
+        );
+        assert!(distinct_distances(&got) > 4, "{got:?}");
+    }
+    for integrator in ["symplectic", "rk4"] {
+        // (A thin envelope: landings missed, the step taken again in pieces.)
+        let text = format!(
+            "{}\n[fluid]\ndensity = 300.0\n{reef}",
+            walker(2.0, integrator, "").replace("[floor]\n", "[floor]\nenvelope = 1e-5\n")
+        );
+        assert!(text.contains("envelope"));
+        let got = assert_same(
+            genomes(&text, 8, 5),
+            &format!("walkers under waves, {integrator}"),
+        );
+        assert!(distinct_distances(&got) > 4, "{got:?}");
+    }
+}
+
+#[test]
 fn swimmers_in_water_that_drags_across_limbs_are_the_engine_s_to_the_bit() {
     // The rods swim task's random starts, 2 s each, and its shipped best
     // (seed 2 of docs/BODIES.md), 2 s: drag across springs, still water,

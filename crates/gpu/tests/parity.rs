@@ -764,7 +764,7 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let err = Batch::pack(&[&reef], 1e-3).unwrap_err();
     assert_eq!(
         err,
-        "world 0: a fluid's current other than a uniform one is not in the GPU step yet"
+        "world 0: a fluid's current that varies (a reef's waves) outside a whole evaluation is not in the GPU step yet"
     );
 
     // At most 64 planes a world (the C notes which a trial leaves in one
