@@ -175,7 +175,7 @@ typedef struct {
     const int *rod_b;
     const double *rod_drag;     /* per rod: -0.5 C rho D, as forces/rod_drag.rs forms it */
     const double *fluid_current; /* AN_CURRENT per fluid: its current (an_current) */
-    const double *rod_current;   /* 3 per rod: its fluid's uniform current (0 in still water) */
+    const double *rod_current;   /* AN_CURRENT per rod: its fluid's current (an_current) */
     const long long *first_plane; /* per creature: its plane constraints, in the world's order */
     const double *plane_param;    /* 7 per plane: point, unit normal, 1 if handled before the floor */
     const long long *plane_first_particle; /* per plane, over the batch: its particles */
@@ -402,18 +402,19 @@ AN_FN void an_soft_contact(const an_batch *b, an_state st, long long q0, long lo
 #define AN_GAUSS_0 0.21132486540518708
 #define AN_GAUSS_1 0.7886751345948129
 
-/* Drag across the rods q0 .. q0 + nq - 1, in still water or a uniform
- * current (forces/rod_drag.rs, `apply`): -0.5 C rho D |v_n| v_n per
- * length, v_n the velocity relative to the water across the rod,
- * integrated by two-point Gauss quadrature, each point's force split
- * between the ends as a lever splits it. */
+/* Drag across the rods q0 .. q0 + nq - 1, in still water, a uniform
+ * current or a reef's waves at time t (forces/rod_drag.rs, `apply`):
+ * -0.5 C rho D |v_n| v_n per length, v_n the velocity relative to the
+ * water across the rod, integrated by two-point Gauss quadrature (the
+ * current taken at each point), each point's force split between the
+ * ends as a lever splits it. */
 AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const double *x,
-                       const double *v, double *f) {
+                       const double *v, double *f, double t) {
     const double gauss[2] = {AN_GAUSS_0, AN_GAUSS_1};
     for (long long q = q0; q < q0 + nq; q++) {
         long long a = b->rod_a[q], e = b->rod_b[q];
         double drag = b->rod_drag[q];
-        const double *cur = b->rod_current + 3 * q;
+        const double *cur = b->rod_current + AN_CURRENT * q;
         double d[3], u[3], dv[3], fa[3] = {0.0, 0.0, 0.0}, fe[3] = {0.0, 0.0, 0.0};
         for (int k = 0; k < 3; k++) {
             d[k] = x[3 * e + k] - x[3 * a + k];
@@ -427,9 +428,13 @@ AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const doub
             dv[k] = v[3 * e + k] - v[3 * a + k];
         }
         for (int g = 0; g < 2; g++) {
-            double xi = gauss[g], w[3], vn[3];
+            double xi = gauss[g], w[3], vn[3], at[3], uc[3];
             for (int k = 0; k < 3; k++) {
-                w[k] = (v[3 * a + k] + dv[k] * xi) - cur[k];
+                at[k] = x[3 * a + k] + d[k] * xi;
+            }
+            an_current(cur, at, t, uc);
+            for (int k = 0; k < 3; k++) {
+                w[k] = (v[3 * a + k] + dv[k] * xi) - uc[k];
             }
             double along = an_dot(w, u);
             for (int k = 0; k < 3; k++) {
@@ -604,7 +609,7 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     long long c0 = b->first_pair[c];
     an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
     long long r0 = b->first_rod[c];
-    an_rod_drag(b, r0, b->first_rod[c + 1] - r0, x, v, f);
+    an_rod_drag(b, r0, b->first_rod[c + 1] - r0, x, v, f, t);
     if (b->floor && b->floor_contact) {
         for (long long i = 0; i < n; i++) {
             an_floor_contact(b, st, i, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);

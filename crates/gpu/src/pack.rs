@@ -489,7 +489,7 @@ impl Batch {
                     b.rod_a.push(a as i32);
                     b.rod_b.push(e as i32);
                     b.rod_drag.push(drag);
-                    b.rod_current.extend(uniform(&rd.current).to_array());
+                    b.rod_current.extend(current(&rd.current));
                 }
             }
             // Planes, in the order of the world's events, each marked
@@ -1056,8 +1056,8 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
     if !f.nbody().is_empty() {
         return refuse("n-body gravity");
     }
-    // Soft contact and drag across springs (in still water or a uniform
-    // current) are the user forces the C steps (body-stage forces, after the fluids, as the
+    // Soft contact and drag across springs (in still water, a uniform
+    // current, or when timed a reef's waves) are the user forces the C steps (body-stage forces, after the fluids, as the
     // engine orders them): every soft contact, then every rod drag.
     let mut rods_seen = false;
     for u in f.user() {
@@ -1065,7 +1065,7 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
         let soft = any.is_some_and(|a| a.is::<SoftContact>());
         let rods = any
             .and_then(|a| a.downcast_ref::<RodDrag>())
-            .is_some_and(|r| uniform_or_still(&r.current).is_some());
+            .is_some_and(|r| timed || uniform_or_still(&r.current).is_some());
         if !(soft || rods) || u.stage() != animats_engine::Stage::Body || (soft && rods_seen) {
             return refuse(&format!("the user force `{}`", u.name()));
         }

@@ -281,8 +281,9 @@ fn skewed_oscillators_are_the_engine_s_to_the_bit() {
 #[test]
 fn creatures_under_a_reef_s_waves_are_the_engine_s_to_the_bit() {
     // A current that asks the time, at each stage's time and each piece's:
-    // random swimmers under shallow waves with each integrator, 2 s, and
-    // the walker on its floor in them (its landings taken in pieces).
+    // random swimmers under shallow waves with each integrator, 2 s, with
+    // drag across their springs too, and the walker on its floor in them
+    // (its landings taken in pieces).
     let reef = "current = { kind = \"reef\", surface = 0.4, amplitude = 0.1, wavelength = 1.5, direction = [1.0, 0.0, 0.3], drift = [0.05, 0.0, 0.0] }\n";
     let swim = include_str!("../../../scenes/bodies_swim.toml");
     for integrator in ["symplectic", "rk4", "midpoint", "euler"] {
@@ -304,6 +305,17 @@ fn creatures_under_a_reef_s_waves_are_the_engine_s_to_the_bit() {
         );
         assert!(distinct_distances(&got) > 4, "{got:?}");
     }
+    // Drag across springs under them, the current taken at each Gauss point.
+    let text = include_str!("../../../scenes/bodies_swim_rods.toml")
+        .replace("duration = 20.0", "duration = 2.0")
+        .replace(
+            "drag_coefficient = 0.47\n",
+            &format!("drag_coefficient = 0.47\n{reef}"),
+        );
+    assert!(text.contains("reef"));
+    let problem = MorphologyProblem::parse(&text, "bodies_swim_rods.toml").unwrap();
+    let got = assert_same(random_bodies(&problem, 4, 8), "rods under waves");
+    assert!(distinct_distances(&got) > 4, "{got:?}");
     for integrator in ["symplectic", "rk4"] {
         // (A thin envelope: landings missed, the step taken again in pieces.)
         let text = format!(
