@@ -36,6 +36,11 @@ pub(crate) fn problem_spec(what: &Bound<'_, PyAny>) -> PyResult<ProblemSpec> {
     }
     let file = path.display().to_string();
     let text = animats_scene::read(&path).map_err(scene_error)?;
+    // What `animats evaluate` would warn of, as `animats.load` warns of it
+    // (a mistake is raised where the problem is built).
+    if let Ok(s) = animats_scene::parse(&text, &file) {
+        crate::scene::warn(what.py(), &file, &s.warnings)?;
+    }
     Ok(ProblemSpec { file, text })
 }
 

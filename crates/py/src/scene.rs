@@ -84,14 +84,21 @@ impl Scene {
     /// Issues each of the scene's warnings as a Python `RuntimeWarning`
     /// ("FILE: message", as `animats simulate` prints them).
     fn warn(self, py: Python<'_>) -> PyResult<Scene> {
-        let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
-        for w in &self.warnings {
-            let text = std::ffi::CString::new(format!("{}: {w}", self.file))
-                .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-            PyErr::warn(py, &category, &text, 1)?;
-        }
+        warn(py, &self.file, &self.warnings)?;
         Ok(self)
     }
+}
+
+/// Issues `warnings` of the scene `file` as Python `RuntimeWarning`s
+/// ("FILE: message", as `animats simulate` prints them).
+pub(crate) fn warn(py: Python<'_>, file: &str, warnings: &[String]) -> PyResult<()> {
+    let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+    for w in warnings {
+        let text = std::ffi::CString::new(format!("{file}: {w}"))
+            .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+        PyErr::warn(py, &category, &text, 1)?;
+    }
+    Ok(())
 }
 
 /// Reads and checks the scene file at `path`. Raises `animats.SceneError`

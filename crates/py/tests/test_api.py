@@ -290,6 +290,18 @@ def test_a_step_past_the_stability_limit_is_a_runtime_warning(root, tmp_path):
     with pytest.warns(RuntimeWarning, match="expect some bodies to blow up"):
         coarse = animats.parse(coarse_text, "coarse.toml")
     assert any("stable below 7.071e-3 s" in x for x in coarse.warnings), coarse.warnings
+    # A scene given by its path to `evaluate` and `Evolution` warns as
+    # `load` does (and as `animats evaluate` prints it).
+    walker = (root / "scenes" / "walker.toml").read_text()
+    coarse_text, changed = re.subn(r"\ndt = [^\n]*\n", "\ndt = 0.05\n", walker, count=1)
+    assert changed == 1
+    coarse_path = tmp_path / "coarse_walker.toml"
+    coarse_path.write_text(coarse_text)
+    genome = animats.load(root / "scenes" / "walker.toml").start()
+    with pytest.warns(RuntimeWarning, match=f"^{re.escape(str(coarse_path))}: dt = 0.05 s .*expect a blow-up"):
+        animats.evaluate(str(coarse_path), genome)
+    with pytest.warns(RuntimeWarning, match="expect a blow-up"):
+        animats.Evolution(str(coarse_path), generations=1, lanes=1, seed=1)
     # The shipped scenes load without a word.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
