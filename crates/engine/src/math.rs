@@ -103,6 +103,62 @@ pub fn sin_lanes(x: [f64; LANES]) -> [f64; LANES] {
     out
 }
 
+/// [`exp`] of [`LANES`] arguments at once, each lane the bits of
+/// `exp(x[i])`.
+///
+/// musl's `exp` (the `libm` crate's port) with its branches turned into
+/// selections, for `2⁻²⁸ < |x| < 708.39` (below, musl returns `1 + x`;
+/// above, it handles overflow): each lane picks musl's `k` (0 below
+/// ½ ln 2, ±1 below 1.5 ln 2, else `⌊x/ln 2 ± ½⌉` truncated), reduces,
+/// evaluates musl's polynomial and scales by `2ᵏ` (musl's `scalbn` is
+/// one multiplication for these `k`), in musl's operations and order.
+/// (`k = 0` goes through the same reduction: `x − 0·ln2hi` is `x`.) Any
+/// other argument sends every lane to [`exp`]. (`tests/math.rs` holds
+/// every lane to `libm::exp` on 10⁷ arguments and the edges.)
+#[inline]
+pub fn exp_lanes(x: [f64; LANES]) -> [f64; LANES] {
+    const LN2HI: f64 = f64::from_bits(0x3FE62E42_FEE00000);
+    const LN2LO: f64 = f64::from_bits(0x3DEA39EF_35793C76);
+    const INVLN2: f64 = f64::from_bits(0x3FF71547_652B82FE);
+    const P1: f64 = f64::from_bits(0x3FC55555_5555553E);
+    const P2: f64 = f64::from_bits(0xBF66C16C_16BEBD93);
+    const P3: f64 = f64::from_bits(0x3F11566A_AF25DE2C);
+    const P4: f64 = f64::from_bits(0xBEBBBD41_C5D26BF1);
+    const P5: f64 = f64::from_bits(0x3E663769_72BEA4D0);
+    const BIAS: f64 = 6_755_399_441_056_767.0; // 1.5·2⁵² + 1023
+    let mut general = true;
+    let mut out = [0.0; LANES];
+    for i in 0..LANES {
+        let x = x[i];
+        let high = (x.to_bits() >> 32) as u32;
+        let hx = high & 0x7fff_ffff;
+        let negative = high >> 31 == 1;
+        general &= (hx > 0x3e30_0000) & (hx < 0x4086_232b);
+        let near = if negative { -1.0 } else { 1.0 };
+        let far = (INVLN2 * x + if negative { -0.5 } else { 0.5 }).trunc();
+        let k = if hx >= 0x3ff0_a2b2 {
+            far
+        } else if hx > 0x3fd6_2e42 {
+            near
+        } else {
+            0.0
+        };
+        let hi = x - k * LN2HI;
+        let lo = k * LN2LO;
+        let x = hi - lo;
+        let xx = x * x;
+        let c = x - xx * (P1 + xx * (P2 + xx * (P3 + xx * (P4 + xx * P5))));
+        let y = 1. + (x * c / (2. - c) - lo + hi);
+        // 2^k: k + 1023 in the last bits of 1.5·2⁵² + 1023 + k.
+        let scale = f64::from_bits(((k + BIAS).to_bits() & 0x7ff) << 52);
+        out[i] = y * scale;
+    }
+    if !general {
+        return std::array::from_fn(|i| exp(x[i]));
+    }
+    out
+}
+
 /// `cos x`.
 #[inline]
 pub fn cos(x: f64) -> f64 {

@@ -1,11 +1,11 @@
-//! `math::sin_lanes` against `math::sin` (the `libm` crate's musl port),
-//! bit for bit, lane by lane: the edges of musl's ranges and their
+//! `math::sin_lanes` and `math::exp_lanes` against `math::sin` and
+//! `math::exp` (the `libm` crate's musl port), bit for bit, lane by lane: the edges of musl's ranges and their
 //! neighbours, each in every lane beside ordinary arguments; the multiples
 //! of π/2 where its reduction cancels; 10⁷ random arguments, spread over
 //! every binade up to 2²⁴ and over an oscillator's phases; random bit
 //! patterns.
 
-use animats_engine::math::{sin, sin_lanes, LANES};
+use animats_engine::math::{exp, exp_lanes, sin, sin_lanes, LANES};
 
 /// Random 64-bit patterns (splitmix64).
 struct Bits(u64);
@@ -119,5 +119,60 @@ fn ten_million_random_arguments_are_libm_s() {
     // Random bit patterns: every exponent, NaNs and infinities included.
     for _ in 0..1_000_000 / LANES {
         check(std::array::from_fn(|_| f64::from_bits(r.next())));
+    }
+}
+
+/// Asserts every lane of `exp_lanes(x)` has `exp`'s bits.
+fn check_exp(x: [f64; LANES]) {
+    let got = exp_lanes(x);
+    for i in 0..LANES {
+        let want = exp(x[i]);
+        assert!(
+            got[i].to_bits() == want.to_bits() || (got[i].is_nan() && want.is_nan()),
+            "lane {i}: exp({:e}) ({:#x}) = {:e}, libm {:e}",
+            x[i],
+            x[i].to_bits(),
+            got[i],
+            want
+        );
+    }
+}
+
+#[test]
+fn exp_at_the_edges_of_musl_s_ranges_and_at_random_is_libm_s() {
+    // musl's range edges as high words (2^-28, ½ ln 2, 1.5 ln 2, 708.39),
+    // with their neighbours, both signs, in every lane beside ordinary
+    // arguments; then 10^7 random ones over every binade to 2^10 and
+    // over a logistic output's inputs; then random bit patterns.
+    let mut v = vec![0.0, f64::INFINITY, f64::NAN, 709.8, -745.2, 1e-300];
+    for high in [0x3e30_0000u64, 0x3fd6_2e42, 0x3ff0_a2b2, 0x4086_232b] {
+        for low in [0u64, 1, 0x7fff_ffff, 0xffff_fffe, 0xffff_ffff] {
+            v.push(f64::from_bits((high << 32) | low));
+            v.push(f64::from_bits(((high - 1) << 32) | low));
+            v.push(f64::from_bits(((high + 1) << 32) | low));
+        }
+    }
+    let negated: Vec<f64> = v.iter().map(|e| -e).collect();
+    v.extend(negated);
+    let ordinary = [0.7, -3.25, 12.5, -0.01];
+    for &x in &v {
+        check_exp([x; LANES]);
+        for lane in 0..LANES {
+            let mut xs = ordinary;
+            xs[lane] = x;
+            check_exp(xs);
+        }
+    }
+    let mut r = Bits(11);
+    for k in 0..10_000_000 / LANES {
+        let x: [f64; LANES] = if k % 2 == 0 {
+            std::array::from_fn(|_| r.spread(-30, 9))
+        } else {
+            std::array::from_fn(|_| 40.0 * (r.unit() - 0.5))
+        };
+        check_exp(x);
+    }
+    for _ in 0..1_000_000 / LANES {
+        check_exp(std::array::from_fn(|_| f64::from_bits(r.next())));
     }
 }

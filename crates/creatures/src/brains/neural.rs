@@ -36,7 +36,22 @@ pub struct NeuralEntry {
     pub seed: Option<u64>,
 }
 
-/// The most weights and biases a network may have.
+/// Each `a` in `y` becomes `1 / (1 + e^−a)`, libm's `exp` a group of
+/// outputs at a time (the same bits as one at a time; lanes past the last
+/// repeat the group's first).
+fn logistic(y: &mut [f64]) {
+    use animats_engine::math::{exp_lanes, LANES};
+    for group in y.chunks_mut(LANES) {
+        let e = exp_lanes(std::array::from_fn(|k| {
+            -group[if k < group.len() { k } else { 0 }]
+        }));
+        for (a, e) in group.iter_mut().zip(e) {
+            *a = 1.0 / (1.0 + e);
+        }
+    }
+}
+
+/// The most weights and biases a network may have./// The most weights and biases a network may have.
 pub const MAX_WEIGHTS: usize = 1_000_000;
 
 impl NeuralEntry {
@@ -165,10 +180,13 @@ impl Brain for Neural {
                     a += w * xi;
                 }
                 y.push(if l + 1 == layers {
-                    1.0 / (1.0 + animats_engine::math::exp(-a))
+                    a
                 } else {
                     animats_engine::math::tanh(a)
                 });
+            }
+            if l + 1 == layers {
+                logistic(y);
             }
             k = biases + n_out;
             std::mem::swap(x, y);
