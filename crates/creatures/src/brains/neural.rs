@@ -51,7 +51,7 @@ fn logistic(y: &mut [f64]) {
     }
 }
 
-/// The most weights and biases a network may have./// The most weights and biases a network may have.
+/// The most weights and biases a network may have.
 pub const MAX_WEIGHTS: usize = 1_000_000;
 
 impl NeuralEntry {
