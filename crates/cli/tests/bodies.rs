@@ -426,7 +426,7 @@ fn shipped(name: &str) -> String {
     .unwrap()
 }
 
-/// The shipped scene `scenes/NAME` (whose step is 0.5 ms) at step `dt`.
+/// The shipped scene `scenes/NAME` at step `dt` (its `[world] dt` line replaced).
 fn shipped_at(name: &str, dt: &str) -> String {
     let text = shipped(name);
     let at = text

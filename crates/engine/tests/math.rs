@@ -36,14 +36,15 @@ impl Bits {
     }
 }
 
-/// Asserts every lane of `sin_lanes(x)` has `sin`'s bits.
-fn check(x: [f64; LANES]) {
-    let got = sin_lanes(x);
+/// Asserts every lane of `lanes(x)` has the bits of `one` (named `name`)
+/// of that lane's argument.
+fn same(name: &str, lanes: fn([f64; LANES]) -> [f64; LANES], one: fn(f64) -> f64, x: [f64; LANES]) {
+    let got = lanes(x);
     for i in 0..LANES {
-        let want = sin(x[i]);
+        let want = one(x[i]);
         assert!(
             got[i].to_bits() == want.to_bits() || (got[i].is_nan() && want.is_nan()),
-            "lane {i}: sin({:e}) ({:#x}) = {:e} ({:#x}), libm {:e} ({:#x})",
+            "lane {i}: {name}({:e}) ({:#x}) = {:e} ({:#x}), libm {:e} ({:#x})",
             x[i],
             x[i].to_bits(),
             got[i],
@@ -52,6 +53,11 @@ fn check(x: [f64; LANES]) {
             want.to_bits()
         );
     }
+}
+
+/// Asserts every lane of `sin_lanes(x)` has `sin`'s bits.
+fn check(x: [f64; LANES]) {
+    same("sin", sin_lanes, sin, x);
 }
 
 #[test]
@@ -124,18 +130,7 @@ fn ten_million_random_arguments_are_libm_s() {
 
 /// Asserts every lane of `exp_lanes(x)` has `exp`'s bits.
 fn check_exp(x: [f64; LANES]) {
-    let got = exp_lanes(x);
-    for i in 0..LANES {
-        let want = exp(x[i]);
-        assert!(
-            got[i].to_bits() == want.to_bits() || (got[i].is_nan() && want.is_nan()),
-            "lane {i}: exp({:e}) ({:#x}) = {:e}, libm {:e}",
-            x[i],
-            x[i].to_bits(),
-            got[i],
-            want
-        );
-    }
+    same("exp", exp_lanes, exp, x);
 }
 
 #[test]

@@ -1047,7 +1047,7 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
         if fl.targets != Targets::All {
             return refuse("a fluid about some particles only");
         }
-        if uniform_or_still(&fl.current).is_none() && !timed {
+        if varies(&fl.current) && !timed {
             return refuse(
                 "a fluid's current that varies (a reef's waves) outside a whole evaluation",
             );
@@ -1065,7 +1065,7 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
         let soft = any.is_some_and(|a| a.is::<SoftContact>());
         let rods = any
             .and_then(|a| a.downcast_ref::<RodDrag>())
-            .is_some_and(|r| timed || uniform_or_still(&r.current).is_some());
+            .is_some_and(|r| timed || !varies(&r.current));
         if !(soft || rods) || u.stage() != animats_engine::Stage::Body || (soft && rods_seen) {
             return refuse(&format!("the user force `{}`", u.name()));
         }
@@ -1080,9 +1080,13 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
 /// normalised (forces/current.rs, `ReefWater::velocity`, which forms each
 /// of them so).
 fn current(c: &animats_engine::Current) -> [f64; 11] {
+    use animats_engine::Current;
     use std::f64::consts::TAU;
+    let uniform = |u: DVec3| [u.x, u.y, u.z, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     match c {
-        animats_engine::Current::Reef(r) => {
+        Current::Still => uniform(DVec3::ZERO),
+        Current::Uniform(v) => uniform(*v),
+        Current::Reef(r) => {
             let k = TAU / r.wavelength;
             let omega = TAU / r.period;
             let dir = DVec3::new(r.direction.x, 0.0, r.direction.z).normalize_or_zero();
@@ -1100,26 +1104,13 @@ fn current(c: &animats_engine::Current) -> [f64; 11] {
                 dir.z,
             ]
         }
-        other => {
-            let u = uniform(other);
-            [u.x, u.y, u.z, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
-        }
     }
 }
 
-/// A current's velocity where the C steps it: still water (0) or a
-/// uniform current; `None` for one that varies (a reef's waves).
-fn uniform_or_still(c: &animats_engine::Current) -> Option<DVec3> {
-    match c {
-        animats_engine::Current::Still => Some(DVec3::ZERO),
-        animats_engine::Current::Uniform(v) => Some(*v),
-        _ => None,
-    }
-}
-
-/// The velocity of a current [`supported`] let through.
-fn uniform(c: &animats_engine::Current) -> DVec3 {
-    uniform_or_still(c).unwrap_or(DVec3::ZERO)
+/// Whether a current varies in time (a reef's waves): the C steps it only
+/// where it keeps the clock.
+fn varies(c: &animats_engine::Current) -> bool {
+    matches!(c, animats_engine::Current::Reef(_))
 }
 
 /// One of a batch's arrays, borrowed.
