@@ -189,6 +189,10 @@ typedef struct {
                                      envelope, rest speed, restitution (NaN: the spheres') */
     const long long *first_slot;  /* per creature: its room in contact_slot */
     long long *contact_slot;      /* 4 n + n (n - 1) / 2 a creature with sphere contact */
+    const long long *first_nbody; /* per creature: its n-body gravity groups */
+    const double *nbody_param;    /* 2 per group: G, softening squared */
+    const long long *nbody_first_body; /* per group, over the batch: its bodies */
+    const int *nbody_body;        /* a body, within the creature, in the group's order */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -554,9 +558,77 @@ AN_FN void an_floor_contact(const an_batch *b, an_state st, long long i, long lo
     }
 }
 
+/* The lanes' sum in nbody/pairs.rs's fixed tree. */
+AN_FN double an_tree8(const double *s) {
+    return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
+}
+
+/* N-body gravity, groups g0 .. g0 + ng - 1 (forces/nbody.rs, `apply`, with
+ * forces/nbody/pairs.rs's sums for a set that is not split into ranges:
+ * fewer than 256 bodies, as pack.rs holds it). Body k's pull is its row:
+ * the bodies after it, body q into accumulator q mod 8 (from +0, in q's
+ * order), reduced in the fixed tree; then, past the first body, plus the
+ * reactions of the rows before it, subtracted from +0 in row order. Each
+ * pair's d = x_later - x_earlier, |d|^2 + eps^2 and 1 / (r2 sqrt r2) are
+ * formed for each of its bodies alike; a pair whose r2 is not positive
+ * (two bodies at one place, unsoftened) pulls nowhere, and is skipped as
+ * `small` skips it (the kernel's zero-weighted terms leave its
+ * accumulators as they were). The force: the pull times G m_k. Out of
+ * line (AN_COLD), so that its registers do not crowd every creature's
+ * step. */
+AN_COLD void an_nbody(const an_batch *b, an_state st, long long g0, long long ng,
+                      const double *x, double *f) {
+    for (long long g = g0; g < g0 + ng; g++) {
+        double G = b->nbody_param[2 * g], eps2 = b->nbody_param[2 * g + 1];
+        long long first = b->nbody_first_body[g], nb = b->nbody_first_body[g + 1] - first;
+        const int *body = b->nbody_body + first;
+        for (long long k = 0; k < nb; k++) {
+            double s[3][8], r[3] = {0.0, 0.0, 0.0};
+            for (int c = 0; c < 3; c++) {
+                for (int l = 0; l < 8; l++) {
+                    s[c][l] = 0.0;
+                }
+            }
+            for (long long q = 0; q < nb; q++) {
+                if (q == k) {
+                    continue;
+                }
+                long long lo = q < k ? q : k, hi = q < k ? k : q;
+                long long a = body[lo], e = body[hi];
+                double dx = x[3 * e] - x[3 * a];
+                double dy = x[3 * e + 1] - x[3 * a + 1];
+                double dz = x[3 * e + 2] - x[3 * a + 2];
+                double r2 = dx * dx + dy * dy + dz * dz + eps2;
+                if (!(r2 > 0.0)) {
+                    continue;
+                }
+                double inv = 1.0 / (r2 * sqrt(r2));
+                if (q > k) {
+                    double wj = st.m[e] * inv;
+                    s[0][q % 8] += dx * wj;
+                    s[1][q % 8] += dy * wj;
+                    s[2][q % 8] += dz * wj;
+                } else {
+                    double wi = st.m[a] * inv;
+                    r[0] -= dx * wi;
+                    r[1] -= dy * wi;
+                    r[2] -= dz * wi;
+                }
+            }
+            long long i = body[k];
+            double gm = G * st.m[i];
+            for (int c = 0; c < 3; c++) {
+                double own = an_tree8(s[c]);
+                double pull = k > 0 ? own + r[c] : own;
+                f[3 * i + c] += pull * gm;
+            }
+        }
+    }
+}
+
 /* The forces on a creature's particles at positions x, velocities v, in
  * the engine's order (force_set.rs, `evaluate`): gravity, springs, angle
- * joints, torque joints, constant forces, fluids, soft contact and then
+ * joints, torque joints, constant forces, fluids, n-body gravity, soft contact and then
  * rod drag (user forces of the body stage), the floor's contact force. h: the step
  * of the trial, t: the time the forces are asked at. */
 AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, long long n,
@@ -606,6 +678,10 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     }
     long long q0 = b->first_fluid[c];
     an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, x, v, f, t);
+    long long n0 = b->first_nbody[c];
+    if (b->first_nbody[c + 1] > n0) {
+        an_nbody(b, st, n0, b->first_nbody[c + 1] - n0, x, f);
+    }
     long long c0 = b->first_pair[c];
     an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
     long long r0 = b->first_rod[c];

@@ -144,6 +144,10 @@ pub(crate) struct Raw {
     contact_param: *const c_double,
     first_slot: *const c_longlong,
     contact_slot: *mut c_longlong,
+    first_nbody: *const c_longlong,
+    nbody_param: *const c_double,
+    nbody_first_body: *const c_longlong,
+    nbody_body: *const c_int,
 }
 
 extern "C" {
@@ -289,6 +293,12 @@ pub struct Batch {
     contact_param: Vec<f64>,
     first_slot: Vec<i64>,
     contact_slot: Vec<i64>,
+    /// N-body gravity (forces/nbody.rs): per creature its groups, each
+    /// one's G and softening squared, and its bodies in its order.
+    first_nbody: Vec<i64>,
+    nbody_param: Vec<f64>,
+    nbody_first_body: Vec<i64>,
+    nbody_body: Vec<i32>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -298,8 +308,8 @@ impl Batch {
     /// world must share the first one's gravity, floor and integrator, and
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
-    /// torques, constant forces, fluids about every particle (still or in a uniform current), soft
-    /// contact, the floor under every particle, flat or shaped, plane
+    /// torques, constant forces, fluids about every particle (still or in a uniform current),
+    /// n-body gravity among fewer than 256 bodies, soft contact, drag across springs, the floor under every particle, flat or shaped, plane
     /// constraints, sphere contact among every particle): anything else is
     /// refused with a message naming the world and what it holds. (A
     /// reef's waves, which ask the time, are stepped only in whole
@@ -391,6 +401,10 @@ impl Batch {
             contact_param: Vec::new(),
             first_slot: vec![0],
             contact_slot: Vec::new(),
+            first_nbody: vec![0],
+            nbody_param: Vec::new(),
+            nbody_first_body: vec![0],
+            nbody_body: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         if let Some(f) = &b.floor {
@@ -466,6 +480,12 @@ impl Batch {
                 b.fluid_density.push(fl.density);
                 b.fluid_current.extend(current(&fl.current));
             }
+            for g in w.forces().nbody() {
+                // As NBodyGravity::apply forms them.
+                b.nbody_param.extend([g.g, g.softening * g.softening]);
+                g.targets().for_each(n, |i| b.nbody_body.push(i as i32));
+                b.nbody_first_body.push(b.nbody_body.len() as i64);
+            }
             for sc in w
                 .forces()
                 .user()
@@ -519,6 +539,7 @@ impl Batch {
             b.first_push.push(b.push_particle.len() as i64);
             b.first_pair.push(b.pair_a.len() as i64);
             b.first_rod.push(b.rod_a.len() as i64);
+            b.first_nbody.push(b.nbody_param.len() as i64 / 2);
             b.first_plane.push(b.plane_first_particle.len() as i64 - 1);
             // Sphere contact ([`supported`]: one, after the floor, every
             // particle, no sleeping).
@@ -789,6 +810,10 @@ impl Batch {
             Array::ContactParam => F64(&self.contact_param),
             Array::FirstSlot => I64(&self.first_slot),
             Array::ContactSlot => I64(&self.contact_slot),
+            Array::FirstNbody => I64(&self.first_nbody),
+            Array::NbodyParam => F64(&self.nbody_param),
+            Array::NbodyFirstBody => I64(&self.nbody_first_body),
+            Array::NbodyBody => I32(&self.nbody_body),
         }
     }
 
@@ -966,6 +991,10 @@ impl Batch {
             contact_param: c(Array::ContactParam),
             first_slot: l(Array::FirstSlot),
             contact_slot: at(Array::ContactSlot) as *mut c_longlong,
+            first_nbody: l(Array::FirstNbody),
+            nbody_param: c(Array::NbodyParam),
+            nbody_first_body: l(Array::NbodyFirstBody),
+            nbody_body: i(Array::NbodyBody),
         }
     }
 }
@@ -974,6 +1003,10 @@ impl Batch {
 /// creature's room for the pairs a check finds: `n (n − 1) / 2` numbers,
 /// 16 MiB at this size).
 const MAX_SPHERES: usize = 2048;
+
+/// An n-body set of this many bodies or more, which the engine sums in
+/// ranges of rows (`forces/nbody/pairs.rs`, `splits`), is not in the C.
+const MAX_NBODY: usize = 256;
 
 /// The most plane constraints a world may hold for the C (it notes which
 /// of them a trial leaves, before handling any event, in one 64-bit word).
@@ -1053,8 +1086,16 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
             );
         }
     }
-    if !f.nbody().is_empty() {
-        return refuse("n-body gravity");
+    // A set the engine sums in ranges, on many threads, is not in the C.
+    for g in f.nbody() {
+        let mut bodies = 0;
+        g.targets().for_each(w.len(), |_| bodies += 1);
+        if bodies >= MAX_NBODY {
+            return refuse(&format!(
+                "n-body gravity among {bodies} bodies (at most {})",
+                MAX_NBODY - 1
+            ));
+        }
     }
     // Soft contact and drag across springs (in still water, a uniform
     // current, or when timed a reef's waves) are the user forces the C steps (body-stage forces, after the fluids, as the
@@ -1239,11 +1280,15 @@ pub(crate) enum Array {
     ContactParam,
     FirstSlot,
     ContactSlot,
+    FirstNbody,
+    NbodyParam,
+    NbodyFirstBody,
+    NbodyBody,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 116] = [
+    pub(crate) const ALL: [Array; 120] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1360,6 +1405,10 @@ impl Array {
         Array::ContactParam,
         Array::FirstSlot,
         Array::ContactSlot,
+        Array::FirstNbody,
+        Array::NbodyParam,
+        Array::NbodyFirstBody,
+        Array::NbodyBody,
     ];
 }
 

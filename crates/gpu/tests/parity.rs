@@ -5,7 +5,7 @@
 //! the engine's paths, below and above its 16-particle "small world"
 //! loop) of springs, angle joints and torque joints, with and without
 //! gravity, in water and air or not, on the floor, pushed, and touching
-//! each other through soft contact.
+//! each other through soft contact; and pulled together by n-body gravity.
 
 use animats_engine::{DVec3, FloorDef, FluidMedium, IntegratorKind, ParticleDef, SpringDef, World};
 use animats_gpu::{Batch, Layout};
@@ -641,6 +641,70 @@ fn bodies_dragged_across_their_springs_in_water_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Random bodies of 2 to 40 particles (both of the engine's n-body sums:
+/// a set of at most 8 summed straight from the particles, a larger one by
+/// its vector kernel, 8 accumulators a row) with n-body gravity among all
+/// their particles, softened or not, and a second set among every other
+/// particle; and three free bodies, two of them at one place, unsoftened
+/// (a pair that pulls nowhere). Positive G, so the bodies pull together.
+#[test]
+fn bodies_pulled_by_n_body_gravity_are_the_engine_s_to_the_bit() {
+    use animats_engine::{NBodyGravity, Targets};
+    let mut rng = Random::for_entry(29, 0);
+    for kind in INTEGRATORS {
+        let make = |rng: &mut Random, pulled: bool| -> Vec<World> {
+            let mut worlds: Vec<World> = (0..16)
+                .map(|k| {
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
+                    let mut w = random_body(rng, n, false, k % 2 == 0, kind).unwrap();
+                    if pulled {
+                        let softening = if k % 2 == 0 { 0.0 } else { 0.05 };
+                        w.add_nbody(NBodyGravity::new(2.3, softening, Targets::All))
+                            .unwrap();
+                        let some: Vec<_> = w.particle_ids().step_by(2).collect();
+                        w.add_nbody(NBodyGravity::new(0.7, 0.1, Targets::Only(some)))
+                            .unwrap();
+                    }
+                    w
+                })
+                .collect();
+            let mut free = World::new();
+            free.set_integrator(kind);
+            for x in [0.0, 0.0, 1.0] {
+                free.add_particle(ParticleDef::new(1.5).at(DVec3::new(x, 0.5, 0.0)))
+                    .unwrap();
+            }
+            if pulled {
+                free.add_nbody(NBodyGravity::new(1.3, 0.0, Targets::All))
+                    .unwrap();
+            }
+            worlds.push(free);
+            worlds
+        };
+        let mut again = rng.clone();
+        let mut worlds = make(&mut rng, true);
+        let mut plain = make(&mut again, false);
+        let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
+        assert!(sizes.iter().any(|&n| n <= 8) && sizes.iter().any(|&n| n > 8));
+        assert_same(
+            &mut worlds,
+            5e-4,
+            400,
+            3,
+            &format!("bodies under n-body gravity {sizes:?}, {kind:?}"),
+        );
+        // The pulls matter: without them every body ends elsewhere.
+        let moved = ending_elsewhere(&worlds, &mut plain);
+        assert_eq!(
+            moved, 17,
+            "{kind:?}: n-body gravity changed only {moved} bodies"
+        );
+        // The two at one place stay there (their own pair pulls nowhere).
+        let free = &worlds[16];
+        assert_eq!(free.state().pos[0], free.state().pos[1]);
+    }
+}
+
 #[test]
 fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let plain = || {
@@ -694,16 +758,25 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "{err}"
     );
 
-    let mut pulled = plain();
-    pulled
+    // An n-body set the engine sums in ranges on many threads.
+    let mut crowd = World::new();
+    for i in 0..256 {
+        crowd
+            .add_particle(ParticleDef::new(1.0).at(DVec3::new(i as f64, 0.0, 0.0)))
+            .unwrap();
+    }
+    crowd
         .add_nbody(animats_engine::NBodyGravity::new(
             1.0,
             0.0,
             Default::default(),
         ))
         .unwrap();
-    let err = Batch::pack(&[&pulled], 1e-3).unwrap_err();
-    assert_eq!(err, "world 0: n-body gravity is not in the GPU step yet");
+    let err = Batch::pack(&[&crowd], 1e-3).unwrap_err();
+    assert_eq!(
+        err,
+        "world 0: n-body gravity among 256 bodies (at most 255) is not in the GPU step yet"
+    );
 
     /// A force of the user's own: the C cannot know it.
     #[derive(Clone)]
