@@ -203,7 +203,9 @@ pub(crate) fn device_batches(device: &str) -> PyResult<Option<Batches>> {
 /// `device="cuda"`, as batches on the GPU): the same bits as `animats
 /// evaluate` on each. A text that is not a scene, or has no `[evolve]`
 /// table, raises `SceneError` naming its index; one the GPU does not
-/// evaluate, a `RuntimeError` naming the entry.
+/// evaluate, a `RuntimeError` naming the entry. What `animats evaluate`
+/// would warn of is a `RuntimeWarning`, once for each message, naming the
+/// scenes that gave it ([`warn_grouped`]).
 #[pyfunction]
 #[pyo3(signature = (texts, threads = None, device = "cpu"))]
 pub fn evaluate_scenes<'py>(
@@ -215,6 +217,7 @@ pub fn evaluate_scenes<'py>(
     let pool = pool(threads)?;
     let files: Vec<String> = (0..texts.len()).map(|k| format!("<scene {k}>")).collect();
     if let Some(b) = device_batches(device)? {
+        let mut warnings = Vec::with_capacity(texts.len());
         for (text, file) in texts.iter().zip(&files) {
             let scene = animats_scene::parse(text, file).map_err(|e| scene_error(e.to_string()))?;
             if scene.evolve.is_none() {
@@ -222,7 +225,9 @@ pub fn evaluate_scenes<'py>(
                     "{file}: the scene has no [evolve] table: nothing to evaluate"
                 )));
             }
+            warnings.push(scene.warnings);
         }
+        warn_grouped(py, &warnings)?;
         let makes: Vec<_> = texts
             .iter()
             .zip(&files)
@@ -234,7 +239,7 @@ pub fn evaluate_scenes<'py>(
             .map_err(runtime_error)?;
         return outcome_dict(py, &o);
     }
-    let results: Vec<Result<Outcome, String>> = py.detach(|| {
+    let results: Vec<Result<(Outcome, Vec<String>), String>> = py.detach(|| {
         on(&pool, || {
             texts
                 .par_iter()
@@ -243,15 +248,19 @@ pub fn evaluate_scenes<'py>(
                 .collect()
         })
     });
-    let o = results
+    let (o, warnings): (Vec<Outcome>, Vec<Vec<String>>) = results
         .into_iter()
         .collect::<Result<Vec<_>, String>>()
-        .map_err(scene_error)?;
+        .map_err(scene_error)?
+        .into_iter()
+        .unzip();
+    warn_grouped(py, &warnings)?;
     outcome_dict(py, &o)
 }
 
-/// One scene text scored as `animats evaluate` scores its file.
-fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
+/// One scene text scored as `animats evaluate` scores its file, and what
+/// it would warn of.
+fn evaluate_text(text: &str, file: &str) -> Result<(Outcome, Vec<String>), String> {
     let scene = animats_scene::parse(text, file).map_err(|e| e.to_string())?;
     if scene.evolve.is_none() {
         return Err(format!(
@@ -259,7 +268,49 @@ fn evaluate_text(text: &str, file: &str) -> Result<Outcome, String> {
         ));
     }
     // Robust, trials: as evolution scores it.
-    animats_scene::evaluate::score(|| animats_scene::parse(text, file).map_err(|e| e.to_string()))
+    let o = animats_scene::evaluate::score(|| {
+        animats_scene::parse(text, file).map_err(|e| e.to_string())
+    })?;
+    Ok((o, scene.warnings))
+}
+
+/// Each distinct message among `warnings` (scene `k`'s at `k`), as one
+/// `RuntimeWarning` naming the scenes that gave it, in the order first
+/// given: `<scene 3>: …`, or `<scenes 0, 4 and 7>: …`, or, past
+/// [`NAMED`] scenes, `<scenes 0, 1, 2, 3, 4 and 995 more>: …`. A batch of
+/// bodies from one encoding often shares a warning (a step past the
+/// springs' stability limit): one line for it, not one per body.
+fn warn_grouped(py: Python<'_>, warnings: &[Vec<String>]) -> PyResult<()> {
+    /// Scenes named in one warning before the rest are counted.
+    const NAMED: usize = 5;
+    let mut groups: Vec<(&str, Vec<usize>)> = Vec::new();
+    for (k, ws) in warnings.iter().enumerate() {
+        for w in ws {
+            match groups.iter_mut().find(|(m, _)| *m == w.as_str()) {
+                Some((_, scenes)) => {
+                    if scenes.last() != Some(&k) {
+                        scenes.push(k);
+                    }
+                }
+                None => groups.push((w.as_str(), vec![k])),
+            }
+        }
+    }
+    for (message, scenes) in groups {
+        let list = |ks: &[usize]| {
+            ks.iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let who = match scenes.len() {
+            1 => format!("<scene {}>", scenes[0]),
+            n if n <= NAMED => format!("<scenes {} and {}>", list(&scenes[..n - 1]), scenes[n - 1]),
+            n => format!("<scenes {} and {} more>", list(&scenes[..NAMED]), n - NAMED),
+        };
+        crate::scene::warn(py, &who, &[message.to_string()])?;
+    }
+    Ok(())
 }
 
 /// Fitness of each row of a `(P, D)` float64 array of genomes under a

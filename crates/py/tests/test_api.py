@@ -302,6 +302,19 @@ def test_a_step_past_the_stability_limit_is_a_runtime_warning(root, tmp_path):
         animats.evaluate(str(coarse_path), genome)
     with pytest.warns(RuntimeWarning, match="expect a blow-up"):
         animats.Evolution(str(coarse_path), generations=1, lanes=1, seed=1)
+    # A batch of texts: one warning a message, naming the scenes that gave
+    # it (the first five, then how many more), none for a sound one.
+    with pytest.warns(RuntimeWarning) as caught:
+        animats.evaluate_scenes([walker] + [coarse_text] * 7, threads=2)
+    assert len(caught) == 1, [str(c.message) for c in caught]
+    assert re.match(r"^<scenes 1, 2, 3, 4, 5 and 2 more>: dt = 0\.05 s .*expect a blow-up", str(caught[0].message)), str(caught[0].message)
+    with pytest.warns(RuntimeWarning, match=r"^<scene 1>: dt = 0\.05 s"):
+        animats.evaluate_scenes([walker, coarse_text])
+    with pytest.warns(RuntimeWarning, match=r"^<scenes 0 and 2>: dt = 0\.05 s"):
+        animats.evaluate_scenes([coarse_text, walker, coarse_text])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        animats.evaluate_scenes([walker])
     # The shipped scenes load without a word.
     with warnings.catch_warnings():
         warnings.simplefilter("error")
