@@ -153,6 +153,9 @@ fn scene_seconds(scene: &animats_scene::Scene) -> f64 {
     scene.evolve.as_ref().map_or(scene.duration, |e| e.duration)
 }
 
+/// The most frames an animation may have.
+const MAX_FRAMES: u64 = 20_000;
+
 /// Simulated instants of the frames.
 fn frame_times(
     seconds: f64,
@@ -167,9 +170,9 @@ fn frame_times(
             .collect(),
         _ => {
             let n = (seconds * fps + 1e-9).floor();
-            if n > 20_000.0 {
+            if n > MAX_FRAMES as f64 {
                 return Err(Failure::Input(format!(
-                    "{n} frames is too many: lower --seconds or --fps"
+                    "{n:.1e} frames (--seconds × --fps) are more than {MAX_FRAMES}: lower --seconds or --fps"
                 )));
             }
             (0..=n as u64).map(|k| k as f64 / fps).collect()

@@ -220,7 +220,7 @@ fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
     let x = |name: &str| dir.join(name).to_string_lossy().into_owned();
     let (bmp, png, gif) = (x("x.bmp"), x("x.png"), x("x.gif"));
     let sea = "scenes/seaworld.toml";
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (
             &[sea, "--seconds", "1", "--out", &bmp],
             ".png, .gif or .mp4",
@@ -238,6 +238,10 @@ fn bad_requests_exit_2_and_a_blow_up_exits_3_leaving_nothing() {
         (
             &[sea, "--seconds", "1", "--sheet", "4", "--out", &gif],
             "--sheet",
+        ),
+        (
+            &[sea, "--seconds", "1e300", "--out", &gif],
+            "2.5e301 frames (--seconds × --fps) are more than 20000",
         ),
     ];
     for (args, expect) in cases {
