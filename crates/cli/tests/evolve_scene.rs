@@ -117,6 +117,36 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(!dir.join("x").join("log.csv").exists());
+    // A length or a step past every limit, named in a few digits.
+    let walker = include_str!("../../../scenes/walker.toml");
+    for (from, to, expect) in [
+        (
+            "duration = 10.0\n",
+            "duration = 1e300\n",
+            "evolve.duration: must be at most 86400 s (a simulated day), got 1e300",
+        ),
+        (
+            "dt = 0.0005",
+            "dt = 1e-300",
+            "at dt = 1e-300 s is 1.000e301 steps, more than 1e12",
+        ),
+        (
+            "dt = 0.0005",
+            "dt = -1e300",
+            "world.dt: must be > 0, got -1e300",
+        ),
+    ] {
+        let at = walker.rfind(from).expect(from);
+        let scene = write(
+            &dir,
+            "far.toml",
+            &format!("{}{to}{}", &walker[..at], &walker[at + from.len()..]),
+        );
+        let o = animats(&["evaluate", &scene]);
+        assert_eq!(o.status.code(), Some(2));
+        let err = text(&o).1;
+        assert!(err.contains(expect), "{to}: {err}");
+    }
     // A missing file, an unknown optimiser.
     let o = animats(&["evaluate", "nope.toml"]);
     assert_eq!(o.status.code(), Some(2));

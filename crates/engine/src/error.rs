@@ -4,6 +4,23 @@
 use crate::particle::ParticleId;
 use std::fmt;
 
+/// A number as a message shows it: as Rust writes it for ordinary
+/// magnitudes, in scientific notation (`1e300`, `2.5e-12`) from 10⁹ and
+/// below 10⁻⁶, where the plain form runs to hundreds of digits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Shown(pub f64);
+
+impl fmt::Display for Shown {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let a = self.0.abs();
+        if a.is_finite() && a != 0.0 && !(1e-6..1e9).contains(&a) {
+            write!(f, "{:e}", self.0)
+        } else {
+            write!(f, "{}", self.0)
+        }
+    }
+}
+
 /// A particle, force or event was described with an impossible value.
 ///
 /// `field` names the offending field (`"mass"`, `"rest_length"`...), so a
@@ -107,3 +124,26 @@ impl fmt::Display for SimError {
 }
 
 impl std::error::Error for SimError {}
+
+#[cfg(test)]
+mod tests {
+    use super::Shown;
+
+    #[test]
+    fn numbers_in_messages_stay_short() {
+        let shown = |x: f64| Shown(x).to_string();
+        assert_eq!(shown(1e300), "1e300");
+        assert_eq!(shown(-1e300), "-1e300");
+        assert_eq!(shown(1e-300), "1e-300");
+        assert_eq!(shown(-2.5e-12), "-2.5e-12");
+        assert_eq!(shown(86_400.0), "86400");
+        assert_eq!(shown(0.01), "0.01");
+        assert_eq!(shown(-1.0), "-1");
+        assert_eq!(shown(999_999_999.0), "999999999");
+        assert_eq!(shown(1e9), "1e9");
+        assert_eq!(shown(1e-6), "0.000001");
+        assert_eq!(shown(0.0), "0");
+        assert_eq!(shown(f64::NAN), "NaN");
+        assert_eq!(shown(f64::NEG_INFINITY), "-inf");
+    }
+}

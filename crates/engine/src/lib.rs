@@ -47,7 +47,7 @@ pub mod snapshot;
 pub mod terrain;
 pub mod world;
 
-pub use error::{ModelError, SimError};
+pub use error::{ModelError, Shown, SimError};
 pub use event::{AsAny, ByPieces, DiscreteEvent, EventContext, EventState, TrialPiece};
 pub use events::floor_collision::{Collision, FloorCollision};
 pub use events::plane_constraint::PlaneConstraint;

@@ -164,7 +164,7 @@ pub(crate) fn finite(field: &'static str, x: f64) -> Result<(), ModelError> {
     } else {
         Err(ModelError::new(
             field,
-            format!("must be a finite number, got {x}"),
+            format!("must be a finite number, got {}", crate::Shown(x)),
         ))
     }
 }
@@ -185,7 +185,10 @@ pub(crate) fn positive(field: &'static str, x: f64) -> Result<(), ModelError> {
     if x > 0.0 {
         Ok(())
     } else {
-        Err(ModelError::new(field, format!("must be > 0, got {x}")))
+        Err(ModelError::new(
+            field,
+            format!("must be > 0, got {}", crate::Shown(x)),
+        ))
     }
 }
 
@@ -194,7 +197,10 @@ pub(crate) fn non_negative(field: &'static str, x: f64) -> Result<(), ModelError
     if x >= 0.0 {
         Ok(())
     } else {
-        Err(ModelError::new(field, format!("must be >= 0, got {x}")))
+        Err(ModelError::new(
+            field,
+            format!("must be >= 0, got {}", crate::Shown(x)),
+        ))
     }
 }
 

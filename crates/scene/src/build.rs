@@ -8,7 +8,7 @@ use crate::nervous::Handles;
 use crate::source::Source;
 use crate::Scene;
 use animats_engine::DVec3;
-use animats_engine::{Gravity, ModelError, ParticleId, Targets, World};
+use animats_engine::{Gravity, ModelError, ParticleId, Shown, Targets, World};
 use std::collections::HashMap;
 use toml::Spanned;
 
@@ -71,7 +71,7 @@ impl At<'_> {
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be a finite number, got {x}")))
+            Err(self.err(field, format!("must be a finite number, got {}", Shown(x))))
         }
     }
 
@@ -80,7 +80,7 @@ impl At<'_> {
         if x > 0.0 {
             Ok(x)
         } else {
-            Err(self.err(field, format!("must be > 0, got {x}")))
+            Err(self.err(field, format!("must be > 0, got {}", Shown(x))))
         }
     }
 

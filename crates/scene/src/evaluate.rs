@@ -25,7 +25,7 @@ use crate::Scene;
 use animats_creatures::brain::GenomeKey;
 use animats_creatures::sensors::probe::TOUCH_TOLERANCE;
 use animats_creatures::NervousSystem;
-use animats_engine::{DVec3, ParticleId, World};
+use animats_engine::{DVec3, ParticleId, Shown, World};
 use std::fmt;
 
 /// The longest evaluation, s (a simulated day).
@@ -303,14 +303,18 @@ impl EvolveSpec {
         if duration > MAX_DURATION {
             return Err(at.err(
                 "duration",
-                format!("must be at most {MAX_DURATION} s (a simulated day), got {duration}"),
+                format!(
+                    "must be at most {MAX_DURATION} s (a simulated day), got {}",
+                    Shown(duration)
+                ),
             ));
         }
         if duration / dt > MAX_STEPS {
             return Err(at.err(
                 "duration",
                 format!(
-                    "{duration} s at dt = {dt} s is {:.3e} steps, more than {MAX_STEPS:e}: raise dt or shorten the evaluation",
+                    "{duration} s at dt = {} s is {:.3e} steps, more than {MAX_STEPS:e}: raise dt or shorten the evaluation",
+                    Shown(dt),
                     duration / dt
                 ),
             ));

@@ -282,7 +282,7 @@ fn mistakes_are_refused_naming_the_entry_and_field() {
         PAIR.replace("dt = 0.001", "dt = 1e-9")
     ));
     assert!(
-        e.contains("evolve.duration: 86000 s at dt = 0.000000001 s is 8.600e13 steps"),
+        e.contains("evolve.duration: 86000 s at dt = 1e-9 s is 8.600e13 steps"),
         "{e}"
     );
     // Springs with the same name.

@@ -317,11 +317,20 @@ impl Morphology {
         }
         let strain = at.positive("muscle_strain", e.muscle_strain)?;
         if strain >= 0.9 {
-            return Err(at.err("muscle_strain", format!("must be below 0.9, got {strain}")));
+            return Err(at.err(
+                "muscle_strain",
+                format!("must be below 0.9, got {}", animats_engine::Shown(strain)),
+            ));
         }
         let size = at.positive("size", e.size)?;
         if size > MAX_SIZE {
-            return Err(at.err("size", format!("must be at most {MAX_SIZE} m, got {size}")));
+            return Err(at.err(
+                "size",
+                format!(
+                    "must be at most {MAX_SIZE} m, got {}",
+                    animats_engine::Shown(size)
+                ),
+            ));
         }
         if size < 4.0 * radius.0 {
             return Err(at.err(
