@@ -193,6 +193,8 @@ typedef struct {
     const double *nbody_param;    /* 2 per group: G, softening squared */
     const long long *nbody_first_body; /* per group, over the batch: its bodies */
     const int *nbody_body;        /* a body, within the creature, in the group's order */
+    double *clock;                /* 2 per creature of a batch of worlds: its time and the
+                                     clock's carry (world/step.rs, `advance_clock`) */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -1135,19 +1137,25 @@ AN_FN int an_step_once(const an_batch *b, an_state st, long long c, double t0) {
     return 1;
 }
 
-/* `steps` steps of creature c. A non-finite state stops the creature at
+/* `steps` steps of creature c, from its clock's time. A non-finite state stops the creature at
  * its last finite state; `failed[c]` records the step (1-based, counted
  * over every run of the batch). */
 AN_FN void an_step_creature(const an_batch *b, an_state st, long long c, long long steps) {
     if (b->failed[c] != 0) {
         return;
     }
+    double *clock = b->clock + 2 * c;
     for (long long step = 0; step < steps; step++) {
-        /* (No force of a world batch asks the time: src/pack.rs.) */
-        if (!an_step_once(b, st, c, 0.0)) {
+        /* Each step from the world's time (a reef's currents ask it). */
+        if (!an_step_once(b, st, c, clock[0])) {
             b->failed[c] = b->steps_before + step + 1;
             return;
         }
+        /* The clock advanced as the engine's: compensated summation. */
+        double y = b->dt - clock[1];
+        double t = clock[0] + y;
+        clock[1] = (t - clock[0]) - y;
+        clock[0] = t;
     }
 }
 

@@ -181,7 +181,8 @@ impl Device {
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
-        batch.set_state(&pos, &vel, &failed);
+        let clock = download_f64(s, &on_device, Array::Clock)?;
+        batch.set_state(&pos, &vel, &failed, &clock);
         batch.ran(steps as u64);
         Ok(())
     }
@@ -222,7 +223,8 @@ impl Device {
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
-        batch.set_state(&pos, &vel, &failed);
+        let clock = download_f64(s, &on_device, Array::Clock)?;
+        batch.set_state(&pos, &vel, &failed, &clock);
         let result = download_f64(s, &on_device, Array::Result)?;
         let ended = download_i64(s, &on_device, Array::Ended)?;
         let measures = download_f64(s, &on_device, Array::MeasureSum)?;

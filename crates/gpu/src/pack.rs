@@ -148,6 +148,7 @@ pub(crate) struct Raw {
     nbody_param: *const c_double,
     nbody_first_body: *const c_longlong,
     nbody_body: *const c_int,
+    clock: *mut c_double,
 }
 
 extern "C" {
@@ -299,6 +300,11 @@ pub struct Batch {
     nbody_param: Vec<f64>,
     nbody_first_body: Vec<i64>,
     nbody_body: Vec<i32>,
+    /// Each world's clock: its time and the rounding carry of its
+    /// compensated sum (`World::time`, `World::time_carry`), for the forces
+    /// that ask the time (a reef's currents). A scene's evaluation keeps its
+    /// own clock (`Rules`).
+    clock: Vec<f64>,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -308,19 +314,13 @@ impl Batch {
     /// world must share the first one's gravity, floor and integrator, and
     /// hold only what the C steps (particles, gravity on every particle,
     /// damped springs, angle joints, torque joints at their present
-    /// torques, constant forces, fluids about every particle (still or in a uniform current),
-    /// n-body gravity among fewer than 256 bodies, soft contact, drag across springs, the floor under every particle, flat or shaped, plane
-    /// constraints, sphere contact among every particle): anything else is
-    /// refused with a message naming the world and what it holds. (A
-    /// reef's waves, which ask the time, are stepped only in whole
-    /// evaluations, [`Batch::pack_scenes`], whose clock the C keeps.)
+    /// torques, constant forces, fluids about every particle (still, in a
+    /// uniform current or under a reef's waves, at each world's own time),
+    /// n-body gravity among fewer than 256 bodies, soft contact, drag
+    /// across springs, the floor under every particle, flat or shaped,
+    /// plane constraints, sphere contact among every particle): anything
+    /// else is refused with a message naming the world and what it holds.
     pub fn pack(worlds: &[&World], dt: f64) -> Result<Batch, String> {
-        Batch::pack_timed(worlds, dt, false)
-    }
-
-    /// [`Batch::pack`]; `timed`: the C keeps each world's clock (a whole
-    /// evaluation), so forces that ask the time may be stepped.
-    pub(crate) fn pack_timed(worlds: &[&World], dt: f64, timed: bool) -> Result<Batch, String> {
         if !(dt > 0.0 && dt.is_finite()) {
             return Err(format!(
                 "dt = {dt}: the step must be a positive number of seconds"
@@ -405,13 +405,14 @@ impl Batch {
             nbody_param: Vec::new(),
             nbody_first_body: vec![0],
             nbody_body: Vec::new(),
+            clock: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
         if let Some(f) = &b.floor {
             (b.terrain, b.terrain_param, b.terrain_height) = terrain_arrays(&f.terrain);
         }
         for (k, w) in worlds.iter().enumerate() {
-            supported(w, timed).map_err(|what| format!("world {k}: {what}"))?;
+            supported(w).map_err(|what| format!("world {k}: {what}"))?;
             let same_gravity = w.forces().gravity().is_some() == gravity
                 && w.forces().g().to_array().map(f64::to_bits) == g.to_array().map(f64::to_bits);
             let floor = floor_of(w).map_err(|e| format!("world {k}: {e}"))?;
@@ -540,6 +541,7 @@ impl Batch {
             b.first_pair.push(b.pair_a.len() as i64);
             b.first_rod.push(b.rod_a.len() as i64);
             b.first_nbody.push(b.nbody_param.len() as i64 / 2);
+            b.clock.extend([w.time(), w.time_carry()]);
             b.first_plane.push(b.plane_first_particle.len() as i64 - 1);
             // Sphere contact ([`supported`]: one, after the floor, every
             // particle, no sleeping).
@@ -682,6 +684,7 @@ impl Batch {
             Array::NeuronState => self.ev.neuron_state.as_mut_ptr() as u64,
             Array::MuscleWork => self.ev.muscle_work.as_mut_ptr() as u64,
             Array::ContactSlot => self.contact_slot.as_mut_ptr() as u64,
+            Array::Clock => self.clock.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -814,16 +817,19 @@ impl Batch {
             Array::NbodyParam => F64(&self.nbody_param),
             Array::NbodyFirstBody => I64(&self.nbody_first_body),
             Array::NbodyBody => I32(&self.nbody_body),
+            Array::Clock => F64(&self.clock),
         }
     }
 
     /// Positions, velocities and failures written back (from a GPU).
-    pub(crate) fn set_state(&mut self, pos: &[f64], vel: &[f64], failed: &[i64]) {
+    pub(crate) fn set_state(&mut self, pos: &[f64], vel: &[f64], failed: &[i64], clock: &[f64]) {
         let n = self.pos.len();
         self.pos.copy_from_slice(&pos[..n]);
         self.vel.copy_from_slice(&vel[..n]);
         let c = self.failed.len();
         self.failed.copy_from_slice(&failed[..c]);
+        let k = self.clock.len();
+        self.clock.copy_from_slice(&clock[..k]);
     }
 
     /// Counts `steps` more taken (by a GPU run).
@@ -995,6 +1001,7 @@ impl Batch {
             nbody_param: c(Array::NbodyParam),
             nbody_first_body: l(Array::NbodyFirstBody),
             nbody_body: i(Array::NbodyBody),
+            clock: m(Array::Clock),
         }
     }
 }
@@ -1013,9 +1020,8 @@ const MAX_NBODY: usize = 256;
 const MAX_PLANES: usize = 64;
 
 /// Whether the C steps world `w` as the engine does: `Err` names the first
-/// thing it holds that the C does not step; `timed` as for
-/// [`Batch::pack_timed`].
-fn supported(w: &World, timed: bool) -> Result<(), String> {
+/// thing it holds that the C does not step.
+fn supported(w: &World) -> Result<(), String> {
     use animats_engine::Targets;
     let f = w.forces();
     let refuse = |what: &str| Err(format!("{what} is not in the GPU step yet"));
@@ -1080,11 +1086,6 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
         if fl.targets != Targets::All {
             return refuse("a fluid about some particles only");
         }
-        if varies(&fl.current) && !timed {
-            return refuse(
-                "a fluid's current that varies (a reef's waves) outside a whole evaluation",
-            );
-        }
     }
     // A set the engine sums in ranges, on many threads, is not in the C.
     for g in f.nbody() {
@@ -1097,16 +1098,14 @@ fn supported(w: &World, timed: bool) -> Result<(), String> {
             ));
         }
     }
-    // Soft contact and drag across springs (in still water, a uniform
-    // current, or when timed a reef's waves) are the user forces the C steps (body-stage forces, after the fluids, as the
-    // engine orders them): every soft contact, then every rod drag.
+    // Soft contact and drag across springs are the user forces the C
+    // steps (body-stage forces, after the fluids, as the engine orders
+    // them): every soft contact, then every rod drag.
     let mut rods_seen = false;
     for u in f.user() {
         let any = u.as_any();
         let soft = any.is_some_and(|a| a.is::<SoftContact>());
-        let rods = any
-            .and_then(|a| a.downcast_ref::<RodDrag>())
-            .is_some_and(|r| timed || !varies(&r.current));
+        let rods = any.is_some_and(|a| a.is::<RodDrag>());
         if !(soft || rods) || u.stage() != animats_engine::Stage::Body || (soft && rods_seen) {
             return refuse(&format!("the user force `{}`", u.name()));
         }
@@ -1146,12 +1145,6 @@ fn current(c: &animats_engine::Current) -> [f64; 11] {
             ]
         }
     }
-}
-
-/// Whether a current varies in time (a reef's waves): the C steps it only
-/// where it keeps the clock.
-fn varies(c: &animats_engine::Current) -> bool {
-    matches!(c, animats_engine::Current::Reef(_))
 }
 
 /// One of a batch's arrays, borrowed.
@@ -1284,11 +1277,12 @@ pub(crate) enum Array {
     NbodyParam,
     NbodyFirstBody,
     NbodyBody,
+    Clock,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 120] = [
+    pub(crate) const ALL: [Array; 121] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1409,6 +1403,7 @@ impl Array {
         Array::NbodyParam,
         Array::NbodyFirstBody,
         Array::NbodyBody,
+        Array::Clock,
     ];
 }
 

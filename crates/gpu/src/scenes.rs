@@ -621,7 +621,7 @@ impl Batch {
             ));
         }
         let worlds: Vec<&World> = scenes.iter().map(|s| &s.world).collect();
-        let mut b = Batch::pack_timed(&worlds, dt, true)?;
+        let mut b = Batch::pack(&worlds, dt)?;
         // Rules for no scene yet (every offset array at [0]), the
         // particles' fixed flags kept; each scene appends its own.
         let mut r = std::mem::take(&mut b.ev);

@@ -615,6 +615,14 @@ impl World {
         self.time
     }
 
+    /// The clock's rounding carry: steps are added to [`World::time`] by
+    /// compensated (Kahan) summation, and this is what the last addition
+    /// lost. With the time, what a second implementation of the step (the
+    /// GPU's C) needs to keep the same clock.
+    pub fn time_carry(&self) -> f64 {
+        self.time_carry
+    }
+
     /// Totals since the world was created.
     pub fn stats(&self) -> Stats {
         self.stats
