@@ -193,6 +193,8 @@ typedef struct {
     const double *nbody_param;    /* 2 per group: G, softening squared */
     const long long *nbody_first_body; /* per group, over the batch: its bodies */
     const int *nbody_body;        /* a body, within the creature, in the group's order */
+    const long long *nbody_first_range; /* per group, over the batch: its ranges of rows */
+    const long long *nbody_range; /* a range's first row (NBodyGravity::row_ranges) */
     double *clock;                /* 2 per creature of a batch of worlds: its time and the
                                      clock's carry (world/step.rs, `advance_clock`) */
 } an_batch;
@@ -566,11 +568,11 @@ AN_FN double an_tree8(const double *s) {
 }
 
 /* N-body gravity, groups g0 .. g0 + ng - 1 (forces/nbody.rs, `apply`, with
- * forces/nbody/pairs.rs's sums for a set that is not split into ranges:
- * fewer than 256 bodies, as pack.rs holds it). Body k's pull is its row:
- * the bodies after it, body q into accumulator q mod 8 (from +0, in q's
- * order), reduced in the fixed tree; then, past the first body, plus the
- * reactions of the rows before it, subtracted from +0 in row order. Each
+ * forces/nbody/pairs.rs's sums). Body k's pull is its row: the bodies
+ * after it, body q into accumulator q mod 8 (from +0, in q's order),
+ * reduced in the fixed tree; then, range by range, for each range of rows
+ * that begins before k (one range below 256 bodies), the reactions its
+ * rows before k give k, subtracted from +0 in row order. Each
  * pair's d = x_later - x_earlier, |d|^2 + eps^2 and 1 / (r2 sqrt r2) are
  * formed for each of its bodies alike; a pair whose r2 is not positive
  * (two bodies at one place, unsoftened) pulls nowhere, and is skipped as
@@ -584,45 +586,57 @@ AN_COLD void an_nbody(const an_batch *b, an_state st, long long g0, long long ng
         double G = b->nbody_param[2 * g], eps2 = b->nbody_param[2 * g + 1];
         long long first = b->nbody_first_body[g], nb = b->nbody_first_body[g + 1] - first;
         const int *body = b->nbody_body + first;
+        const long long *range = b->nbody_range + b->nbody_first_range[g];
+        long long nr = b->nbody_first_range[g + 1] - b->nbody_first_range[g];
         for (long long k = 0; k < nb; k++) {
-            double s[3][8], r[3] = {0.0, 0.0, 0.0};
+            long long i = body[k];
+            double s[3][8], pull[3];
             for (int c = 0; c < 3; c++) {
                 for (int l = 0; l < 8; l++) {
                     s[c][l] = 0.0;
                 }
             }
-            for (long long q = 0; q < nb; q++) {
-                if (q == k) {
-                    continue;
-                }
-                long long lo = q < k ? q : k, hi = q < k ? k : q;
-                long long a = body[lo], e = body[hi];
-                double dx = x[3 * e] - x[3 * a];
-                double dy = x[3 * e + 1] - x[3 * a + 1];
-                double dz = x[3 * e + 2] - x[3 * a + 2];
+            for (long long q = k + 1; q < nb; q++) {
+                long long e = body[q];
+                double dx = x[3 * e] - x[3 * i];
+                double dy = x[3 * e + 1] - x[3 * i + 1];
+                double dz = x[3 * e + 2] - x[3 * i + 2];
                 double r2 = dx * dx + dy * dy + dz * dz + eps2;
                 if (!(r2 > 0.0)) {
                     continue;
                 }
-                double inv = 1.0 / (r2 * sqrt(r2));
-                if (q > k) {
-                    double wj = st.m[e] * inv;
-                    s[0][q % 8] += dx * wj;
-                    s[1][q % 8] += dy * wj;
-                    s[2][q % 8] += dz * wj;
-                } else {
-                    double wi = st.m[a] * inv;
-                    r[0] -= dx * wi;
-                    r[1] -= dy * wi;
-                    r[2] -= dz * wi;
+                double wj = st.m[e] * (1.0 / (r2 * sqrt(r2)));
+                s[0][q % 8] += dx * wj;
+                s[1][q % 8] += dy * wj;
+                s[2][q % 8] += dz * wj;
+            }
+            for (int c = 0; c < 3; c++) {
+                pull[c] = an_tree8(s[c]);
+            }
+            for (long long r = 0; r < nr && range[r] < k; r++) {
+                long long end = r + 1 < nr && range[r + 1] < k ? range[r + 1] : k;
+                double re[3] = {0.0, 0.0, 0.0};
+                for (long long q = range[r]; q < end; q++) {
+                    long long a = body[q];
+                    double dx = x[3 * i] - x[3 * a];
+                    double dy = x[3 * i + 1] - x[3 * a + 1];
+                    double dz = x[3 * i + 2] - x[3 * a + 2];
+                    double r2 = dx * dx + dy * dy + dz * dz + eps2;
+                    if (!(r2 > 0.0)) {
+                        continue;
+                    }
+                    double wi = st.m[a] * (1.0 / (r2 * sqrt(r2)));
+                    re[0] -= dx * wi;
+                    re[1] -= dy * wi;
+                    re[2] -= dz * wi;
+                }
+                for (int c = 0; c < 3; c++) {
+                    pull[c] += re[c];
                 }
             }
-            long long i = body[k];
             double gm = G * st.m[i];
             for (int c = 0; c < 3; c++) {
-                double own = an_tree8(s[c]);
-                double pull = k > 0 ? own + r[c] : own;
-                f[3 * i + c] += pull * gm;
+                f[3 * i + c] += pull[c] * gm;
             }
         }
     }

@@ -3,8 +3,8 @@
 //! per-creature offsets, so one batch holds bodies of any sizes.
 
 use animats_engine::{
-    DVec3, FloorCollision, IntegratorKind, PlaneConstraint, RodDrag, SoftContact, SphereContact,
-    Terrain, World,
+    DVec3, FloorCollision, IntegratorKind, NBodyGravity, PlaneConstraint, RodDrag, SoftContact,
+    SphereContact, Terrain, World,
 };
 use std::os::raw::{c_double, c_int, c_longlong};
 use std::sync::Arc;
@@ -148,6 +148,8 @@ pub(crate) struct Raw {
     nbody_param: *const c_double,
     nbody_first_body: *const c_longlong,
     nbody_body: *const c_int,
+    nbody_first_range: *const c_longlong,
+    nbody_range: *const c_longlong,
     clock: *mut c_double,
 }
 
@@ -295,11 +297,15 @@ pub struct Batch {
     first_slot: Vec<i64>,
     contact_slot: Vec<i64>,
     /// N-body gravity (forces/nbody.rs): per creature its groups, each
-    /// one's G and softening squared, and its bodies in its order.
+    /// one's G and softening squared, its bodies in its order, and the
+    /// first rows of the ranges its pairs are summed in
+    /// (`NBodyGravity::row_ranges`).
     first_nbody: Vec<i64>,
     nbody_param: Vec<f64>,
     nbody_first_body: Vec<i64>,
     nbody_body: Vec<i32>,
+    nbody_first_range: Vec<i64>,
+    nbody_range: Vec<i64>,
     /// Each world's clock: its time and the rounding carry of its
     /// compensated sum (`World::time`, `World::time_carry`), for the forces
     /// that ask the time (a reef's currents). A scene's evaluation keeps its
@@ -316,7 +322,7 @@ impl Batch {
     /// damped springs, angle joints, torque joints at their present
     /// torques, constant forces, fluids about every particle (still, in a
     /// uniform current or under a reef's waves, at each world's own time),
-    /// n-body gravity among fewer than 256 bodies, soft contact, drag
+    /// n-body gravity, soft contact, drag
     /// across springs, the floor under every particle, flat or shaped,
     /// plane constraints, sphere contact among every particle): anything
     /// else is refused with a message naming the world and what it holds.
@@ -405,6 +411,8 @@ impl Batch {
             nbody_param: Vec::new(),
             nbody_first_body: vec![0],
             nbody_body: Vec::new(),
+            nbody_first_range: vec![0],
+            nbody_range: Vec::new(),
             clock: Vec::new(),
             ev: crate::scenes::Rules::default(),
         };
@@ -484,8 +492,13 @@ impl Batch {
             for g in w.forces().nbody() {
                 // As NBodyGravity::apply forms them.
                 b.nbody_param.extend([g.g, g.softening * g.softening]);
+                let first = b.nbody_body.len();
                 g.targets().for_each(n, |i| b.nbody_body.push(i as i32));
                 b.nbody_first_body.push(b.nbody_body.len() as i64);
+                let ranges = NBodyGravity::row_ranges(b.nbody_body.len() - first);
+                b.nbody_range
+                    .extend(ranges[..ranges.len() - 1].iter().map(|&r| r as i64));
+                b.nbody_first_range.push(b.nbody_range.len() as i64);
             }
             for sc in w
                 .forces()
@@ -817,6 +830,8 @@ impl Batch {
             Array::NbodyParam => F64(&self.nbody_param),
             Array::NbodyFirstBody => I64(&self.nbody_first_body),
             Array::NbodyBody => I32(&self.nbody_body),
+            Array::NbodyFirstRange => I64(&self.nbody_first_range),
+            Array::NbodyRange => I64(&self.nbody_range),
             Array::Clock => F64(&self.clock),
         }
     }
@@ -1001,6 +1016,8 @@ impl Batch {
             nbody_param: c(Array::NbodyParam),
             nbody_first_body: l(Array::NbodyFirstBody),
             nbody_body: i(Array::NbodyBody),
+            nbody_first_range: l(Array::NbodyFirstRange),
+            nbody_range: l(Array::NbodyRange),
             clock: m(Array::Clock),
         }
     }
@@ -1010,10 +1027,6 @@ impl Batch {
 /// creature's room for the pairs a check finds: `n (n − 1) / 2` numbers,
 /// 16 MiB at this size).
 const MAX_SPHERES: usize = 2048;
-
-/// An n-body set of this many bodies or more, which the engine sums in
-/// ranges of rows (`forces/nbody/pairs.rs`, `splits`), is not in the C.
-const MAX_NBODY: usize = 256;
 
 /// The most plane constraints a world may hold for the C (it notes which
 /// of them a trial leaves, before handling any event, in one 64-bit word).
@@ -1085,17 +1098,6 @@ fn supported(w: &World) -> Result<(), String> {
     for fl in f.fluids() {
         if fl.targets != Targets::All {
             return refuse("a fluid about some particles only");
-        }
-    }
-    // A set the engine sums in ranges, on many threads, is not in the C.
-    for g in f.nbody() {
-        let mut bodies = 0;
-        g.targets().for_each(w.len(), |_| bodies += 1);
-        if bodies >= MAX_NBODY {
-            return refuse(&format!(
-                "n-body gravity among {bodies} bodies (at most {})",
-                MAX_NBODY - 1
-            ));
         }
     }
     // Soft contact and drag across springs are the user forces the C
@@ -1277,12 +1279,14 @@ pub(crate) enum Array {
     NbodyParam,
     NbodyFirstBody,
     NbodyBody,
+    NbodyFirstRange,
+    NbodyRange,
     Clock,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 121] = [
+    pub(crate) const ALL: [Array; 123] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1403,6 +1407,8 @@ impl Array {
         Array::NbodyParam,
         Array::NbodyFirstBody,
         Array::NbodyBody,
+        Array::NbodyFirstRange,
+        Array::NbodyRange,
         Array::Clock,
     ];
 }

@@ -62,6 +62,17 @@ impl NBodyGravity {
         Ok(())
     }
 
+    /// The ranges of rows its pairs are summed in for a set of `bodies`:
+    /// each range's first row, then `bodies` (one range below 256
+    /// bodies). Body `k`'s sum is its own row's, then, range by range,
+    /// the reactions the rows of each range that begins before `k` give
+    /// it, each range's summed from +0 in row order (`nbody/pairs.rs`):
+    /// what a second implementation of the sum (the GPU's C) needs to
+    /// give the same bits.
+    pub fn row_ranges(bodies: usize) -> Vec<usize> {
+        pairs::bounds(bodies)
+    }
+
     /// Whether its evaluation splits over the current rayon pool's threads
     /// in a world of `n` particles.
     pub(crate) fn on_threads(&self, n: usize) -> bool {

@@ -257,7 +257,7 @@ pub(super) fn splits(n: usize) -> bool {
 /// The first row of each range for `n` bodies, then `n`: [`RANGES`] ranges
 /// of about equal work (row `i` visits the `n − i − 1` bodies after it),
 /// or one for a set that does not split.
-fn bounds(n: usize) -> Vec<usize> {
+pub(super) fn bounds(n: usize) -> Vec<usize> {
     if !splits(n) {
         return vec![0, n];
     }
