@@ -567,6 +567,23 @@ AN_FN double an_tree8(const double *s) {
     return ((s[0] + s[1]) + (s[2] + s[3])) + ((s[4] + s[5]) + (s[6] + s[7]));
 }
 
+/* The n-body pair of the earlier body a and the later e at positions x:
+ * d = x_e - x_a and inv = 1 / (r2 sqrt r2), r2 = |d|^2 + eps2, as
+ * nbody/pairs.rs forms them; 0 where r2 is not positive (two bodies at one
+ * place, unsoftened: the pair pulls nowhere). */
+AN_FN int an_pair(const double *x, long long a, long long e, double eps2, double *d,
+                  double *inv) {
+    for (int c = 0; c < 3; c++) {
+        d[c] = x[3 * e + c] - x[3 * a + c];
+    }
+    double r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + eps2;
+    if (!(r2 > 0.0)) {
+        return 0;
+    }
+    *inv = 1.0 / (r2 * sqrt(r2));
+    return 1;
+}
+
 /* N-body gravity, groups g0 .. g0 + ng - 1 (forces/nbody.rs, `apply`, with
  * forces/nbody/pairs.rs's sums). Body k's pull is its row: the bodies
  * after it, body q into accumulator q mod 8 (from +0, in q's order),
@@ -598,17 +615,14 @@ AN_COLD void an_nbody(const an_batch *b, an_state st, long long g0, long long ng
             }
             for (long long q = k + 1; q < nb; q++) {
                 long long e = body[q];
-                double dx = x[3 * e] - x[3 * i];
-                double dy = x[3 * e + 1] - x[3 * i + 1];
-                double dz = x[3 * e + 2] - x[3 * i + 2];
-                double r2 = dx * dx + dy * dy + dz * dz + eps2;
-                if (!(r2 > 0.0)) {
+                double d[3], inv;
+                if (!an_pair(x, i, e, eps2, d, &inv)) {
                     continue;
                 }
-                double wj = st.m[e] * (1.0 / (r2 * sqrt(r2)));
-                s[0][q % 8] += dx * wj;
-                s[1][q % 8] += dy * wj;
-                s[2][q % 8] += dz * wj;
+                double wj = st.m[e] * inv;
+                for (int c = 0; c < 3; c++) {
+                    s[c][q % 8] += d[c] * wj;
+                }
             }
             for (int c = 0; c < 3; c++) {
                 pull[c] = an_tree8(s[c]);
@@ -618,17 +632,14 @@ AN_COLD void an_nbody(const an_batch *b, an_state st, long long g0, long long ng
                 double re[3] = {0.0, 0.0, 0.0};
                 for (long long q = range[r]; q < end; q++) {
                     long long a = body[q];
-                    double dx = x[3 * i] - x[3 * a];
-                    double dy = x[3 * i + 1] - x[3 * a + 1];
-                    double dz = x[3 * i + 2] - x[3 * a + 2];
-                    double r2 = dx * dx + dy * dy + dz * dz + eps2;
-                    if (!(r2 > 0.0)) {
+                    double d[3], inv;
+                    if (!an_pair(x, a, i, eps2, d, &inv)) {
                         continue;
                     }
-                    double wi = st.m[a] * (1.0 / (r2 * sqrt(r2)));
-                    re[0] -= dx * wi;
-                    re[1] -= dy * wi;
-                    re[2] -= dz * wi;
+                    double wi = st.m[a] * inv;
+                    for (int c = 0; c < 3; c++) {
+                        re[c] -= d[c] * wi;
+                    }
                 }
                 for (int c = 0; c < 3; c++) {
                     pull[c] += re[c];
