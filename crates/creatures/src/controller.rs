@@ -38,4 +38,9 @@ pub trait Actor: Send {
     fn acts(&self) -> bool {
         true
     }
+    /// The actor as itself, for code that reads a built-in kind's state
+    /// (the GPU's packer reads a jellyfish's); others need not say.
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        None
+    }
 }

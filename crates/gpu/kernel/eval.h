@@ -6,7 +6,8 @@
  * (creatures/src/nervous_system.rs `act`: every sensor read, then every
  * controller — oscillator, neural network, CTRNN, FSM — in the scene's
  * order, each output slewed by its actuator's rate and clamped to [0, 1]
- * and its target set; then the gates), the world steps, its clock
+ * and its target set; then the gates), the jellyfish act (their pulses
+ * and steering, creatures/src/jellyfish), the world steps, its clock
  * advances (Kahan), the divergence guard checks every 64th step
  * (engine/src/guard.rs: a driven world's speed limit), the actuators'
  * positive work is summed, the measures record the step
@@ -477,8 +478,152 @@ AN_FN void an_hop(const an_batch *b, an_state st, long long c, long long m, doub
     an_net_outputs(b, c, u0, m, out, dt);
 }
 
+/* Actuator::set_level of a jellyfish's actuator `a` (its numbers: range,
+ * initial level, pushes) to level l, along `axis` (ForceMagnitude::set:
+ * every push of its constant force is axis times the value). */
+AN_FN void an_jelly_force(const an_batch *b, long long c, const double *a, const double *axis, double l) {
+    double level = an_unit(l);
+    double value = a[0] + level * (a[1] - a[0]);
+    long long k0 = b->first_push[c] + (long long)a[3];
+    for (long long k = k0; k < k0 + (long long)a[4]; k++) {
+        for (int d = 0; d < 3; d++) {
+            b->push_force[3 * k + d] = axis[d] * value;
+        }
+    }
+}
+
+/* JellyfishFsm::advance_phase: the phase moved on by dt; 1 when the pulse
+ * is over (the phase back to 0). */
+AN_FN int an_jelly_phase(double *s, double dt, double period) {
+    s[3] = s[3] + 6.283185307179586 * dt / period;
+    if (s[3] >= 6.283185307179586) {
+        s[3] = 0.0;
+        return 1;
+    }
+    return 0;
+}
+
+/* f64::clamp to [0, 1] (a NaN stays NaN). */
+AN_FN double an_clamp01(double x) {
+    if (x < 0.0) {
+        x = 0.0;
+    }
+    if (x > 1.0) {
+        x = 1.0;
+    }
+    return x;
+}
+
+/* Jellyfish m (a network entry of kind 5) of creature c acts at time t
+ * (creatures/src/jellyfish/mod.rs `act`): the dome's normal (Body::normal)
+ * becomes every force's axis; the FSM (jellyfish/fsm.rs `step`, through
+ * its Brain::think) reads the food at each dome mass, the depth and each
+ * mass's lean, and orders the pulse's and the steering forces' levels, or
+ * their initial levels to rest. scenes.rs `add_jellyfish` says how its
+ * numbers and state are laid out. Out of line on a GPU (AN_COLD), so that
+ * creatures without one keep their registers. */
+AN_COLD void an_jellyfish(const an_batch *b, an_state st, long long c, long long m, double t, double dt) {
+    const double *w = b->net_weight + b->net_first_weight[m];
+    double *s = b->net_scratch + b->net_first_scratch[m];
+    long long n = (long long)w[0];
+    const double *dome = w + 7, *acts = w + 7 + 3 * n;
+    double *food = s + 5, *lean = food + n;
+    const double *x = st.x;
+    const double *p0 = x + 3 * (long long)dome[0], *p1 = x + 3 * (long long)dome[3],
+                 *p2 = x + 3 * (long long)dome[6];
+    double u[3], v[3], normal[3], axis[3] = {0.0, 0.0, 0.0};
+    for (int d = 0; d < 3; d++) {
+        u[d] = p0[d] - p1[d];
+        v[d] = p2[d] - p0[d];
+    }
+    an_cross(u, v, normal);
+    double rcp = 1.0 / sqrt(an_dot(normal, normal)); /* normalize_or_zero */
+    if (rcp - rcp == 0.0 && rcp > 0.0) {
+        for (int d = 0; d < 3; d++) {
+            axis[d] = normal[d] * rcp;
+        }
+    }
+    double cy = 0.0; /* the dome's centre's height: the sum from zero */
+    for (long long i = 0; i < n; i++) {
+        cy = cy + x[3 * (long long)dome[3 * i] + 1];
+    }
+    cy = cy / (double)n;
+    for (long long i = 0; i < n; i++) {
+        const double *sensor = x + 3 * (long long)dome[3 * i + 1], *at = x + 3 * (long long)dome[3 * i + 2];
+        food[i] = an_unit(0.1 / an_hypot(at[0] - sensor[0], at[2] - sensor[2]));
+        lean[i] = (x[3 * (long long)dome[3 * i] + 1] - cy) / w[2];
+    }
+    double depth = an_unit(x[3 * (long long)w[6] + 1] / w[1]);
+    /* JellyfishFsm::step */
+    int order = 0; /* 0 rest, 1 track, 2 hover */
+    double pulse = 0.0;
+    if (s[0] == 0.0) { /* idle */
+        s[2] = an_clamp01(s[2] + 0.4 * dt);
+        if (!(depth >= 1.0 || s[2] < 0.2)) {
+            if (s[2] > 0.9 || (s[2] > 0.5 && s[1] == 1.0)) {
+                s[1] = 1.0;
+                s[0] = 1.0;
+                s[4] = an_from_bits(0x7ff8000000000000ULL);
+            } else {
+                if (s[4] != s[4]) {
+                    s[4] = depth;
+                }
+                s[1] = 2.0;
+                s[0] = 2.0;
+            }
+        }
+    } else if (s[0] == 1.0) { /* track */
+        s[2] = an_clamp01(s[2] - 0.1 * dt);
+        if (an_jelly_phase(s, dt, w[3])) {
+            s[0] = 0.0;
+        } else {
+            order = 1;
+        }
+    } else { /* hover */
+        int reached = s[4] == s[4] && depth >= s[4];
+        if (an_jelly_phase(s, dt, w[3]) || reached) {
+            s[3] = 0.0;
+            s[0] = 0.0;
+        } else {
+            order = 2;
+        }
+    }
+    if (order != 0) { /* pulse_level */
+        double p = 0.5 * an_sin(s[3]);
+        pulse = 0.5 + (p < 0.0 ? 0.1 * p : p);
+    }
+    long long least = 0;
+    int gradient = 0;
+    for (long long i = 1; i < n; i++) {
+        if (food[i] < food[least]) {
+            least = i;
+        }
+        if (food[i] != food[0]) {
+            gradient = 1;
+        }
+    }
+    an_jelly_force(b, c, acts, axis, order != 0 ? pulse : acts[2]);
+    for (long long i = 0; i < n; i++) {
+        const double *a = acts + 5 * (i + 1);
+        double level = a[2];
+        if (order != 0) { /* balanced */
+            level = 0.5 - w[4] * lean[i] * an_fabs(pulse);
+        }
+        if (order == 1) {
+            if (gradient && i == least) {
+                level = level + (an_fabs(pulse) - 0.5);
+            } else {
+                double wobble = 0.5 * an_sin((double)i * 5.0 * t + depth);
+                level = level + w[5] * wobble * an_fabs(pulse);
+            }
+        }
+        an_jelly_force(b, c, a, axis, level);
+    }
+}
+
 /* The nervous system of creature c acts at time t (nervous_system.rs
- * `act`): every sensor read, then every controller in the scene's order. */
+ * `act`): every sensor read, then every controller in the scene's order;
+ * then the jellyfish (Scene::step: the actors after the nervous system). */
 AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double dt) {
     long long k0 = b->first_ctrl[c], k1 = b->first_ctrl[c + 1];
     int gated = b->eval_param[AN_PARAMS * c + 15] != 0.0;
@@ -497,11 +642,16 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
             an_ctrnn(b, c, b->ctrl_index[k], t, dt);
         } else if (b->ctrl_kind[k] == 4) {
             an_hop(b, st, c, b->ctrl_index[k], dt);
-        } else {
+        } else if (b->ctrl_kind[k] == 3) {
             an_fsm(b, c, b->ctrl_index[k], t, dt);
         }
     }
     an_gates(b, c);
+    for (long long k = k0; k < k1; k++) {
+        if (b->ctrl_kind[k] == 5) {
+            an_jellyfish(b, st, c, b->ctrl_index[k], t, dt);
+        }
+    }
 }
 
 /* scene::evaluate::centre_at: the centre of mass of particles ids[0 ..

@@ -161,4 +161,49 @@ AN_FN double an_atan2(double y, double x) {
     }
 }
 
+/* hypot(x, y): e_hypot.c as the libm crate has it, its operations in
+ * its order: |x| >= |y| arranged, the special cases, then the sum of the
+ * squares split exactly (sq) for a correctly rounded square root. */
+AN_FN void an_hypot_sq(double x, double *hi, double *lo) {
+    double xc = x * 134217729.0; /* 2^27 + 1 */
+    double xh = x - xc + xc;
+    double xl = x - xh;
+    *hi = x * x;
+    *lo = xh * xh - *hi + 2.0 * xh * xl + xl * xl;
+}
+AN_FN double an_hypot(double x, double y) {
+    unsigned long long ux = an_bits(x) & 0x7fffffffffffffffULL, uy = an_bits(y) & 0x7fffffffffffffffULL;
+    if (ux < uy) {
+        unsigned long long t = ux;
+        ux = uy;
+        uy = t;
+    }
+    long long ex = (long long)(ux >> 52), ey = (long long)(uy >> 52);
+    x = an_from_bits(ux);
+    y = an_from_bits(uy);
+    if (ey == 0x7ff) {
+        return y;
+    }
+    if (ex == 0x7ff || uy == 0) {
+        return x;
+    }
+    if (ex - ey > 64) {
+        return x + y;
+    }
+    double z = 1.0;
+    if (ex > 0x3ff + 510) {
+        z = an_from_bits(0x6bb0000000000000ULL); /* 2^700 */
+        x = x * an_from_bits(0x1430000000000000ULL);
+        y = y * an_from_bits(0x1430000000000000ULL);
+    } else if (ey < 0x3ff - 450) {
+        z = an_from_bits(0x1430000000000000ULL); /* 2^-700 */
+        x = x * an_from_bits(0x6bb0000000000000ULL);
+        y = y * an_from_bits(0x6bb0000000000000ULL);
+    }
+    double hx, lx, hy, ly;
+    an_hypot_sq(x, &hx, &lx);
+    an_hypot_sq(y, &hy, &ly);
+    return z * sqrt(ly + lx + hy + hx);
+}
+
 #endif

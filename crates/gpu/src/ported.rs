@@ -7,6 +7,7 @@ use std::os::raw::c_double;
 extern "C" {
     fn animats_atan(x: c_double) -> c_double;
     fn animats_atan2(y: c_double, x: c_double) -> c_double;
+    fn animats_hypot(x: c_double, y: c_double) -> c_double;
     fn animats_sin(x: c_double) -> c_double;
     fn animats_cos(x: c_double) -> c_double;
     fn animats_exp(x: c_double) -> c_double;
@@ -54,4 +55,10 @@ pub fn atan(x: f64) -> f64 {
 pub fn atan2(y: f64, x: f64) -> f64 {
     // SAFETY: a pure function of its arguments.
     unsafe { animats_atan2(y, x) }
+}
+
+/// `hypot(x, y)` as the C step computes it (a jellyfish's food sense).
+pub fn hypot(x: f64, y: f64) -> f64 {
+    // SAFETY: a pure function of its arguments.
+    unsafe { animats_hypot(x, y) }
 }

@@ -10,7 +10,9 @@
 //! speed), actuators (a spring's rest length, an angle joint's rest angle, a
 //! torque joint's torque, a constant force's scale; with or without a
 //! `rate`, gated or not) and the positive work they do, oscillator (sine or skewed), neural,
-//! CTRNN and FSM brains and the roobot's hopping FSM, the centre of the particles that count,
+//! CTRNN and FSM brains and the roobot's hopping FSM, the thesis's
+//! jellyfish (its pulses and steering under its own FSM, after the scene's
+//! controllers), the centre of the particles that count,
 //! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
 //! scene, the `[archive]` measures and `[evolve] terms`, and every term of
 //! the fitness (time, distance, energy, target, measures). Anything else a
@@ -23,6 +25,7 @@ use animats_creatures::actuators::AnyActuator;
 use animats_creatures::brains::ctrnn::Ctrnn;
 use animats_creatures::brains::fsm::{Condition, Fsm};
 use animats_creatures::brains::neural::Neural;
+use animats_creatures::jellyfish::{Behaviour, Jellyfish};
 use animats_creatures::nervous_system::{Inputs, NervousSystem, Wired};
 use animats_creatures::roobot::{FsmSenses, HopFsm, HopState};
 use animats_creatures::sensor::Sensor;
@@ -194,19 +197,24 @@ impl Rules {
             .evolve
             .as_ref()
             .ok_or("it has no [evolve] table: nothing to evaluate")?;
-        if let Some(a) = scene.actors.iter().find(|a| a.acts()) {
-            let who = a
-                .status()
-                .map_or("a creature that acts by itself".into(), |s| {
-                    format!("the creature `{}`", s.name)
-                });
-            return Err(format!(
-                "{who} (a jellyfish, a bubble column, a quadruped with its scripted step) is not in the GPU evaluation yet"
-            ));
+        // Of the creatures that act by themselves, the jellyfish.
+        let mut jellies = Vec::new();
+        for a in scene.actors.iter().filter(|a| a.acts()) {
+            let Some(j) = a.as_any().and_then(|x| x.downcast_ref::<Jellyfish>()) else {
+                let who = a
+                    .status()
+                    .map_or("a creature that acts by itself".into(), |s| {
+                        format!("the creature `{}`", s.name)
+                    });
+                return Err(format!(
+                    "{who} (a bubble column, a quadruped with its scripted step) is not in the GPU evaluation yet"
+                ));
+            };
+            jellies.push(j);
         }
         let nervous = &scene.nervous;
         let world = &scene.world;
-        if nervous.is_empty() && world.is_passive() {
+        if nervous.is_empty() && scene.actors.is_empty() && world.is_passive() {
             return Err("the divergence guard's energy check of a scene nothing drives is not in the GPU evaluation yet".into());
         }
         // Each constant force's first push (the pushes are its particles,
@@ -278,6 +286,10 @@ impl Rules {
                     .extend([g[1 + j], g[1 + n + j], g[1 + 2 * n + j], shift(o), duty]);
             }
             self.first_output.push(self.output_muscle.len() as i64);
+        }
+        // The jellyfish act after the controllers (`Scene::step`).
+        for j in jellies {
+            self.add_jellyfish(j, &first_push)?;
         }
         self.centre_particle
             .extend(spec.particles.iter().map(|p| p.index() as i32));
@@ -506,6 +518,73 @@ impl Rules {
         self.net_first_scratch.push(self.net_scratch.len() as i64);
         self.end_network((0..4).map(|k| senses.sensors + k), &c.outputs, shift);
         Ok(true)
+    }
+
+    /// Appends jellyfish `j` (a network entry of kind 5, acting after the
+    /// scene's controllers as `Scene::step` has it; creatures/src/jellyfish):
+    /// its numbers the dome's count n, the depth sense's ceiling, the
+    /// dome's radius, the pulse's period, the balance and wobble factors,
+    /// the depth sense's particle; per dome mass its particle, its food
+    /// sensor's particle and the food; per actuator (the pulse, then each
+    /// steering force) its range, initial level and constant force's
+    /// pushes (first, count). Its scratch: the FSM's behaviour and
+    /// previous one (0 idle, 1 track, 2 hover), energy, phase and the depth
+    /// it holds (NaN: none), then room for its n food levels and n leans.
+    fn add_jellyfish(
+        &mut self,
+        j: &Jellyfish,
+        first_push: &[(usize, usize)],
+    ) -> Result<(), String> {
+        let n = j.body.dome.len();
+        if n < 3 || j.food.len() != n || j.steer.len() != n {
+            return Err(format!(
+                "the jellyfish `{}` has {n} dome masses, {} food senses and {} steering forces: not in the GPU evaluation",
+                j.name,
+                j.food.len(),
+                j.steer.len()
+            ));
+        }
+        let fsm = &j.fsm;
+        self.ctrl_kind.push(5);
+        self.ctrl_index.push(self.net_clock.len() as i32);
+        self.net_weight.extend([
+            n as f64,
+            j.depth.ceiling,
+            j.dome_radius(),
+            fsm.pulse_period,
+            fsm.balance,
+            fsm.wobble,
+            j.depth.particle.index() as f64,
+        ]);
+        for (d, f) in j.body.dome.iter().zip(&j.food) {
+            self.net_weight.extend([
+                d.index() as f64,
+                f.sensor.index() as f64,
+                f.food.index() as f64,
+            ]);
+        }
+        for a in std::iter::once(&j.pulse).chain(&j.steer) {
+            let (lo, hi) = a.range();
+            let (first, count) = first_push[a.target().force.index()];
+            self.net_weight
+                .extend([lo, hi, a.initial_level(), first as f64, count as f64]);
+        }
+        self.net_clock.push(f64::NAN);
+        let code = |b: Behaviour| match b {
+            Behaviour::Idle => 0.0,
+            Behaviour::Track => 1.0,
+            Behaviour::Hover => 2.0,
+        };
+        self.net_scratch.extend([
+            code(fsm.behaviour()),
+            code(fsm.previous()),
+            fsm.energy(),
+            fsm.phase(),
+            fsm.hover_depth().unwrap_or(f64::NAN),
+        ]);
+        self.push_scratch(2 * n);
+        self.end_network(std::iter::empty(), &[], &|_| f64::NAN);
+        Ok(())
     }
 
     /// Appends sensor `name`: a scene's `[[sensor]]`, or one of a

@@ -7,6 +7,7 @@
 //! end rules (`fail_on_touch`, `fail_on_stretch`) and blow-ups. What the C
 //! does not evaluate is refused by name.
 
+use animats_creatures::jellyfish::{Behaviour, Jellyfish};
 use animats_creatures::random::Random;
 use animats_gpu::{cpu_has_fma, rank_correlation, Batch, Layout, Mode};
 use animats_scene::evaluate::{Ended, Evaluation, SceneProblem};
@@ -831,6 +832,174 @@ fn the_quadruped_s_gaits_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// A tank of SeaWorld's water (still, a floor, gravity) holding food and
+/// two of the thesis's jellyfish, each placed, weighed and given a
+/// ceiling from `rng`; `[evolve]` scores the first one's dome rising.
+fn jellyfish_tank(rng: &mut Random, dt: f64, integrator: &str, duration: f64) -> String {
+    let mut r = |lo: f64, hi: f64| rng.between(lo, hi);
+    let mut text = format!(
+        "[world]\ndt = {dt}\nintegrator = \"{integrator}\"\nduration = {duration}\n\n\
+         [floor]\nenvelope = 0.01\n\n\
+         [fluid]\ndensity = 1000.0\ndrag_coefficient = 0.47\n\n\
+         [[food]]\nposition = [{}, {}, {}]\n\n",
+        r(-0.6, 0.6),
+        r(0.3, 1.2),
+        r(-0.6, 0.6)
+    );
+    for name in ["a", "b"] {
+        let scale = r(0.6, 1.5);
+        text += &format!(
+            "[[jellyfish]]\nname = \"{name}\"\nposition = [{}, {}, {}]\n\
+             dome_mass = {}\ntentacle_mass = {}\nceiling = {}\n\n",
+            r(-0.5, 0.5),
+            r(0.5, 0.9),
+            r(-0.5, 0.5),
+            0.2 * scale,
+            0.02 * scale,
+            r(0.7, 1.4)
+        );
+    }
+    text + &format!(
+        "[evolve]\nduration = {duration}\naxis = [0.0, 1.0, 0.0]\ndistance_weight = 1.0\n\
+         time_weight = 0.0\nparticles = [\"a.dome0\", \"a.dome1\", \"a.dome2\"]\n"
+    )
+}
+
+/// The behaviours the jellyfish of `text` pass through when the engine
+/// runs its scene (their states, from `Actor::status`, at every step).
+fn behaviours(text: &str) -> std::collections::BTreeSet<&'static str> {
+    let mut scene = animats_scene::parse(text, "tank.toml").unwrap();
+    let dt = scene.dt;
+    let steps = (scene.evolve.as_ref().unwrap().duration / dt).round() as u64;
+    let mut seen = std::collections::BTreeSet::new();
+    for _ in 0..steps {
+        scene.step(dt).unwrap();
+        for a in &scene.actors {
+            seen.extend(a.status().map(|s| s.state));
+        }
+    }
+    seen
+}
+
+#[test]
+fn jellyfish_under_their_own_pulses_are_the_engine_s_to_the_bit() {
+    // The thesis's jellyfish act by themselves (their FSM reads food,
+    // depth and lean, and pulses and steers along the dome's normal): the
+    // yardstick scenes as shipped, 20 s (RK4 at 10 ms; the second with
+    // drag across its springs), then tanks of two jellyfish each, food and
+    // ceilings placed at random, on the floor's side of the water, under
+    // RK4 at SeaWorld's 10 ms and symplectic Euler at 2 ms.
+    let swim = include_str!("../../../scenes/jellyfish_swim.toml");
+    for (file, text) in [
+        ("jellyfish_swim.toml", swim),
+        (
+            "jellyfish_swim_rods.toml",
+            include_str!("../../../scenes/jellyfish_swim_rods.toml"),
+        ),
+    ] {
+        let scene = animats_scene::parse(text, file).unwrap();
+        let got = assert_same(vec![scene], file);
+        assert!(got[0].distance > 4.0, "{file}: it swims up: {got:?}");
+    }
+    // Two edges of its FSM: food level with its dome, along +x, where two
+    // dome masses smell it alike (the first of them pushes); and, under
+    // gravity, deep below y = 0, where its depth sense reads 0 and so a
+    // tired one's hover ends at once (it has reached the depth it holds).
+    let beside = swim.replace(
+        "position = [0.0, 1000.0, 0.0]",
+        "position = [3.0, 0.0, 0.0]",
+    );
+    let deep = swim
+        .replace("gravity = [0.0, 0.0, 0.0]", "")
+        .replace("position = [0.0, 0.0, 0.0]", "position = [0.0, -30.0, 0.0]");
+    for (what, text) in [("beside the food", &beside), ("deep", &deep)] {
+        let scene = animats_scene::parse(text, "jellyfish_swim.toml").unwrap();
+        assert_same(vec![scene], what);
+    }
+    assert_eq!(
+        behaviours(&deep).into_iter().collect::<Vec<_>>(),
+        ["hover", "idle", "track"]
+    );
+    // Packed mid-run (its energy spent, a depth held, its phase part-way
+    // and its forces on), every 97th step from 4 s to 14 s in, and at the
+    // first three steps it idles between two pulses of tracking (which
+    // it goes back to): the FSM's whole state goes with it.
+    let mut scene = animats_scene::parse(&deep, "jellyfish_swim.toml").unwrap();
+    let mut at: Vec<u64> = (0..11).map(|k| 400 + 97 * k).collect();
+    for step in 1..=1000 {
+        scene.step(0.01).unwrap();
+        let any = scene.actors[0].as_any().unwrap();
+        let fsm = &any.downcast_ref::<Jellyfish>().unwrap().fsm;
+        if fsm.behaviour() == Behaviour::Idle && fsm.previous() == Behaviour::Track {
+            at.push(step);
+        }
+    }
+    assert!(at.len() > 13, "{at:?}");
+    let later = at[..14]
+        .iter()
+        .map(|&k| {
+            let mut scene = animats_scene::parse(&deep, "jellyfish_swim.toml").unwrap();
+            scene.steps(k, 0.01).unwrap();
+            scene
+        })
+        .collect();
+    assert_same(later, "packed mid-run");
+    let mut rng = Random::for_entry(17, 0);
+    for (dt, integrator, n) in [(0.01, "rk4", 8), (0.002, "symplectic", 4)] {
+        let texts: Vec<String> = (0..n)
+            .map(|_| jellyfish_tank(&mut rng, dt, integrator, 20.0))
+            .collect();
+        let scenes = texts
+            .iter()
+            .map(|t| animats_scene::parse(t, "tank.toml").unwrap())
+            .collect();
+        let got = assert_same(scenes, &format!("jellyfish tanks, {integrator}"));
+        assert!(distinct_distances(&got) == n, "{integrator}: {got:?}");
+        // Between them they idle, track food and hover.
+        let mut seen = std::collections::BTreeSet::new();
+        for t in &texts {
+            seen.extend(behaviours(t));
+        }
+        assert_eq!(
+            seen.into_iter().collect::<Vec<_>>(),
+            ["hover", "idle", "track"],
+            "{integrator}"
+        );
+    }
+}
+
+#[test]
+fn jellyfish_and_evolved_swimmers_share_a_batch_bit_for_bit() {
+    // Any mix of bodies in one batch: the swim task's random bodies
+    // (spring muscles under oscillators, self-contact) and jellyfish in
+    // the same water (Sims's: no gravity, no floor; symplectic Euler at
+    // 1 ms), 2 s each, alternating in the batch.
+    let text = include_str!("../../../scenes/bodies_swim.toml")
+        .replace("duration = 20.0", "duration = 2.0");
+    let problem = MorphologyProblem::parse(&text, "bodies_swim.toml").unwrap();
+    let bodies = random_bodies(&problem, 3, 6);
+    let jelly = include_str!("../../../scenes/jellyfish_swim.toml")
+        .replace("dt = 0.01 ", "dt = 0.001 ")
+        .replace("integrator = \"rk4\"", "integrator = \"symplectic\"")
+        .replace("duration = 20.0", "duration = 2.0");
+    assert!(jelly.contains("dt = 0.001 ") && jelly.contains("symplectic"));
+    let mut rng = Random::for_entry(23, 0);
+    let mut scenes = Vec::new();
+    for body in bodies {
+        scenes.push(body);
+        let at = format!(
+            "position = [{}, {}, {}]",
+            rng.between(-1.0, 1.0),
+            rng.between(-1.0, 1.0),
+            rng.between(-1.0, 1.0)
+        );
+        let own = jelly.replace("position = [0.0, 0.0, 0.0]", &at);
+        scenes.push(animats_scene::parse(&own, "jellyfish_swim.toml").unwrap());
+    }
+    let got = assert_same(scenes, "jellyfish among swimmers");
+    assert!(distinct_distances(&got) == 12, "{got:?}");
+}
+
 #[test]
 fn the_thesis_s_roobot_is_the_engine_s_to_the_bit() {
     // scenes/hop_evolver.toml, the thesis's experiment (RK4 at 8 ms, 20 s,
@@ -883,8 +1052,9 @@ fn the_thesis_s_roobot_is_the_engine_s_to_the_bit() {
 
 #[test]
 fn what_the_c_does_not_evaluate_is_refused_by_name() {
-    // A creature that acts by itself (the quadruped with its scripted
-    // step: without one it is particles, springs and joints, evaluated).
+    // A creature that acts by itself other than a jellyfish (the
+    // quadruped with its scripted step: without one it is particles,
+    // springs and joints, evaluated).
     let dog = QUADRUPED.replace("demo_at = -1.0", "demo_at = 2.0");
     let dog = SceneProblem::parse(&dog, "quadruped3_gait.toml")
         .unwrap()

@@ -1,4 +1,4 @@
-//! The C port of the step's transcendental functions (kernel/libm.h,
+//! The C port of the step's transcendental functions and hypot (kernel/libm.h,
 //! kernel/trig.h)
 //! against the engine's (`animats_engine::math`, the `libm` crate), bit for
 //! bit, on more than a million arguments each: every special value, then
@@ -84,6 +84,29 @@ fn atan2_is_the_libm_crate_s_to_the_bit() {
         };
         let (c, rust) = (ported::atan2(y, x), math::atan2(y, x));
         assert!(same(c, rust), "atan2({y:e}, {x:e}): C {c:e}, libm {rust:e}");
+    }
+}
+
+#[test]
+fn hypot_is_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(5);
+    for &y in &SPECIAL {
+        for &x in &SPECIAL {
+            let (c, rust) = (ported::hypot(x, y), math::hypot(x, y));
+            assert!(same(c, rust), "hypot({x:e}, {y:e}): C {c:e}, libm {rust:e}");
+        }
+    }
+    for i in 0..1_100_000 {
+        let (x, y) = match i % 4 {
+            // Alike (a jellyfish's food sense), past the scaling's bounds
+            // (2^510 and 2^-450), 64 binades apart or more, anything.
+            0 => (r.spread(-8, 4), r.spread(-8, 4)),
+            1 => (r.spread(400, 1023), r.spread(-1074, -400)),
+            2 => (r.spread(-200, 200), r.spread(-200, 200)),
+            _ => (f64::from_bits(r.next()), f64::from_bits(r.next())),
+        };
+        let (c, rust) = (ported::hypot(x, y), math::hypot(x, y));
+        assert!(same(c, rust), "hypot({x:e}, {y:e}): C {c:e}, libm {rust:e}");
     }
 }
 

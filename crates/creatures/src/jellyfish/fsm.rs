@@ -135,6 +135,12 @@ impl JellyfishFsm {
         self.behaviour
     }
 
+    /// The behaviour it last chose on leaving idle (track or hover; idle
+    /// at the start): a tired jellyfish keeps tracking after a pulse.
+    pub fn previous(&self) -> Behaviour {
+        self.previous
+    }
+
     /// Internal energy, in [0, 1].
     pub fn energy(&self) -> f64 {
         self.energy

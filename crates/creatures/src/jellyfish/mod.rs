@@ -100,6 +100,11 @@ impl Jellyfish {
         })
     }
 
+    /// Radius of its dome ring, m: the unit of its balance sense.
+    pub fn dome_radius(&self) -> f64 {
+        self.body_radius
+    }
+
     /// Mean horizontal distance from the dome masses to the food, m.
     pub fn food_distance(&self, world: &World) -> f64 {
         self.food.iter().map(|f| f.distance(world)).sum::<f64>() / self.food.len() as f64
@@ -144,5 +149,9 @@ impl Actor for Jellyfish {
             energy: Some(self.fsm.energy()),
             phase: Some(self.fsm.phase()),
         })
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 }
