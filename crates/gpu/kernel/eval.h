@@ -621,6 +621,74 @@ AN_COLD void an_jellyfish(const an_batch *b, an_state st, long long c, long long
     }
 }
 
+/* Raibert's controller m (a network entry of kind 6) of a roobot, creature
+ * c, whose state is st, at time t (roobot/raibert.rs: RaibertSenses::read,
+ * then Raibert::think): thrust in stance once the hip stops falling, the
+ * body's pitch servoed by the ankle in stance, the foot placed by the hip
+ * in flight; its levels to the leg, hip and ankle. scenes.rs
+ * `add_raibert` says how its numbers and state are laid out. */
+AN_COLD void an_raibert(const an_batch *b, an_state st, long long c, long long m, double t, double dt) {
+    const double *g = b->net_weight + b->net_first_weight[m];
+    double *s = b->net_scratch + b->net_first_scratch[m];
+    const double *x = st.x;
+    const double *tilt_fwd = g + 13, *fwd = g + 20;
+    const double *base = x + 3 * (long long)g[11], *tip = x + 3 * (long long)g[12];
+    const double *hip = x + 3 * (long long)g[16], *foot = x + 3 * (long long)g[17];
+    const double *head = x + 3 * (long long)g[18], *tail = x + 3 * (long long)g[19];
+    const double *hv = st.v + 3 * (long long)g[16];
+    double lean[3], body[3], leg[3];
+    for (int d = 0; d < 3; d++) {
+        lean[d] = tip[d] - base[d];
+        body[d] = head[d] - tail[d];
+        leg[d] = hip[d] - foot[d];
+    }
+    double foot_height = b->sensor_level[b->first_sensor[c] + (long long)g[10]];
+    double angle = an_atan2(an_dot(lean, tilt_fwd), lean[1]);
+    double pitch = an_atan2(body[1], an_dot(body, fwd));
+    double climb = hv[1], v = an_dot(hv, fwd), length = sqrt(an_dot(leg, leg));
+    /* Raibert::think */
+    int down = foot_height <= 0.0;
+    if (down && s[0] == 0.0) {
+        s[0] = 1.0;
+        s[1] = 0.0;
+        s[2] = t;
+    } else if (!down && s[0] != 0.0) {
+        s[0] = 0.0;
+        if (t > s[2]) {
+            s[3] = an_minnum(t - s[2], 1.0);
+        }
+    }
+    double rate = s[4] == s[4] ? (angle - s[4]) / dt : 0.0;
+    s[4] = angle;
+    double pitch_rate = s[5] == s[5] ? (pitch - s[5]) / dt : 0.0;
+    s[5] = pitch;
+    double out[3];
+    if (s[0] != 0.0) {
+        if (climb >= 0.0) {
+            s[1] = 1.0;
+        }
+        out[0] = g[1] + (s[1] != 0.0 ? g[0] : 0.0);
+        double tau = -g[6] * pitch - g[7] * pitch_rate;
+        out[2] = 0.5 + tau / (2.0 * g[9]);
+        out[1] = 0.5;
+    } else {
+        out[0] = g[1];
+        double ahead = v * s[3] / 2.0 + g[2] * (v - g[3]);
+        double q = ahead / an_maxnum(length, 1e-3);
+        if (q < -0.9) { /* f64::clamp */
+            q = -0.9;
+        }
+        if (q > 0.9) {
+            q = 0.9;
+        }
+        double target = -an_asin(q);
+        double tau = -g[4] * (angle - target) - g[5] * rate;
+        out[1] = 0.5 + tau / (2.0 * g[8]);
+        out[2] = 0.5;
+    }
+    an_net_outputs(b, c, b->first_muscle[c], m, out, dt);
+}
+
 /* The nervous system of creature c acts at time t (nervous_system.rs
  * `act`): every sensor read, then every controller in the scene's order;
  * then the jellyfish (Scene::step: the actors after the nervous system). */
@@ -644,6 +712,8 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
             an_hop(b, st, c, b->ctrl_index[k], dt);
         } else if (b->ctrl_kind[k] == 3) {
             an_fsm(b, c, b->ctrl_index[k], t, dt);
+        } else if (b->ctrl_kind[k] == 6) {
+            an_raibert(b, st, c, b->ctrl_index[k], t, dt);
         }
     }
     an_gates(b, c);

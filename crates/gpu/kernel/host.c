@@ -7,6 +7,7 @@
 double animats_atan(double x) { return an_atan(x); }
 double animats_atan2(double y, double x) { return an_atan2(y, x); }
 double animats_hypot(double x, double y) { return an_hypot(x, y); }
+double animats_asin(double x) { return an_asin(x); }
 
 #include "trig.h"
 #include "exp.h"

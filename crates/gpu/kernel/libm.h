@@ -206,4 +206,46 @@ AN_FN double an_hypot(double x, double y) {
     return z * sqrt(ly + lx + hy + hx);
 }
 
+/* asin(x): e_asin.c as the libm crate has it (Raibert's foot placement). */
+AN_FN double an_asin_r(double z) {
+    double p = z * (1.66666666666666657415e-01 +
+                    z * (-3.25565818622400915405e-01 +
+                         z * (2.01212532134862925881e-01 +
+                              z * (-4.00555345006794114027e-02 +
+                                   z * (7.91534994289814532176e-04 + z * 3.47933107596021167570e-05)))));
+    double q = 1.0 + z * (-2.40339491173441421878e+00 +
+                          z * (2.02094576023350569471e+00 +
+                               z * (-6.88283971605453293030e-01 + z * 7.70381505559019352791e-02)));
+    return p / q;
+}
+AN_FN double an_asin(double x) {
+    const double pio2_hi = 1.57079632679489655800e+00, pio2_lo = 6.12323399573676603587e-17;
+    unsigned int hx = (unsigned int)(an_bits(x) >> 32);
+    unsigned int ix = hx & 0x7fffffffu;
+    if (ix >= 0x3ff00000u) { /* |x| >= 1 or NaN */
+        unsigned int lx = (unsigned int)an_bits(x);
+        if (((ix - 0x3ff00000u) | lx) == 0) {
+            return x * pio2_hi + an_from_bits(0x3870000000000000ULL);
+        }
+        return 0.0 / (x - x);
+    }
+    if (ix < 0x3fe00000u) { /* |x| < 0.5 */
+        if (ix >= 0x00100000u && ix < 0x3e500000u) {
+            return x;
+        }
+        return x + x * an_asin_r(x * x);
+    }
+    double z = (1.0 - an_fabs(x)) * 0.5;
+    double s = sqrt(z);
+    double r = an_asin_r(z);
+    if (ix >= 0x3fef3333u) { /* |x| > 0.975 */
+        x = pio2_hi - (2.0 * (s + s * r) - pio2_lo);
+    } else {
+        double f = an_from_bits(an_bits(s) & 0xffffffff00000000ULL);
+        double c = (z - f * f) / (s + f);
+        x = 0.5 * pio2_hi - (2.0 * s * r - (pio2_lo - 2.0 * c) - (0.5 * pio2_hi - 2.0 * f));
+    }
+    return hx >> 31 ? -x : x;
+}
+
 #endif

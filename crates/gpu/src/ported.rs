@@ -8,6 +8,7 @@ extern "C" {
     fn animats_atan(x: c_double) -> c_double;
     fn animats_atan2(y: c_double, x: c_double) -> c_double;
     fn animats_hypot(x: c_double, y: c_double) -> c_double;
+    fn animats_asin(x: c_double) -> c_double;
     fn animats_sin(x: c_double) -> c_double;
     fn animats_cos(x: c_double) -> c_double;
     fn animats_exp(x: c_double) -> c_double;
@@ -61,4 +62,10 @@ pub fn atan2(y: f64, x: f64) -> f64 {
 pub fn hypot(x: f64, y: f64) -> f64 {
     // SAFETY: a pure function of its arguments.
     unsafe { animats_hypot(x, y) }
+}
+
+/// `asin x` as the C step computes it (Raibert's foot placement).
+pub fn asin(x: f64) -> f64 {
+    // SAFETY: a pure function of its argument.
+    unsafe { animats_asin(x) }
 }

@@ -10,7 +10,8 @@
 //! speed), actuators (a spring's rest length, an angle joint's rest angle, a
 //! torque joint's torque, a constant force's scale; with or without a
 //! `rate`, gated or not) and the positive work they do, oscillator (sine or skewed), neural,
-//! CTRNN and FSM brains and the roobot's hopping FSM, the thesis's
+//! CTRNN and FSM brains, the roobot's hopping FSM and Raibert's
+//! controller, the thesis's
 //! jellyfish (its pulses and steering under its own FSM, after the scene's
 //! controllers), the centre of the particles that count,
 //! `fail_on_touch` and `fail_on_stretch`, the divergence guard of a driven
@@ -27,7 +28,8 @@ use animats_creatures::brains::fsm::{Condition, Fsm};
 use animats_creatures::brains::neural::Neural;
 use animats_creatures::jellyfish::{Behaviour, Jellyfish};
 use animats_creatures::nervous_system::{Inputs, NervousSystem, Wired};
-use animats_creatures::roobot::{FsmSenses, HopFsm, HopState};
+use animats_creatures::roobot::raibert::RaibertSenses;
+use animats_creatures::roobot::{FsmSenses, HopFsm, HopState, Raibert};
 use animats_creatures::sensor::Sensor;
 use animats_creatures::sensors::probe::{Probe, ScaledSensor};
 use animats_creatures::sensors::{HeightSensor, SpeedSensor, TiltSensor, TouchdownSensor};
@@ -258,7 +260,7 @@ impl Rules {
         }
         for c in &nervous.controllers {
             let shift = |o: usize| nervous.offsets.get(o).copied().unwrap_or(f64::NAN);
-            if self.add_hop(c, nervous, &shift)? {
+            if self.add_hop(c, nervous, &shift)? || self.add_raibert(c, nervous, &shift)? {
                 continue;
             }
             if self.add_network(c, &shift)? {
@@ -517,6 +519,68 @@ impl Rules {
         });
         self.net_first_scratch.push(self.net_scratch.len() as i64);
         self.end_network((0..4).map(|k| senses.sensors + k), &c.outputs, shift);
+        Ok(true)
+    }
+
+    /// Appends Raibert's controller `c` for a roobot (a network entry of
+    /// kind 6; creatures/src/roobot/raibert.rs): its numbers the 8 gains,
+    /// the hip's and ankle's torques, then what its senses read: the foot
+    /// height sensor (within the creature's sensors), the leg's tilt (its
+    /// base, tip and forward direction), the hip, foot, head and tail, the
+    /// forward direction; its scratch: in stance, thrusting, when the
+    /// stance began, the last stance's duration, the last leg angle and
+    /// pitch (NaN: none yet). `Ok(false)` if `c` is not one.
+    fn add_raibert(
+        &mut self,
+        c: &Wired,
+        nervous: &NervousSystem,
+        shift: &dyn Fn(usize) -> f64,
+    ) -> Result<bool, String> {
+        let Some(r) = c.brain.as_any().and_then(|a| a.downcast_ref::<Raibert>()) else {
+            return Ok(false);
+        };
+        let senses = match &c.inputs {
+            Inputs::Senses(s) => s.as_any().and_then(|a| a.downcast_ref::<RaibertSenses>()),
+            Inputs::Sensors(_) => None,
+        };
+        let Some(senses) =
+            senses.filter(|s| c.outputs.len() == 3 && s.foot_height < nervous.sensors.len())
+        else {
+            return Err(format!(
+                "the controller `{}` (raibert) reads senses other than a roobot's: not in the GPU evaluation yet",
+                c.name
+            ));
+        };
+        let i = |p: ParticleId| p.index() as f64;
+        self.ctrl_kind.push(6);
+        self.ctrl_index.push(self.net_clock.len() as i32);
+        self.net_weight.extend(r.gains);
+        self.net_weight.extend([
+            r.hip_torque,
+            r.ankle_torque,
+            senses.foot_height as f64,
+            i(senses.angle.base),
+            i(senses.angle.tip),
+        ]);
+        self.net_weight.extend(senses.angle.forward.to_array());
+        self.net_weight.extend([
+            i(senses.hip),
+            i(senses.foot),
+            i(senses.head),
+            i(senses.tail),
+        ]);
+        self.net_weight.extend(senses.forward.to_array());
+        self.net_clock.push(f64::NAN);
+        self.net_scratch.extend([
+            f64::from(u8::from(r.in_stance)),
+            f64::from(u8::from(r.thrusting)),
+            r.stance_started,
+            r.last_stance,
+            r.last_angle.unwrap_or(f64::NAN),
+            r.last_pitch.unwrap_or(f64::NAN),
+        ]);
+        self.net_first_scratch.push(self.net_scratch.len() as i64);
+        self.end_network(std::iter::empty(), &c.outputs, shift);
         Ok(true)
     }
 

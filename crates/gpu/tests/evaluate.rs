@@ -832,6 +832,73 @@ fn the_quadruped_s_gaits_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// `n` scenes of `text` whose genomes lie about its own, each gene moved
+/// by up to `spread` of its range.
+fn about(text: &str, n: usize, seed: u64, spread: f64) -> Vec<Scene> {
+    let problem = SceneProblem::parse(text, "about.toml").unwrap();
+    let mut rng = Random::for_entry(seed, 0);
+    (0..n)
+        .map(|_| {
+            let g: Vec<f64> = problem
+                .start()
+                .iter()
+                .zip(problem.bounds())
+                .map(|(&x, &(lo, hi))| (x + (hi - lo) * rng.between(-spread, spread)).clamp(lo, hi))
+                .collect();
+            problem.scene(&g).unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn raibert_s_controller_on_the_roobot_is_the_engine_s_to_the_bit() {
+    // scenes/hop_evolver.toml with Raibert's controller for the thesis's
+    // FSM (`brain = "raibert"`, its 8 gains the genome): its hand-set
+    // gains, random ones (which fall within 3 s) and gains about the
+    // hand-set ones (many hop the whole 20 s, through hundreds of
+    // landings), at the thesis's 8 ms and at 2 ms, and facing 0.7 rad.
+    let raibert = HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
+    assert!(raibert.contains("raibert"));
+    let turned = raibert.replace("brain = \"raibert\"", "brain = \"raibert\"\nheading = 0.7");
+    let fine = raibert.replace("dt = 0.008", "dt = 0.002");
+    for (what, text) in [("8 ms", raibert), ("turned", turned), ("2 ms", fine)] {
+        let mut scenes = genomes(&text, 6, 7);
+        scenes.extend(about(&text, 10, 8, 0.05));
+        // Feet placed far ahead and far behind (k_v high, a speed wanted
+        // backwards or fast: past the placement's clamp at ±0.9, with a
+        // hip servo soft enough not to saturate), and thrusts and flight
+        // levels low and high.
+        for gains in [
+            "[0.1, 0.5, 5.0, -2.0, 0.3, 0.0, 0.0, 0.0]",
+            "[0.1, 0.5, 5.0, 5.0, 0.3, 0.0, 0.0, 0.0]",
+            "[0.03, 0.5, 0.1, 1.0, 5.0, 0.3, 0.0, 0.0]",
+            "[0.06, 0.3, 0.1, 1.0, 5.0, 0.3, 0.0, 0.0]",
+            "[0.2, 0.1, 0.1, 1.0, 5.0, 0.3, 0.0, 0.0]",
+            "[0.01, 0.6, 0.1, 1.0, 5.0, 0.3, 0.0, 0.0]",
+        ] {
+            let own = text.replace(
+                "brain = \"raibert\"",
+                &format!("brain = \"raibert\"\ngains = {gains}"),
+            );
+            scenes.push(
+                SceneProblem::parse(&own, "raibert.toml")
+                    .unwrap()
+                    .fresh()
+                    .unwrap(),
+            );
+        }
+        let got = assert_same(scenes, &format!("raibert, {what}"));
+        assert!(distinct_distances(&got) == 22, "{what}: {got:?}");
+        let whole = got.iter().filter(|e| e.ended == Ended::Timeout).count();
+        let hopped: f64 = got.iter().map(|e| e.time).sum();
+        assert!(
+            (3..22).contains(&whole) && hopped > 80.0,
+            "{what}: {:?}",
+            got.iter().map(|e| (&e.ended, e.time)).collect::<Vec<_>>()
+        );
+    }
+}
+
 /// A tank of SeaWorld's water (still, a floor, gravity) holding food and
 /// two of the thesis's jellyfish, each placed, weighed and given a
 /// ceiling from `rng`; `[evolve]` scores the first one's dome rising.

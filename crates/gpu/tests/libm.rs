@@ -88,6 +88,27 @@ fn atan2_is_the_libm_crate_s_to_the_bit() {
 }
 
 #[test]
+fn asin_is_the_libm_crate_s_to_the_bit() {
+    let mut r = Bits(6);
+    let mut args: Vec<f64> = SPECIAL.to_vec();
+    // Each branch's edges (2^-26, 0.5, 0.975, 1), Raibert's clamp (±0.9),
+    // then [-1, 1] evenly, every binade below 1, and any bits.
+    for edge in [2f64.powi(-26), 0.5, 0.975, 1.0, 0.9] {
+        for k in -4i64..=4 {
+            let x = f64::from_bits((edge.to_bits() as i64 + k) as u64);
+            args.extend([x, -x]);
+        }
+    }
+    args.extend((0..400_000).map(|_| 2.0 * (r.next() >> 11) as f64 / (1u64 << 53) as f64 - 1.0));
+    args.extend((0..400_000).map(|_| r.spread(-1074, -1)));
+    args.extend((0..300_000).map(|_| f64::from_bits(r.next())));
+    for x in args {
+        let (c, rust) = (ported::asin(x), math::asin(x));
+        assert!(same(c, rust), "asin({x:e}): C {c:e}, libm {rust:e}");
+    }
+}
+
+#[test]
 fn hypot_is_the_libm_crate_s_to_the_bit() {
     let mut r = Bits(5);
     for &y in &SPECIAL {

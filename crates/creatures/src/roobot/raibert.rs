@@ -71,15 +71,21 @@ pub struct Raibert {
     /// The gains (see [`GAIN_NAMES`]).
     pub gains: [f64; GAIN_COUNT],
     /// Hip motor torque at levels 0 and 1, N m.
-    hip_torque: f64,
+    pub hip_torque: f64,
     /// Ankle motor torque at levels 0 and 1, N m.
-    ankle_torque: f64,
-    in_stance: bool,
-    thrusting: bool,
-    stance_started: f64,
-    last_stance: f64,
-    last_angle: Option<f64>,
-    last_pitch: Option<f64>,
+    pub ankle_torque: f64,
+    /// Whether the foot was down at the last step.
+    pub in_stance: bool,
+    /// Whether this stance's thrust has begun (the hip stopped falling).
+    pub thrusting: bool,
+    /// When this stance began, s.
+    pub stance_started: f64,
+    /// The last stance's duration, s (at most 1).
+    pub last_stance: f64,
+    /// The leg's angle at the last step (its rate's reference), rad.
+    pub last_angle: Option<f64>,
+    /// The body's pitch at the last step, rad.
+    pub last_pitch: Option<f64>,
 }
 
 /// What Raibert's controller reads, in order ([`RaibertSenses`]).
@@ -168,6 +174,10 @@ impl Brain for Raibert {
         Some(if self.in_stance { "stance" } else { "flight" })
     }
 
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
+    }
+
     fn genome(&self) -> Vec<f64> {
         self.gains.to_vec()
     }
@@ -194,13 +204,20 @@ impl Brain for Raibert {
 
 /// The roobot's senses as Raibert's controller reads them ([`INPUTS`]).
 pub struct RaibertSenses {
-    foot_height: usize,
-    angle: TiltSensor,
-    hip: ParticleId,
-    foot: ParticleId,
-    head: ParticleId,
-    tail: ParticleId,
-    forward: DVec3,
+    /// Index of the foot height sensor in the nervous system.
+    pub foot_height: usize,
+    /// The leg's angle from the vertical (its raw angle, not its level).
+    pub angle: TiltSensor,
+    /// The hip, whose velocity it reads.
+    pub hip: ParticleId,
+    /// The foot (the leg's length is hip to foot).
+    pub foot: ParticleId,
+    /// The head (the body's pitch is the tail-to-head line's).
+    pub head: ParticleId,
+    /// The tail's first mass.
+    pub tail: ParticleId,
+    /// The direction it faces.
+    pub forward: DVec3,
 }
 
 impl RaibertSenses {
@@ -233,5 +250,9 @@ impl Senses for RaibertSenses {
         out[3] = hip.y;
         out[4] = hip.dot(self.forward);
         out[5] = (world.position(self.hip) - world.position(self.foot)).length();
+    }
+
+    fn as_any(&self) -> Option<&dyn std::any::Any> {
+        Some(self)
     }
 }
