@@ -8,6 +8,8 @@
 # neural brains reading touch sensors and 8,192 gaits of the thesis's
 # quadruped (model 3) around its evolved walk, 16,384 roobots (the
 # thesis's hopper, its FSM's parameters about the evolved ones, 20 s),
+# 4,096 roobots under Raibert's controller and 4,096 of the thesis's
+# jellyfish (food and ceiling at random, 20 s),
 # 4,096 walkers on rough ground (a heightfield: terrain's kernel), 4,096
 # walkers among rocks (sphere contact, the event: its own kernel),
 # each evaluated for 10 s by the engine on every core, by the C and by the
@@ -62,7 +64,7 @@ for run in "65536 1000 20" "16384 1000 0"; do
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
-for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10" "quadruped 8192 10" "roobot 16384 20" "rough 4096 10" "rocks 4096 10"; do
+for run in "walker 65536 10" "bodies 16384 10" "neural 16384 10" "quadruped 8192 10" "roobot 16384 20" "raibert 4096 20" "jellyfish 4096 20" "rough 4096 10" "rocks 4096 10"; do
   echo "== gpu_evaluate $run"
   # shellcheck disable=SC2086
   "$E" $run

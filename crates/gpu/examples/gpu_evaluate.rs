@@ -17,6 +17,15 @@
 //! held in its plane, its hopping FSM) with the evolved parameters and
 //! parameters around them, each moved by up to 2 % of its range.
 //!
+//! `raibert`: the same hopper under Raibert's controller (`brain =
+//! "raibert"`), its hand-set gains and gains around them, each moved by up
+//! to 5 % of its range.
+//!
+//! `jellyfish`: the thesis's jellyfish under its own pulses
+//! (`scenes/jellyfish_swim.toml`, RK4 at 10 ms), its food put at random
+//! within 3 m of it (so that it steers), its ceiling at random between
+//! 0.5 and 5 m (so that it idles and hovers).
+//!
 //! `rough`: the walker on rough ground (`scenes/walker_rough.toml`: a
 //! heightfield, the kernel compiled with terrain), its evolved gait and
 //! random ones.
@@ -25,7 +34,7 @@
 //! contact, the event, in a kernel of its own), gaits about its own, each
 //! gene moved by up to 5 % of its range.
 //!
-//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|rough|rocks] [COUNT] [SECONDS]
+//!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|raibert|jellyfish|rough|rocks] [COUNT] [SECONDS]
 //!
 //! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too.
 //!
@@ -46,6 +55,7 @@ const QUADRUPED_WALK: &str = include_str!("../../../scenes/quadruped3_walk.toml"
 const HOP_EVOLVER: &str = include_str!("../../../scenes/hop_evolver.toml");
 const WALKER_ROUGH: &str = include_str!("../../../scenes/walker_rough_evolved.toml");
 const WALKER_ROCKS: &str = include_str!("../../../scenes/walker_rocks.toml");
+const JELLYFISH_SWIM: &str = include_str!("../../../scenes/jellyfish_swim.toml");
 
 fn fail(e: impl std::fmt::Display) -> ! {
     eprintln!("gpu_evaluate: {e}");
@@ -72,7 +82,24 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
             .map(|&(lo, hi)| rng.between(lo, hi))
             .collect();
         problem.scene(&g)
-    } else if kind == "quadruped" || kind == "roobot" || kind == "rocks" {
+    } else if kind == "jellyfish" {
+        let text = JELLYFISH_SWIM
+            .replace("duration = 20.0", &format!("duration = {seconds}"))
+            .replace(
+                "position = [0.0, 1000.0, 0.0]",
+                &format!(
+                    "position = [{}, {}, {}]",
+                    rng.between(-3.0, 3.0),
+                    rng.between(-3.0, 3.0),
+                    rng.between(-3.0, 3.0)
+                ),
+            )
+            .replace(
+                "ceiling = 2000.0",
+                &format!("ceiling = {}", rng.between(0.5, 5.0)),
+            );
+        animats_scene::parse(&text, "scenes/jellyfish_swim.toml").map_err(|e| e.to_string())
+    } else if kind == "quadruped" || kind == "roobot" || kind == "raibert" || kind == "rocks" {
         let (text, file, spread) = if kind == "quadruped" {
             (
                 QUADRUPED_WALK.to_string(),
@@ -82,6 +109,9 @@ fn scene(kind: &str, seconds: f64, k: u64) -> Result<Scene, String> {
         } else if kind == "rocks" {
             // Gaits about the walker's, which walk into the rocks.
             (duration(WALKER_ROCKS), "scenes/walker_rocks.toml", 0.05)
+        } else if kind == "raibert" {
+            let own = HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
+            (own, "scenes/hop_evolver.toml", 0.05)
         } else {
             let evolved = HOP_EVOLVER.replace("params = \"initial\"", "params = \"evolved\"");
             (evolved, "scenes/hop_evolver.toml", 0.02)
@@ -128,10 +158,18 @@ fn main() {
         .unwrap_or_else(|_| fail("SECONDS: a number"));
     if !matches!(
         kind,
-        "walker" | "bodies" | "neural" | "quadruped" | "roobot" | "rough" | "rocks"
+        "walker"
+            | "bodies"
+            | "neural"
+            | "quadruped"
+            | "roobot"
+            | "raibert"
+            | "jellyfish"
+            | "rough"
+            | "rocks"
     ) || !(1..=10_000_000).contains(&count)
     {
-        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot|rough|rocks] [COUNT 1 to 10,000,000] [SECONDS]");
+        fail("usage: gpu_evaluate [walker|bodies|neural|quadruped|roobot|raibert|jellyfish|rough|rocks] [COUNT 1 to 10,000,000] [SECONDS]");
     }
     if !(seconds > 0.0 && seconds <= 1000.0) {
         fail("SECONDS: more than 0, at most 1000");
