@@ -316,15 +316,12 @@ AN_FN void an_motors(const an_batch *b, long long m0, long long nm, const double
  * normalised, y 0), its drift in the first three. */
 #define AN_CURRENT 11
 
-/* The current's velocity at p at time t, into u (ReefWater::velocity,
- * in its order: glam's dot and its vector sums written out). */
-AN_FN void an_current(const double *cur, const double *p, double t, double *u) {
-    if (cur[3] != cur[3]) {
-        u[0] = cur[0];
-        u[1] = cur[1];
-        u[2] = cur[2];
-        return;
-    }
+/* A reef's current at p at time t, into u (ReefWater::velocity, in its
+ * order: glam's dot and its vector sums written out). Out of line on a
+ * GPU (AN_COLD): inlined into the fluid's and the rods' loops, its exp,
+ * sin and cos took the flat floor's evaluation from 168 registers to 255,
+ * spilling, for every creature, in a reef or not. */
+AN_COLD void an_reef_current(const double *cur, const double *p, double t, double *u) {
     const double *dir = cur + 8;
     double depth = cur[4] - p[1];
     depth = depth > 0.0 ? depth : 0.0; /* f64::max(depth, 0.0): NaN gives 0 */
@@ -335,6 +332,18 @@ AN_FN void an_current(const double *cur, const double *p, double t, double *u) {
     u[0] = (dir[0] * along + 0.0 * up) + cur[0];
     u[1] = (dir[1] * along + 1.0 * up) + cur[1];
     u[2] = (dir[2] * along + 0.0 * up) + cur[2];
+}
+
+/* The current's velocity at p at time t, into u: a uniform current's
+ * (still water's 0), or a reef's. */
+AN_FN void an_current(const double *cur, const double *p, double t, double *u) {
+    if (cur[3] != cur[3]) {
+        u[0] = cur[0];
+        u[1] = cur[1];
+        u[2] = cur[2];
+        return;
+    }
+    an_reef_current(cur, p, t, u);
 }
 
 /* Fluids q0 .. q0 + nq - 1 on every particle of the creature, still, in
