@@ -9,6 +9,7 @@
 
 use animats_creatures::jellyfish::{Behaviour, Jellyfish};
 use animats_creatures::random::Random;
+use animats_creatures::roobot::Raibert;
 use animats_gpu::{cpu_has_fma, rank_correlation, Batch, Layout, Mode};
 use animats_scene::evaluate::{Ended, Evaluation, SceneProblem};
 use animats_scene::morphology::problem::MorphologyProblem;
@@ -897,6 +898,55 @@ fn raibert_s_controller_on_the_roobot_is_the_engine_s_to_the_bit() {
             got.iter().map(|e| (&e.ended, e.time)).collect::<Vec<_>>()
         );
     }
+    // Packed mid-run, hopping (its hand-set gains, and with an attitude
+    // servo): at 12 points each, in stance and in flight, thrusting or
+    // not, a stance's duration and the last angle and pitch in its state;
+    let raibert = HOP_EVOLVER.replace("params = \"initial\"", "brain = \"raibert\"");
+    let servo = raibert.replace(
+        "brain = \"raibert\"",
+        "brain = \"raibert\"\ngains = [0.1, 0.5, 0.1, 1.0, 5.0, 0.3, 0.5, 0.05]",
+    );
+    let fresh = |text: &str| {
+        SceneProblem::parse(text, "hop_evolver.toml")
+            .unwrap()
+            .fresh()
+            .unwrap()
+    };
+    let raibert_of = |scene: &Scene| -> Raibert {
+        let any = scene.nervous.controllers[0].brain.as_any().unwrap();
+        any.downcast_ref::<Raibert>().unwrap().clone()
+    };
+    let mut states = std::collections::BTreeSet::new();
+    let mut later = Vec::new();
+    for text in [&raibert, &servo] {
+        for k in 0..12 {
+            let mut scene = fresh(text);
+            scene.steps(101 + 37 * k, 0.008).unwrap();
+            let r = raibert_of(&scene);
+            states.insert((r.in_stance, r.thrusting));
+            later.push(scene);
+        }
+    }
+    assert_eq!(states.len(), 3, "{states:?}");
+    // And random gains where, falling, the hip sinks again after the
+    // thrust began (which stays on), packed at the first such step.
+    let random = || genomes(&servo, 8, 7);
+    for i in 0..8 {
+        let mut scene = random().swap_remove(i);
+        let hip = scene.particle("roobot.hip").unwrap();
+        let step = (1..=400).find(|_| {
+            scene.step(0.008).unwrap();
+            let r = raibert_of(&scene);
+            r.in_stance && r.thrusting && scene.world.velocity(hip).y < 0.0
+        });
+        if let Some(k) = step {
+            let mut scene = random().swap_remove(i);
+            scene.steps(k, 0.008).unwrap();
+            later.push(scene);
+        }
+    }
+    assert!(later.len() > 24, "no fall after a thrust");
+    assert_same(later, "raibert, packed mid-run");
 }
 
 /// A tank of SeaWorld's water (still, a floor, gravity) holding food and
