@@ -80,11 +80,13 @@ def main():
     failed = False
     for arch in sys.argv[1:] or ["sm_90"]:
         # As crates/gpu/src/cuda.rs's three kernels: the flat floor's,
-        # terrain's and sphere contact's (on the flat floor).
+        # terrain's and sphere contact's (on the flat floor); then the flat
+        # floor's with implicit Euler (its other two are compiled alike).
         kinds = [
             ("flat floor", ["-DAN_FLAT_ONLY"]),
             ("terrain", []),
             ("sphere contact", ["-DAN_FLAT_ONLY", "-DAN_SPHERES"]),
+            ("implicit Euler, flat floor", ["-DAN_FLAT_ONLY", "-DAN_WITH_IMPLICIT"]),
         ]
         for kernel, extra in kinds:
             ok, log = compile_for(lib, arch, src, extra)

@@ -4,9 +4,11 @@
 //! does, strict), by the C on every core, and by the GPU; every coordinate
 //! compared as bits; throughput of each.
 //!
-//!     cargo run --release -p animats-gpu --example gpu_check -- [CREATURES] [STEPS] [PARTICLES]
+//!     cargo run --release -p animats-gpu --example gpu_check -- [CREATURES] [STEPS] [PARTICLES] [INTEGRATOR]
 //!
-//! PARTICLES 0 (the default) mixes sizes of 2 to 40. Exit 2 where no GPU
+//! PARTICLES 0 (the default) mixes sizes of 2 to 40. INTEGRATOR as a
+//! scene's `integrator` (default `rk4`; `implicit` runs implicit Euler's
+//! kernels). Exit 2 where no GPU
 //! can be used (the message says why), 1 if any bit differs.
 
 use animats_creatures::random::Random;
@@ -27,6 +29,16 @@ fn main() {
             })
     };
     let (creatures, steps, particles) = (arg(1, 65_536), arg(2, 1000), arg(3, 20));
+    let kind: IntegratorKind = match std::env::args()
+        .nth(4)
+        .map_or(Ok(IntegratorKind::Rk4), |a| a.parse())
+    {
+        Ok(kind) => kind,
+        Err(e) => {
+            eprintln!("gpu_check: INTEGRATOR: {e}");
+            std::process::exit(2)
+        }
+    };
     if creatures == 0 || creatures > 10_000_000 || particles == 1 || particles > 1000 {
         eprintln!("gpu_check: 1 to 10,000,000 creatures of 2 to 1000 particles (0: mixed)");
         std::process::exit(2);
@@ -40,7 +52,7 @@ fn main() {
             } else {
                 particles as usize
             };
-            let mut w = match random_body(&mut rng, n, true, k % 2 == 0, IntegratorKind::Rk4) {
+            let mut w = match random_body(&mut rng, n, true, k % 2 == 0, kind) {
                 Ok(w) => w,
                 Err(e) => {
                     eprintln!("gpu_check: {e}");
@@ -72,8 +84,9 @@ fn main() {
         }
     };
     println!(
-        "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} RK4 steps of {dt} s, {} CPU threads",
+        "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} {} steps of {dt} s, {} CPU threads",
         if particles == 0 { "2 to 40 particles each".to_string() } else { format!("{particles} particles each") },
+        kind.name(),
         rayon::current_num_threads()
     );
     let rate = |secs: f64| (creatures * steps) as f64 / secs;

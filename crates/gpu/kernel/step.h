@@ -37,7 +37,7 @@
 #include "spheres.h"
 
 /* Integrators, as IntegratorKind's order in the engine. */
-enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3 };
+enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3, AN_IMPLICIT = 4 };
 
 /*
  * A batch of creatures of any mix of sizes, as structures of arrays with
@@ -197,6 +197,9 @@ typedef struct {
     const long long *nbody_range; /* a range's first row (NBodyGravity::row_ranges) */
     double *clock;                /* 2 per creature of a batch of worlds: its time and the
                                      clock's carry (world/step.rs, `advance_clock`) */
+    double *implicit;             /* AN_IMPLICIT_ROOM per particle: implicit Euler's room */
+    double solver_tolerance;      /* implicit Euler's conjugate gradients: relative tolerance */
+    long long solver_iterations;  /* and most iterations */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -729,6 +732,347 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     }
 }
 
+/* Implicit Euler's room per particle (integrators/implicit.rs): the
+ * right-hand side's h^2 (df/dx) v0 (3), the particle's own block of S
+ * (9), then b, x, r, z, p, q of the conjugate gradients (3 each) and the
+ * preconditioner's inverse block (9). A 3x3 block is stored by columns,
+ * as glam's DMat3. */
+#define AN_IMPLICIT_ROOM 39
+
+/* glam's DMat3::mul_vec3: (x_axis v.x + y_axis v.y) + z_axis v.z. */
+AN_FN void an_m3_mul(const double *m, const double *v, double *out) {
+    for (int k = 0; k < 3; k++) {
+        out[k] = (m[k] * v[0] + m[3 + k] * v[1]) + m[6 + k] * v[2];
+    }
+}
+
+/* Jacobian::s: -(dfdx h^2 + dfdv h), element by element. */
+AN_FN void an_jac_s(const double *dfdx, const double *dfdv, double h, double *s) {
+    for (int k = 0; k < 9; k++) {
+        s[k] = -(dfdx[k] * (h * h) + dfdv[k] * h);
+    }
+}
+
+/* Jacobian::block (single where i == j) of particles i and j: the
+ * right-hand side's term and, on the diagonal, the block added; off it,
+ * the block is returned in s for the caller (apply) to use. */
+AN_FN void an_jac_block(double *rhs, double *diag, const double *v0, long long i, long long j,
+                        const double *dfdx, const double *dfdv, double h, double *s) {
+    double mv[3];
+    an_jac_s(dfdx, dfdv, h, s);
+    an_m3_mul(dfdx, v0 + 3 * j, mv);
+    for (int k = 0; k < 3; k++) {
+        rhs[3 * i + k] += mv[k] * (h * h);
+    }
+    if (i == j) {
+        for (int k = 0; k < 9; k++) {
+            diag[9 * i + k] += s[k];
+        }
+    }
+}
+
+/* Spring s's central interaction at positions x (spring.rs `jacobian`,
+ * Jacobian::central): 0 for a spring of no length; else its unit vector
+ * n, alpha and beta. */
+AN_FN int an_jac_spring(const an_batch *b, an_state st, long long s0, long long s, const double *x,
+                        double h, double *n, double *alpha, double *beta, double *along,
+                        double *across) {
+    long long a = st.sa[s - s0], e = st.sb[s - s0];
+    double d[3];
+    for (int k = 0; k < 3; k++) {
+        d[k] = x[3 * e + k] - x[3 * a + k];
+    }
+    double l = sqrt(an_dot(d, d));
+    if (l == 0.0) {
+        return 0;
+    }
+    double k = st.k[s - s0], c = st.d[s - s0];
+    double slack = 1.0 - b->rest_length[s] / l;
+    double across0 = k * (slack > 0.0 ? slack : 0.0); /* f64::max(slack, 0.0) */
+    for (int q = 0; q < 3; q++) {
+        n[q] = d[q] / l;
+    }
+    *along = k;
+    *across = across0;
+    *alpha = h * h * (k - across0) + h * c;
+    *beta = h * h * across0;
+    return 1;
+}
+
+/* Angle joint q's gradient of its angle at positions x (angle_joint.rs
+ * `jacobian`): 0 where it has no plane of bending; else g[0..9]: the
+ * gradients at its first end, its joint and its second end. */
+AN_FN int an_jac_joint(const an_batch *b, long long q, const double *x, double *g) {
+    long long a = b->joint_a[q], j = b->joint_j[q], e = b->joint_b[q];
+    double ra[3], rb[3], normal[3], pa[3], pb[3];
+    for (int k = 0; k < 3; k++) {
+        ra[k] = x[3 * a + k] - x[3 * j + k];
+        rb[k] = x[3 * e + k] - x[3 * j + k];
+    }
+    double la2 = an_dot(ra, ra), lb2 = an_dot(rb, rb);
+    an_cross(ra, rb, normal);
+    double n2 = an_dot(normal, normal);
+    if (n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0) {
+        return 0;
+    }
+    double nl = sqrt(n2);
+    an_cross(normal, ra, pa);
+    an_cross(normal, rb, pb);
+    double wa = -1.0 / (nl * la2), wb = 1.0 / (nl * lb2);
+    for (int k = 0; k < 3; k++) {
+        g[k] = pa[k] * wa;
+        g[6 + k] = pb[k] * wb;
+        g[3 + k] = -(g[k] + g[6 + k]);
+    }
+    return 1;
+}
+
+/* The block of angle joint q between its particles u and w (0 its first
+ * end, 1 its joint, 2 its second end), from its gradients g: dfdx =
+ * outer (-k), dfdv = outer (-c), outer = g_u g_w^T. */
+AN_FN void an_jac_joint_block(const an_batch *b, long long q, const double *g, int u, int w,
+                              double *dfdx, double *dfdv) {
+    double k = -b->joint_stiffness[q], c = -b->joint_damping[q];
+    for (int col = 0; col < 3; col++) {
+        for (int r = 0; r < 3; r++) {
+            double o = g[3 * u + r] * g[3 * w + col];
+            dfdx[3 * col + r] = o * k;
+            dfdv[3 * col + r] = o * c;
+        }
+    }
+}
+
+/* The conjugate gradients' dot product (implicit.rs `dot`): four lanes,
+ * particle k into lane k mod 4 up to the last whole four, the rest into
+ * lane 0, then (s0 + s1) + (s2 + s3). */
+AN_FN double an_cg_dot(const double *a, const double *b, long long n) {
+    double s[4] = {0.0, 0.0, 0.0, 0.0};
+    long long whole = n - n % 4;
+    for (long long i = 0; i < whole; i++) {
+        s[i % 4] += an_dot(a + 3 * i, b + 3 * i);
+    }
+    for (long long i = whole; i < n; i++) {
+        s[0] += an_dot(a + 3 * i, b + 3 * i);
+    }
+    return (s[0] + s[1]) + (s[2] + s[3]);
+}
+
+/* (M + S) p into out (Jacobian::apply): each particle's own block, then
+ * each spring's central interaction in order, then each angle joint's
+ * off-diagonal blocks in order, all formed again from the step's start
+ * x0 (the same numbers the engine stores). */
+AN_FN void an_cg_apply(const an_batch *b, an_state st, long long c, long long n, long long s0,
+                       long long ns, double h, const double *x0, const double *diag,
+                       const double *p, double *out) {
+    for (long long i = 0; i < n; i++) {
+        double mv[3];
+        an_m3_mul(diag + 9 * i, p + 3 * i, mv);
+        for (int k = 0; k < 3; k++) {
+            out[3 * i + k] = p[3 * i + k] * st.m[i] + mv[k];
+        }
+    }
+    for (long long s = s0; s < s0 + ns; s++) {
+        double nv[3], alpha, beta, along, across;
+        if (!an_jac_spring(b, st, s0, s, x0, h, nv, &alpha, &beta, &along, &across)) {
+            continue;
+        }
+        long long a = st.sa[s - s0], e = st.sb[s - s0];
+        double nb = alpha * an_dot(nv, p + 3 * e), na = alpha * an_dot(nv, p + 3 * a);
+        for (int k = 0; k < 3; k++) {
+            out[3 * a + k] -= nv[k] * nb + p[3 * e + k] * beta;
+        }
+        for (int k = 0; k < 3; k++) {
+            out[3 * e + k] -= nv[k] * na + p[3 * a + k] * beta;
+        }
+    }
+    for (long long q = b->first_joint[c]; q < b->first_joint[c + 1]; q++) {
+        double g[9];
+        if (!an_jac_joint(b, q, x0, g)) {
+            continue;
+        }
+        long long ids[3] = {b->joint_a[q], b->joint_j[q], b->joint_b[q]};
+        for (int u = 0; u < 3; u++) {
+            for (int w = 0; w < 3; w++) {
+                if (ids[u] == ids[w]) {
+                    continue;
+                }
+                double dfdx[9], dfdv[9], sb[9], mv[3];
+                an_jac_joint_block(b, q, g, u, w, dfdx, dfdv);
+                an_jac_s(dfdx, dfdv, h, sb);
+                an_m3_mul(sb, p + 3 * ids[w], mv);
+                for (int k = 0; k < 3; k++) {
+                    out[3 * ids[u] + k] += mv[k];
+                }
+            }
+        }
+    }
+}
+
+/* One implicit Euler step of size h from (x0, v0) at time t into (x1, v1)
+ * (integrators/implicit.rs `step`): the forces at the start, their
+ * Jacobian (springs, angle joints, fluids' drag, in the engine's order),
+ * then (M + S) dv = h f0 + h^2 (df/dx) v0 solved by conjugate gradients
+ * preconditioned by each particle's inverse block, to the batch's
+ * tolerance or iterations; v1 = v0 + dv, x1 = x0 + h v1. Out of line on a
+ * GPU (AN_COLD). */
+AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long p0, long long n,
+                         long long s0, long long ns, double h, double t, const double *x0,
+                         const double *v0, double *x1, double *v1, double *f) {
+    double *room = b->implicit + AN_IMPLICIT_ROOM * p0;
+    double *rhs = room, *diag = room + 3 * n, *bv = room + 12 * n, *xs = room + 15 * n;
+    double *r = room + 18 * n, *z = room + 21 * n, *p = room + 24 * n, *q = room + 27 * n;
+    double *pre = room + 30 * n;
+    an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
+    for (long long k = 0; k < AN_IMPLICIT_ROOM * n; k++) {
+        room[k] = 0.0;
+    }
+    /* Springs: Jacobian::central. */
+    for (long long s = s0; s < s0 + ns; s++) {
+        double nv[3], alpha, beta, along, across;
+        if (!an_jac_spring(b, st, s0, s, x0, h, nv, &alpha, &beta, &along, &across)) {
+            continue;
+        }
+        long long a = st.sa[s - s0], e = st.sb[s - s0];
+        double u[3], kv[3], sm[9];
+        for (int k = 0; k < 3; k++) {
+            u[k] = v0[3 * a + k] - v0[3 * e + k];
+        }
+        double nu = an_dot(nv, u);
+        for (int k = 0; k < 3; k++) {
+            kv[k] = -(nv[k] * (nu * (along - across)) + u[k] * across) * (h * h);
+            rhs[3 * a + k] += kv[k];
+            rhs[3 * e + k] -= kv[k];
+        }
+        for (int col = 0; col < 3; col++) {
+            for (int row = 0; row < 3; row++) {
+                sm[3 * col + row] = nv[row] * (nv[col] * alpha) + (row == col ? beta : 0.0);
+            }
+        }
+        for (int k = 0; k < 9; k++) {
+            diag[9 * a + k] += sm[k];
+            diag[9 * e + k] += sm[k];
+        }
+    }
+    /* Angle joints: Jacobian::block over their three particles. */
+    for (long long qj = b->first_joint[c]; qj < b->first_joint[c + 1]; qj++) {
+        double g[9];
+        if (!an_jac_joint(b, qj, x0, g)) {
+            continue;
+        }
+        long long ids[3] = {b->joint_a[qj], b->joint_j[qj], b->joint_b[qj]};
+        for (int u = 0; u < 3; u++) {
+            for (int w = 0; w < 3; w++) {
+                double dfdx[9], dfdv[9], sb[9];
+                an_jac_joint_block(b, qj, g, u, w, dfdx, dfdv);
+                an_jac_block(rhs, diag, v0, ids[u], ids[w], dfdx, dfdv, h, sb);
+            }
+        }
+    }
+    /* Fluids: their drag's df/dv about every particle (fluid.rs). */
+    for (long long qf = b->first_fluid[c]; qf < b->first_fluid[c + 1]; qf++) {
+        double drag = b->fluid_drag[qf];
+        const double *cur = b->fluid_current + AN_CURRENT * qf;
+        for (long long i = 0; i < n; i++) {
+            double uc[3], vr[3];
+            an_current(cur, x0 + 3 * i, t, uc);
+            for (int k = 0; k < 3; k++) {
+                vr[k] = v0[3 * i + k] - uc[k];
+            }
+            double speed = sqrt(an_dot(vr, vr));
+            if (speed > 0.0) {
+                double r0 = st.r[i], uu[3], dfdx[9], dfdv[9], sb[9];
+                for (int k = 0; k < 3; k++) {
+                    uu[k] = vr[k] / speed;
+                }
+                double scale = drag * r0 * r0 * speed;
+                for (int col = 0; col < 3; col++) {
+                    for (int row = 0; row < 3; row++) {
+                        dfdx[3 * col + row] = 0.0;
+                        dfdv[3 * col + row] =
+                            (uu[row] * uu[col] + (row == col ? 1.0 : 0.0)) * scale;
+                    }
+                }
+                an_jac_block(rhs, diag, v0, i, i, dfdx, dfdv, h, sb);
+            }
+        }
+    }
+    for (long long i = 0; i < n; i++) {
+        if (b->fixed[p0 + i]) {
+            continue;
+        }
+        for (int k = 0; k < 3; k++) {
+            bv[3 * i + k] = f[3 * i + k] * h + rhs[3 * i + k];
+        }
+        /* (M + S_ii).inverse(), as glam inverts: the columns' cross
+         * products over the determinant, transposed. */
+        double m[9], t0[3], t1[3], t2[3];
+        for (int col = 0; col < 3; col++) {
+            for (int row = 0; row < 3; row++) {
+                m[3 * col + row] = (row == col ? st.m[i] : 0.0) + diag[9 * i + 3 * col + row];
+            }
+        }
+        an_cross(m + 3, m + 6, t0);
+        an_cross(m + 6, m, t1);
+        an_cross(m, m + 3, t2);
+        double inv_det = 1.0 / an_dot(m, t0);
+        for (int col = 0; col < 3; col++) {
+            pre[9 * i + 3 * col] = t0[col] * inv_det;
+            pre[9 * i + 3 * col + 1] = t1[col] * inv_det;
+            pre[9 * i + 3 * col + 2] = t2[col] * inv_det;
+        }
+    }
+    /* conjugate_gradients */
+    for (long long k = 0; k < 3 * n; k++) {
+        r[k] = bv[k];
+    }
+    for (long long i = 0; i < n; i++) {
+        an_m3_mul(pre + 9 * i, r + 3 * i, z + 3 * i);
+    }
+    for (long long k = 0; k < 3 * n; k++) {
+        p[k] = z[k];
+    }
+    double rz = an_cg_dot(r, z, n);
+    double stop = rz * b->solver_tolerance * b->solver_tolerance;
+    if (rz == rz && rz > 0.0) {
+        for (long long it = 1; it <= b->solver_iterations; it++) {
+            an_cg_apply(b, st, c, n, s0, ns, h, x0, diag, p, q);
+            for (long long i = 0; i < n; i++) {
+                if (b->fixed[p0 + i]) {
+                    q[3 * i] = 0.0;
+                    q[3 * i + 1] = 0.0;
+                    q[3 * i + 2] = 0.0;
+                }
+            }
+            double pq = an_cg_dot(p, q, n);
+            if (pq != pq || pq <= 0.0) {
+                break;
+            }
+            double alpha = rz / pq;
+            for (long long k = 0; k < 3 * n; k++) {
+                xs[k] += alpha * p[k];
+                r[k] -= alpha * q[k];
+            }
+            for (long long i = 0; i < n; i++) {
+                an_m3_mul(pre + 9 * i, r + 3 * i, z + 3 * i);
+            }
+            double rz_new = an_cg_dot(r, z, n);
+            if (rz_new <= stop) {
+                break;
+            }
+            double beta = rz_new / rz;
+            rz = rz_new;
+            for (long long k = 0; k < 3 * n; k++) {
+                p[k] = z[k] + beta * p[k];
+            }
+        }
+    }
+    for (long long k = 0; k < 3 * n; k++) {
+        double v = v0[k] + xs[k];
+        v1[k] = v;
+        x1[k] = x0[k] + h * v;
+    }
+}
+
 /* One integrator step of size h from (x0, v0) at time t into (x1, v1)
  * (the files of integrators/, each stage's forces at their times); f,
  * dx, dv: scratch. */
@@ -794,6 +1138,13 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
         }
         break;
     }
+#if !defined(__CUDACC_RTC__) || defined(AN_WITH_IMPLICIT)
+    /* On a GPU only in the kernels compiled for implicit batches: its
+     * call alone spills every kernel's registers. */
+    case AN_IMPLICIT:
+        an_implicit(b, st, c, p0, n, s0, ns, h, t, x0, v0, x1, v1, f);
+        break;
+#endif
     default: /* AN_SYMPLECTIC */
         an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {

@@ -53,6 +53,10 @@ pub struct Device {
     /// The kernel with sphere contact (on the flat floor, `AN_SPHERES`),
     /// compiled when a batch with it first comes.
     spheres: std::sync::OnceLock<Result<Kernels, String>>,
+    /// The three again with implicit Euler (`AN_WITH_IMPLICIT`: its step spills
+    /// every kernel's registers, so only its batches carry it), each
+    /// compiled when a batch that needs it first comes.
+    implicit: [std::sync::OnceLock<Result<Kernels, String>>; 3],
     name: String,
     arch: (i32, i32),
     mode: Mode,
@@ -118,13 +122,14 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let flat = kernels(&ctx, arch, &name, Variant::Flat, mode)?;
+        let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode)?;
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
             flat,
             terrain: std::sync::OnceLock::new(),
             spheres: std::sync::OnceLock::new(),
+            implicit: Default::default(),
             name,
             arch,
             mode,
@@ -135,16 +140,27 @@ impl Device {
     /// The kernel for `batch`: the flat floor's, terrain's or sphere
     /// contact's (compiled now if it was not yet).
     fn kernels(&self, batch: &Batch) -> Result<&Kernels, String> {
-        let (cell, variant) = if batch.sphere_contact() {
-            (&self.spheres, Variant::Spheres)
+        let variant = if batch.sphere_contact() {
+            Variant::Spheres
         } else if batch.on_terrain() {
-            (&self.terrain, Variant::Terrain)
+            Variant::Terrain
         } else {
-            return Ok(&self.flat);
+            Variant::Flat
         };
-        cell.get_or_init(|| kernels(&self.ctx, self.arch, &self.name, variant, self.mode))
-            .as_ref()
-            .map_err(Clone::clone)
+        let implicit = batch.implicit();
+        let cell = match (variant, implicit) {
+            (Variant::Flat, false) => return Ok(&self.flat),
+            (Variant::Terrain, false) => &self.terrain,
+            (Variant::Spheres, false) => &self.spheres,
+            (v, true) => &self.implicit[v as usize],
+        };
+        cell.get_or_init(|| {
+            kernels(
+                &self.ctx, self.arch, &self.name, variant, implicit, self.mode,
+            )
+        })
+        .as_ref()
+        .map_err(Clone::clone)
     }
 
     /// The mode its kernels were compiled in.
@@ -251,15 +267,16 @@ impl Device {
 }
 
 /// Which of the kernels: each holds only the code its batches need, so
-/// that the commonest hold the fewest registers.
+/// that the commonest hold the fewest registers (each also with implicit
+/// Euler, `AN_WITH_IMPLICIT`, for batches that step with it).
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Variant {
     /// The flat floor (or none): `AN_FLAT_ONLY`.
-    Flat,
+    Flat = 0,
     /// Terrain.
-    Terrain,
+    Terrain = 1,
     /// Sphere contact on the flat floor: `AN_FLAT_ONLY` and `AN_SPHERES`.
-    Spheres,
+    Spheres = 2,
 }
 
 /// The kernel `variant` compiled for `arch` in `mode`, from the disk's
@@ -270,6 +287,7 @@ fn kernels(
     arch: (i32, i32),
     name: &str,
     variant: Variant,
+    implicit: bool,
     mode: Mode,
 ) -> Result<Kernels, String> {
     let src = source();
@@ -279,6 +297,9 @@ fn kernels(
     }
     if variant == Variant::Spheres {
         options.push("-DAN_SPHERES".into());
+    }
+    if implicit {
+        options.push("-DAN_WITH_IMPLICIT".into());
     }
     let kept = crate::cache::folder()
         .map(|dir| crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch));

@@ -4,7 +4,7 @@
 
 use animats_engine::{
     DVec3, FloorCollision, IntegratorKind, NBodyGravity, PlaneConstraint, RodDrag, SoftContact,
-    SphereContact, Terrain, World,
+    Solver, SphereContact, Terrain, World,
 };
 use std::os::raw::{c_double, c_int, c_longlong};
 use std::sync::Arc;
@@ -151,6 +151,9 @@ pub(crate) struct Raw {
     nbody_first_range: *const c_longlong,
     nbody_range: *const c_longlong,
     clock: *mut c_double,
+    implicit: *mut c_double,
+    solver_tolerance: c_double,
+    solver_iterations: c_longlong,
 }
 
 extern "C" {
@@ -206,6 +209,10 @@ impl Shared {
         &self.0
     }
 }
+
+/// Doubles per particle of implicit Euler's room (`AN_IMPLICIT_ROOM` in
+/// `kernel/step.h`).
+const IMPLICIT: usize = 39;
 
 /// Doubles of scratch per particle the C step uses.
 const SCRATCH: usize = 15;
@@ -311,6 +318,10 @@ pub struct Batch {
     /// that ask the time (a reef's currents). A scene's evaluation keeps its
     /// own clock (`Rules`).
     clock: Vec<f64>,
+    /// Implicit Euler's room (`IMPLICIT` doubles a particle; empty under
+    /// the other integrators) and its solver, which the batch's worlds share.
+    implicit: Vec<f64>,
+    solver: Solver,
     /// A scene's evaluation: its muscles, oscillators and rules.
     pub(crate) ev: crate::scenes::Rules,
 }
@@ -414,6 +425,8 @@ impl Batch {
             nbody_first_range: vec![0],
             nbody_range: Vec::new(),
             clock: Vec::new(),
+            implicit: Vec::new(),
+            solver: first.solver(),
             ev: crate::scenes::Rules::default(),
         };
         if let Some(f) = &b.floor {
@@ -428,6 +441,13 @@ impl Batch {
                 return Err(format!(
                     "world {k}: a batch shares one floor; world 0 has {:?}, this one {floor:?}",
                     b.floor
+                ));
+            }
+            if integrator == IntegratorKind::Implicit && w.solver() != b.solver {
+                return Err(format!(
+                    "world {k}: a batch shares one implicit solver; world 0 has {:?}, this one {:?}",
+                    b.solver,
+                    w.solver()
                 ));
             }
             if !same_gravity || w.integrator() != integrator {
@@ -594,6 +614,9 @@ impl Batch {
             b.ev.fixed.extend(props.fixed.iter().map(|&f| i32::from(f)));
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
+        if integrator == IntegratorKind::Implicit {
+            b.implicit = vec![0.0; IMPLICIT * b.mass.len()];
+        }
         b.ev.no_rules(worlds.len());
         Ok(b)
     }
@@ -601,6 +624,11 @@ impl Batch {
     /// Whether the batch's floor has a shape (`[terrain]`).
     pub fn on_terrain(&self) -> bool {
         self.terrain != 0
+    }
+
+    /// Whether the batch steps with implicit Euler.
+    pub fn implicit(&self) -> bool {
+        self.integrator == IntegratorKind::Implicit
     }
 
     /// Whether a creature of the batch has sphere contact (the event).
@@ -698,6 +726,7 @@ impl Batch {
             Array::MuscleWork => self.ev.muscle_work.as_mut_ptr() as u64,
             Array::ContactSlot => self.contact_slot.as_mut_ptr() as u64,
             Array::Clock => self.clock.as_mut_ptr() as u64,
+            Array::Implicit => self.implicit.as_mut_ptr() as u64,
             other => match self.array(other) {
                 Slice::F64(v) => v.as_ptr() as u64,
                 Slice::I32(v) => v.as_ptr() as u64,
@@ -833,6 +862,7 @@ impl Batch {
             Array::NbodyFirstRange => I64(&self.nbody_first_range),
             Array::NbodyRange => I64(&self.nbody_range),
             Array::Clock => F64(&self.clock),
+            Array::Implicit => F64(&self.implicit),
         }
     }
 
@@ -913,6 +943,7 @@ impl Batch {
                 IntegratorKind::Euler => 0,
                 IntegratorKind::Midpoint => 1,
                 IntegratorKind::Rk4 => 2,
+                IntegratorKind::Implicit => 4,
                 _ => 3,
             },
             dt: self.dt,
@@ -1019,6 +1050,9 @@ impl Batch {
             nbody_first_range: l(Array::NbodyFirstRange),
             nbody_range: l(Array::NbodyRange),
             clock: m(Array::Clock),
+            implicit: m(Array::Implicit),
+            solver_tolerance: self.solver.tolerance,
+            solver_iterations: c_longlong::from(self.solver.max_iterations),
         }
     }
 }
@@ -1042,8 +1076,8 @@ fn supported(w: &World) -> Result<(), String> {
         IntegratorKind::Euler
         | IntegratorKind::Midpoint
         | IntegratorKind::Rk4
-        | IntegratorKind::Symplectic => {}
-        other => return refuse(&format!("the {other:?} integrator")),
+        | IntegratorKind::Symplectic
+        | IntegratorKind::Implicit => {}
     }
     let mut planes = 0;
     let mut floors = 0;
@@ -1282,11 +1316,12 @@ pub(crate) enum Array {
     NbodyFirstRange,
     NbodyRange,
     Clock,
+    Implicit,
 }
 
 impl Array {
     /// Every array, each at its own index (`a as usize`).
-    pub(crate) const ALL: [Array; 123] = [
+    pub(crate) const ALL: [Array; 124] = [
         Array::FirstParticle,
         Array::FirstSpring,
         Array::InvMass,
@@ -1410,6 +1445,7 @@ impl Array {
         Array::NbodyFirstRange,
         Array::NbodyRange,
         Array::Clock,
+        Array::Implicit,
     ];
 }
 

@@ -146,7 +146,7 @@ fn perturbed(text: &str, n: usize, seed: u64) -> Vec<Scene> {
 
 #[test]
 fn the_walker_s_evaluation_is_the_engine_s_to_the_bit_under_every_integrator() {
-    for (k, integrator) in ["symplectic", "rk4", "midpoint", "euler"]
+    for (k, integrator) in ["symplectic", "rk4", "midpoint", "euler", "implicit"]
         .iter()
         .enumerate()
     {

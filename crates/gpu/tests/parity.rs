@@ -833,6 +833,97 @@ fn bodies_in_a_reef_s_waves_each_at_its_own_time_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Implicit Euler (integrators/implicit.rs: one Newton step, the springs',
+/// angle joints' and drag's Jacobian, conjugate gradients): random bodies
+/// of 2 to 40 particles, half with angle and torque joints, under gravity
+/// dropped onto the floor with its contact force and a push (its located
+/// collisions take part steps), in still water, in a uniform current
+/// and under a reef's waves, every third with a particle held fixed; the
+/// solver as the engine's default, at a loose tolerance, and held to 3
+/// iterations (the step then keeps its last iterate).
+#[test]
+fn bodies_under_implicit_euler_are_the_engine_s_to_the_bit() {
+    use animats_engine::{Current, ReefWater, Solver};
+    let reef = Current::Reef(ReefWater {
+        surface: 1.0,
+        amplitude: 0.3,
+        wavelength: 2.0,
+        period: 1.7,
+        direction: DVec3::new(1.0, 0.0, 0.4),
+        drift: DVec3::new(0.05, 0.0, -0.02),
+    });
+    let mut rng = Random::for_entry(37, 0);
+    let solvers = [
+        Solver::default(),
+        Solver {
+            tolerance: 1e-3,
+            max_iterations: 2000,
+        },
+        Solver {
+            tolerance: 1e-9,
+            max_iterations: 3,
+        },
+    ];
+    for (case, water) in ["floor", "still", "current", "reef"].iter().enumerate() {
+        for solver in solvers {
+            let mut worlds: Vec<World> = (0..12)
+                .map(|k| {
+                    let n = 2 + (rng.uniform() * 39.0) as usize;
+                    let kind = IntegratorKind::Implicit;
+                    let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind).unwrap();
+                    w.set_solver(solver).unwrap();
+                    if k % 3 == 0 {
+                        let anchor = ParticleDef::new(1.0)
+                            .with_radius(0.05)
+                            .at(DVec3::new(0.0, 1.5, 0.0))
+                            .fixed();
+                        let a = w.add_particle(anchor).unwrap();
+                        let other = w.particle_ids().next().unwrap();
+                        w.add_spring(SpringDef::new(a, other, 300.0, 1.0)).unwrap();
+                    }
+                    if case == 0 {
+                        for p in w.particle_ids().collect::<Vec<_>>() {
+                            let x = w.position(p) + DVec3::new(0.0, 1.2, 0.0);
+                            w.set_position(p, x).unwrap();
+                        }
+                        w.add_floor(FloorDef::default()).unwrap();
+                        let ids: Vec<_> = w.particle_ids().collect();
+                        w.add_constant_force(ids, random_vec(&mut rng, 3.0))
+                            .unwrap();
+                    } else {
+                        let current = match case {
+                            1 => Current::Still,
+                            2 => Current::Uniform(random_vec(&mut rng, 0.8)),
+                            _ => reef.clone(),
+                        };
+                        w.add_fluid(FluidMedium {
+                            current,
+                            ..FluidMedium::water()
+                        })
+                        .unwrap();
+                    }
+                    w
+                })
+                .collect();
+            let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
+            assert_same(
+                &mut worlds,
+                2e-3,
+                250,
+                3,
+                &format!("implicit Euler, {water}, {solver:?} {sizes:?}"),
+            );
+            if case == 0 {
+                let down = worlds
+                    .iter()
+                    .filter(|w| w.state().pos.iter().any(|x| x.y < 0.21))
+                    .count();
+                assert!(down > 6, "only {down} bodies reached the floor");
+            }
+        }
+    }
+}
+
 #[test]
 fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
     let plain = || {
@@ -1027,11 +1118,21 @@ fn what_the_c_does_not_step_is_refused_naming_the_world_and_the_entry() {
         "world 0: sphere contact on terrain is not in the GPU step yet"
     );
 
-    let mut implicit = plain();
-    implicit.set_integrator(IntegratorKind::Implicit);
-    let err = Batch::pack(&[&implicit], 1e-3).unwrap_err();
+    // Implicit Euler's worlds share one solver.
+    let implicit = |iterations: u32| {
+        let mut w = plain();
+        w.set_integrator(IntegratorKind::Implicit);
+        w.set_solver(animats_engine::Solver {
+            tolerance: 1e-9,
+            max_iterations: iterations,
+        })
+        .unwrap();
+        w
+    };
+    Batch::pack(&[&implicit(50), &implicit(50)], 1e-3).unwrap();
+    let err = Batch::pack(&[&implicit(50), &implicit(60)], 1e-3).unwrap_err();
     assert!(
-        err.contains("Implicit integrator is not in the GPU step yet"),
+        err.starts_with("world 1: a batch shares one implicit solver"),
         "{err}"
     );
 
