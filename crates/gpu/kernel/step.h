@@ -17,8 +17,9 @@
  * constant forces, fluids (still, in a uniform current or under a reef's waves) on every particle and their drag across springs ([fluid]
  * springs), soft (penalty) contact between spheres, sphere contact, the
  * event (spheres.h), the
- * floor, flat or on terrain (terrain.h: its located collisions with backtracking, and its contact force), and the explicit integrators
- * (Euler, midpoint, RK4, symplectic Euler). Everything else is refused when a world is packed
+ * floor, flat or on terrain (terrain.h: its located collisions with backtracking, and its contact force), n-body gravity, the explicit integrators
+ * (Euler, midpoint, RK4, symplectic Euler) and implicit Euler (on a GPU
+ * only in kernels compiled with AN_WITH_IMPLICIT). Everything else is refused when a world is packed
  * (crates/gpu/src/pack.rs), naming what is missing.
  */
 #ifndef ANIMATS_STEP_H
