@@ -237,22 +237,35 @@ AN_FN void an_cross(const double *a, const double *b, double *out) {
 }
 
 /* Angle joints j0 .. j0 + nj - 1 (forces/angle_joint.rs, `apply`). */
+/* Angle joint q's arms ra, rb at positions x, their squared lengths, the
+ * normal ra x rb and its length nl (AngleJoint::bend): 0 when the arms
+ * are collinear or one has no length (no plane of bending). */
+AN_FN int an_bend(const an_batch *b, long long q, const double *x, double *ra, double *rb,
+                  double *la2, double *lb2, double *normal, double *nl) {
+    long long a = b->joint_a[q], j = b->joint_j[q], e = b->joint_b[q];
+    for (int k = 0; k < 3; k++) {
+        ra[k] = x[3 * a + k] - x[3 * j + k];
+        rb[k] = x[3 * e + k] - x[3 * j + k];
+    }
+    *la2 = an_dot(ra, ra);
+    *lb2 = an_dot(rb, rb);
+    an_cross(ra, rb, normal);
+    double n2 = an_dot(normal, normal);
+    if (n2 <= 1e-24 * *la2 * *lb2 || *la2 == 0.0 || *lb2 == 0.0) {
+        return 0;
+    }
+    *nl = sqrt(n2);
+    return 1;
+}
+
 AN_FN void an_angle_joints(const an_batch *b, long long j0, long long nj, const double *x,
                            const double *v, double *f) {
     for (long long q = j0; q < j0 + nj; q++) {
         long long a = b->joint_a[q], j = b->joint_j[q], e = b->joint_b[q];
-        double ra[3], rb[3], normal[3], pa[3], pb[3], va[3], vb[3];
-        for (int k = 0; k < 3; k++) {
-            ra[k] = x[3 * a + k] - x[3 * j + k];
-            rb[k] = x[3 * e + k] - x[3 * j + k];
-        }
-        double la2 = an_dot(ra, ra), lb2 = an_dot(rb, rb);
-        an_cross(ra, rb, normal);
-        double n2 = an_dot(normal, normal);
-        if (n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0) {
+        double ra[3], rb[3], normal[3], pa[3], pb[3], va[3], vb[3], la2, lb2, nl;
+        if (!an_bend(b, q, x, ra, rb, &la2, &lb2, normal, &nl)) {
             continue; /* collinear or degenerate: no plane of bending */
         }
-        double nl = sqrt(n2);
         double theta = an_atan2(nl, an_dot(ra, rb));
         an_cross(normal, ra, pa);
         an_cross(normal, rb, pb);
@@ -804,19 +817,10 @@ AN_FN int an_jac_spring(const an_batch *b, an_state st, long long s0, long long 
  * `jacobian`): 0 where it has no plane of bending; else g[0..9]: the
  * gradients at its first end, its joint and its second end. */
 AN_FN int an_jac_joint(const an_batch *b, long long q, const double *x, double *g) {
-    long long a = b->joint_a[q], j = b->joint_j[q], e = b->joint_b[q];
-    double ra[3], rb[3], normal[3], pa[3], pb[3];
-    for (int k = 0; k < 3; k++) {
-        ra[k] = x[3 * a + k] - x[3 * j + k];
-        rb[k] = x[3 * e + k] - x[3 * j + k];
-    }
-    double la2 = an_dot(ra, ra), lb2 = an_dot(rb, rb);
-    an_cross(ra, rb, normal);
-    double n2 = an_dot(normal, normal);
-    if (n2 <= 1e-24 * la2 * lb2 || la2 == 0.0 || lb2 == 0.0) {
+    double ra[3], rb[3], normal[3], pa[3], pb[3], la2, lb2, nl;
+    if (!an_bend(b, q, x, ra, rb, &la2, &lb2, normal, &nl)) {
         return 0;
     }
-    double nl = sqrt(n2);
     an_cross(normal, ra, pa);
     an_cross(normal, rb, pb);
     double wa = -1.0 / (nl * la2), wb = 1.0 / (nl * lb2);

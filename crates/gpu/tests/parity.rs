@@ -769,15 +769,8 @@ fn large_n_body_sets_summed_in_ranges_are_the_engine_s_to_the_bit() {
 /// currents it asks at each stage's time and each piece's are the engine's.
 #[test]
 fn bodies_in_a_reef_s_waves_each_at_its_own_time_are_the_engine_s_to_the_bit() {
-    use animats_engine::{Current, ReefWater, RodDrag};
-    let reef = Current::Reef(ReefWater {
-        surface: 1.0,
-        amplitude: 0.3,
-        wavelength: 2.0,
-        period: 1.7,
-        direction: DVec3::new(1.0, 0.0, 0.4),
-        drift: DVec3::new(0.05, 0.0, -0.02),
-    });
+    use animats_engine::RodDrag;
+    let reef = reef();
     let mut rng = Random::for_entry(31, 0);
     for kind in INTEGRATORS {
         let make = |rng: &mut Random, at: &dyn Fn(usize) -> f64| -> Vec<World> {
@@ -833,6 +826,19 @@ fn bodies_in_a_reef_s_waves_each_at_its_own_time_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// A shallow reef's waves (1 m deep, 0.3 m high, 2 m long, 1.7 s) with a
+/// drift.
+fn reef() -> animats_engine::Current {
+    animats_engine::Current::Reef(animats_engine::ReefWater {
+        surface: 1.0,
+        amplitude: 0.3,
+        wavelength: 2.0,
+        period: 1.7,
+        direction: DVec3::new(1.0, 0.0, 0.4),
+        drift: DVec3::new(0.05, 0.0, -0.02),
+    })
+}
+
 /// Implicit Euler (integrators/implicit.rs: one Newton step, the springs',
 /// angle joints' and drag's Jacobian, conjugate gradients): random bodies
 /// of 2 to 40 particles, half with angle and torque joints, under gravity
@@ -843,15 +849,8 @@ fn bodies_in_a_reef_s_waves_each_at_its_own_time_are_the_engine_s_to_the_bit() {
 /// iterations (the step then keeps its last iterate).
 #[test]
 fn bodies_under_implicit_euler_are_the_engine_s_to_the_bit() {
-    use animats_engine::{Current, ReefWater, Solver};
-    let reef = Current::Reef(ReefWater {
-        surface: 1.0,
-        amplitude: 0.3,
-        wavelength: 2.0,
-        period: 1.7,
-        direction: DVec3::new(1.0, 0.0, 0.4),
-        drift: DVec3::new(0.05, 0.0, -0.02),
-    });
+    use animats_engine::{Current, Solver};
+    let reef = reef();
     let mut rng = Random::for_entry(37, 0);
     let solvers = [
         Solver::default(),
