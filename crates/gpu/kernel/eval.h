@@ -41,6 +41,18 @@ AN_FN double an_unit(double x) {
     return 0.0;
 }
 
+/* Pushes first .. first + count - 1 of creature c's constant forces set
+ * to axis times value (ForceScale::set, ForceMagnitude::set). */
+AN_FN void an_set_pushes(const an_batch *b, long long c, long long first, long long count,
+                         const double *axis, double value) {
+    long long k0 = b->first_push[c] + first;
+    for (long long k = k0; k < k0 + count; k++) {
+        for (int d = 0; d < 3; d++) {
+            b->push_force[3 * k + d] = axis[d] * value;
+        }
+    }
+}
+
 /* Actuated::set of muscle q (over the batch) of creature c: its target
  * given `value` (actuators/: a spring's rest length, an angle joint's rest
  * angle, a torque joint's torque, a constant force's vector scaled). */
@@ -56,15 +68,10 @@ AN_FN void an_set_target(const an_batch *b, long long c, long long q, double val
     case 2:
         b->motor_torque[b->first_motor[c] + i] = value;
         break;
-    default: {
-        long long k0 = b->first_push[c] + b->muscle_push[2 * q];
-        for (long long k = k0; k < k0 + b->muscle_push[2 * q + 1]; k++) {
-            for (int d = 0; d < 3; d++) {
-                b->push_force[3 * k + d] = b->muscle_base[3 * q + d] * value;
-            }
-        }
+    default:
+        an_set_pushes(b, c, b->muscle_push[2 * q], b->muscle_push[2 * q + 1], b->muscle_base + 3 * q,
+                      value);
         break;
-    }
     }
 }
 
@@ -483,13 +490,7 @@ AN_FN void an_hop(const an_batch *b, an_state st, long long c, long long m, doub
  * every push of its constant force is axis times the value). */
 AN_FN void an_jelly_force(const an_batch *b, long long c, const double *a, const double *axis, double l) {
     double level = an_unit(l);
-    double value = a[0] + level * (a[1] - a[0]);
-    long long k0 = b->first_push[c] + (long long)a[3];
-    for (long long k = k0; k < k0 + (long long)a[4]; k++) {
-        for (int d = 0; d < 3; d++) {
-            b->push_force[3 * k + d] = axis[d] * value;
-        }
-    }
+    an_set_pushes(b, c, (long long)a[3], (long long)a[4], axis, a[0] + level * (a[1] - a[0]));
 }
 
 /* JellyfishFsm::advance_phase: the phase moved on by dt; 1 when the pulse

@@ -198,7 +198,9 @@ typedef struct {
     const long long *nbody_range; /* a range's first row (NBodyGravity::row_ranges) */
     double *clock;                /* 2 per creature of a batch of worlds: its time and the
                                      clock's carry (world/step.rs, `advance_clock`) */
-    double *implicit;             /* AN_IMPLICIT_ROOM per particle: implicit Euler's room */
+    double *implicit;             /* implicit Euler's room: AN_IMPLICIT_ROOM per particle,
+                                     AN_IMPLICIT_SPRING per spring, AN_IMPLICIT_JOINT per
+                                     angle joint, a creature's after the ones before it */
     double solver_tolerance;      /* implicit Euler's conjugate gradients: relative tolerance */
     long long solver_iterations;  /* and most iterations */
 } an_batch;
@@ -746,12 +748,17 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     }
 }
 
-/* Implicit Euler's room per particle (integrators/implicit.rs): the
- * right-hand side's h^2 (df/dx) v0 (3), the particle's own block of S
- * (9), then b, x, r, z, p, q of the conjugate gradients (3 each) and the
- * preconditioner's inverse block (9). A 3x3 block is stored by columns,
- * as glam's DMat3. */
+/* Implicit Euler's room (integrators/implicit.rs, jacobian.rs): per
+ * particle, the right-hand side's h^2 (df/dx) v0 (3), the particle's own
+ * block of S (9), then b, x, r, z, p, q of the conjugate gradients (3
+ * each) and the preconditioner's inverse block (9); per spring, its
+ * central interaction as Jacobian::central stores it (1 if it has one,
+ * its unit vector, alpha, beta); per angle joint, its six off-diagonal
+ * blocks of S as Jacobian::block stores them (1 if it has them, then the
+ * blocks). A 3x3 block is stored by columns, as glam's DMat3. */
 #define AN_IMPLICIT_ROOM 39
+#define AN_IMPLICIT_SPRING 6
+#define AN_IMPLICIT_JOINT 55
 
 /* glam's DMat3::mul_vec3: (x_axis v.x + y_axis v.y) + z_axis v.z. */
 AN_FN void an_m3_mul(const double *m, const double *v, double *out) {
@@ -864,11 +871,11 @@ AN_FN double an_cg_dot(const double *a, const double *b, long long n) {
 
 /* (M + S) p into out (Jacobian::apply): each particle's own block, then
  * each spring's central interaction in order, then each angle joint's
- * off-diagonal blocks in order, all formed again from the step's start
- * x0 (the same numbers the engine stores). */
-AN_FN void an_cg_apply(const an_batch *b, an_state st, long long c, long long n, long long s0,
-                       long long ns, double h, const double *x0, const double *diag,
-                       const double *p, double *out) {
+ * off-diagonal blocks in order, as the step stored them (sr: the
+ * springs' room, jr: the joints'). */
+AN_FN void an_cg_apply(const an_batch *b, an_state st, long long c, long long n, long long ns,
+                       const double *sr, const double *jr, const double *diag, const double *p,
+                       double *out) {
     for (long long i = 0; i < n; i++) {
         double mv[3];
         an_m3_mul(diag + 9 * i, p + 3 * i, mv);
@@ -876,37 +883,38 @@ AN_FN void an_cg_apply(const an_batch *b, an_state st, long long c, long long n,
             out[3 * i + k] = p[3 * i + k] * st.m[i] + mv[k];
         }
     }
-    for (long long s = s0; s < s0 + ns; s++) {
-        double nv[3], alpha, beta, along, across;
-        if (!an_jac_spring(b, st, s0, s, x0, h, nv, &alpha, &beta, &along, &across)) {
+    for (long long s = 0; s < ns; s++) {
+        const double *e = sr + AN_IMPLICIT_SPRING * s, *nv = e + 1;
+        if (e[0] == 0.0) {
             continue;
         }
-        long long a = st.sa[s - s0], e = st.sb[s - s0];
-        double nb = alpha * an_dot(nv, p + 3 * e), na = alpha * an_dot(nv, p + 3 * a);
+        double alpha = e[4], beta = e[5];
+        long long a = st.sa[s], z = st.sb[s];
+        double nb = alpha * an_dot(nv, p + 3 * z), na = alpha * an_dot(nv, p + 3 * a);
         for (int k = 0; k < 3; k++) {
-            out[3 * a + k] -= nv[k] * nb + p[3 * e + k] * beta;
+            out[3 * a + k] -= nv[k] * nb + p[3 * z + k] * beta;
         }
         for (int k = 0; k < 3; k++) {
-            out[3 * e + k] -= nv[k] * na + p[3 * a + k] * beta;
+            out[3 * z + k] -= nv[k] * na + p[3 * a + k] * beta;
         }
     }
-    for (long long q = b->first_joint[c]; q < b->first_joint[c + 1]; q++) {
-        double g[9];
-        if (!an_jac_joint(b, q, x0, g)) {
+    long long j0 = b->first_joint[c];
+    for (long long q = j0; q < b->first_joint[c + 1]; q++) {
+        const double *e = jr + AN_IMPLICIT_JOINT * (q - j0);
+        if (e[0] == 0.0) {
             continue;
         }
         long long ids[3] = {b->joint_a[q], b->joint_j[q], b->joint_b[q]};
+        int k = 0;
         for (int u = 0; u < 3; u++) {
             for (int w = 0; w < 3; w++) {
-                if (ids[u] == ids[w]) {
+                if (u == w) {
                     continue;
                 }
-                double dfdx[9], dfdv[9], sb[9], mv[3];
-                an_jac_joint_block(b, q, g, u, w, dfdx, dfdv);
-                an_jac_s(dfdx, dfdv, h, sb);
-                an_m3_mul(sb, p + 3 * ids[w], mv);
-                for (int k = 0; k < 3; k++) {
-                    out[3 * ids[u] + k] += mv[k];
+                double mv[3];
+                an_m3_mul(e + 1 + 9 * k++, p + 3 * ids[w], mv);
+                for (int d = 0; d < 3; d++) {
+                    out[3 * ids[u] + d] += mv[d];
                 }
             }
         }
@@ -923,12 +931,16 @@ AN_FN void an_cg_apply(const an_batch *b, an_state st, long long c, long long n,
 AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long p0, long long n,
                          long long s0, long long ns, double h, double t, const double *x0,
                          const double *v0, double *x1, double *v1, double *f) {
-    double *room = b->implicit + AN_IMPLICIT_ROOM * p0;
+    long long j0 = b->first_joint[c], nj = b->first_joint[c + 1] - j0;
+    double *room = b->implicit + AN_IMPLICIT_ROOM * p0 + AN_IMPLICIT_SPRING * s0 +
+                   AN_IMPLICIT_JOINT * j0;
     double *rhs = room, *diag = room + 3 * n, *bv = room + 12 * n, *xs = room + 15 * n;
     double *r = room + 18 * n, *z = room + 21 * n, *p = room + 24 * n, *q = room + 27 * n;
-    double *pre = room + 30 * n;
+    double *pre = room + 30 * n, *sr = room + AN_IMPLICIT_ROOM * n;
+    double *jr = sr + AN_IMPLICIT_SPRING * ns;
     an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
-    for (long long k = 0; k < AN_IMPLICIT_ROOM * n; k++) {
+    for (long long k = 0; k < AN_IMPLICIT_ROOM * n + AN_IMPLICIT_SPRING * ns + AN_IMPLICIT_JOINT * nj;
+         k++) {
         room[k] = 0.0;
     }
     /* Springs: Jacobian::central. */
@@ -938,7 +950,13 @@ AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long 
             continue;
         }
         long long a = st.sa[s - s0], e = st.sb[s - s0];
-        double u[3], kv[3], sm[9];
+        double u[3], kv[3], sm[9], *stored = sr + AN_IMPLICIT_SPRING * (s - s0);
+        stored[0] = 1.0;
+        for (int k = 0; k < 3; k++) {
+            stored[1 + k] = nv[k];
+        }
+        stored[4] = alpha;
+        stored[5] = beta;
         for (int k = 0; k < 3; k++) {
             u[k] = v0[3 * a + k] - v0[3 * e + k];
         }
@@ -959,17 +977,25 @@ AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long 
         }
     }
     /* Angle joints: Jacobian::block over their three particles. */
-    for (long long qj = b->first_joint[c]; qj < b->first_joint[c + 1]; qj++) {
-        double g[9];
+    for (long long qj = j0; qj < j0 + nj; qj++) {
+        double g[9], *stored = jr + AN_IMPLICIT_JOINT * (qj - j0);
         if (!an_jac_joint(b, qj, x0, g)) {
             continue;
         }
+        stored[0] = 1.0;
         long long ids[3] = {b->joint_a[qj], b->joint_j[qj], b->joint_b[qj]};
+        int k = 0;
         for (int u = 0; u < 3; u++) {
             for (int w = 0; w < 3; w++) {
                 double dfdx[9], dfdv[9], sb[9];
                 an_jac_joint_block(b, qj, g, u, w, dfdx, dfdv);
                 an_jac_block(rhs, diag, v0, ids[u], ids[w], dfdx, dfdv, h, sb);
+                if (u != w) {
+                    for (int d = 0; d < 9; d++) {
+                        stored[1 + 9 * k + d] = sb[d];
+                    }
+                    k++;
+                }
             }
         }
     }
@@ -1040,7 +1066,7 @@ AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long 
     double stop = rz * b->solver_tolerance * b->solver_tolerance;
     if (rz == rz && rz > 0.0) {
         for (long long it = 1; it <= b->solver_iterations; it++) {
-            an_cg_apply(b, st, c, n, s0, ns, h, x0, diag, p, q);
+            an_cg_apply(b, st, c, n, ns, sr, jr, diag, p, q);
             for (long long i = 0; i < n; i++) {
                 if (b->fixed[p0 + i]) {
                     q[3 * i] = 0.0;

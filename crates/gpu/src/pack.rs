@@ -210,9 +210,10 @@ impl Shared {
     }
 }
 
-/// Doubles per particle of implicit Euler's room (`AN_IMPLICIT_ROOM` in
-/// `kernel/step.h`).
-const IMPLICIT: usize = 39;
+/// Doubles of implicit Euler's room per particle, per spring and per
+/// angle joint (`AN_IMPLICIT_ROOM`, `AN_IMPLICIT_SPRING` and
+/// `AN_IMPLICIT_JOINT` in `kernel/step.h`).
+const IMPLICIT: [usize; 3] = [39, 6, 55];
 
 /// Doubles of scratch per particle the C step uses.
 const SCRATCH: usize = 15;
@@ -318,8 +319,8 @@ pub struct Batch {
     /// that ask the time (a reef's currents). A scene's evaluation keeps its
     /// own clock (`Rules`).
     clock: Vec<f64>,
-    /// Implicit Euler's room (`IMPLICIT` doubles a particle; empty under
-    /// the other integrators) and its solver, which the batch's worlds share.
+    /// Implicit Euler's room (`IMPLICIT` doubles a particle, a spring and
+    /// an angle joint; empty under the other integrators) and its solver, which the batch's worlds share.
     implicit: Vec<f64>,
     solver: Solver,
     /// A scene's evaluation: its muscles, oscillators and rules.
@@ -615,7 +616,13 @@ impl Batch {
         }
         b.scratch = vec![0.0; SCRATCH * b.mass.len()];
         if integrator == IntegratorKind::Implicit {
-            b.implicit = vec![0.0; IMPLICIT * b.mass.len()];
+            let [per_particle, per_spring, per_joint] = IMPLICIT;
+            b.implicit = vec![
+                0.0;
+                per_particle * b.mass.len()
+                    + per_spring * b.rest_length.len()
+                    + per_joint * b.joint_a.len()
+            ];
         }
         b.ev.no_rules(worlds.len());
         Ok(b)
