@@ -1113,8 +1113,18 @@ fn jellyfish_and_evolved_swimmers_share_a_batch_bit_for_bit() {
         let own = jelly.replace("position = [0.0, 0.0, 0.0]", &at);
         scenes.push(animats_scene::parse(&own, "jellyfish_swim.toml").unwrap());
     }
+    // And the task's shipped winner (its muscles at 16 a second), 2 s.
+    let best = include_str!("../../../scenes/bodies_swim_evolved.toml")
+        .replace("duration = 20.0", "duration = 2.0");
+    assert!(best.contains("rate = 16.0"));
+    scenes.push(animats_scene::parse(&best, "bodies_swim_evolved.toml").unwrap());
     let got = assert_same(scenes, "jellyfish among swimmers");
-    assert!(distinct_distances(&got) == 12, "{got:?}");
+    assert!(distinct_distances(&got) == 13, "{got:?}");
+    assert!(
+        got[12].distance > 0.5,
+        "the shipped swimmer swims: {:?}",
+        got[12]
+    );
 }
 
 #[test]
