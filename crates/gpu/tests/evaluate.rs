@@ -949,6 +949,50 @@ fn raibert_s_controller_on_the_roobot_is_the_engine_s_to_the_bit() {
     assert_same(later, "raibert, packed mid-run");
 }
 
+#[test]
+fn a_stance_past_raibert_s_one_second_cap_places_the_next_foot_as_the_engine_does() {
+    // Thrusts too weak to leave the floor soon, without the touch rule (a
+    // roobot that sits down goes on): stances of more than a second, after
+    // which the foot is placed by the stance's duration capped at 1 s
+    // (`Raibert::think`; `an_raibert`'s `an_minnum`). Found by evaluating
+    // 3,000 such gains with the engine with and without its cap: these
+    // are three of the six whose results the cap changes, so a C without
+    // it fails here (tried).
+    let raibert = HOP_EVOLVER
+        .replace("params = \"initial\"", "brain = \"raibert\"")
+        .replace("fail_on_touch", "# fail_on_touch");
+    let raibert_of = |scene: &Scene| -> Raibert {
+        let any = scene.nervous.controllers[0].brain.as_any().unwrap();
+        any.downcast_ref::<Raibert>().unwrap().clone()
+    };
+    let mut scenes = Vec::new();
+    for gains in [
+        "[0.014310244352763695, 0.6790795984793772, 0.18211216627695972, 0.5550689905788553, \
+          2.265723923628169, 0.9587019802537916, 0.2121769246586811, -0.16935600322031671]",
+        "[0.0019877028443946853, 0.5923173752934672, 0.1882617074511114, 1.6000871618949435, \
+          4.94098622720635, 0.4695380416367637, 0.2350793493422767, -0.12763372215082042]",
+        "[0.007752679379883789, 0.4110332707506258, 0.08760551188406068, 1.1650059159646098, \
+          2.0365751927044524, 0.5539347498104413, -0.031084884770154364, -0.052513724845306975]",
+    ] {
+        let text = raibert.replace(
+            "brain = \"raibert\"",
+            &format!("brain = \"raibert\"\ngains = {gains}"),
+        );
+        let problem = SceneProblem::parse(&text, "raibert.toml").unwrap();
+        // The engine's controller reaches the cap within the evaluation.
+        let mut scene = problem.fresh().unwrap();
+        let capped = (0..2500).any(|_| {
+            scene.step(0.008).unwrap();
+            raibert_of(&scene).last_stance == 1.0
+        });
+        assert!(capped, "{gains}: no stance of a second or more");
+        scenes.push(problem.fresh().unwrap());
+    }
+    let got = assert_same(scenes, "raibert, stances past the cap");
+    assert!(got.iter().all(|e| e.ended == Ended::Timeout), "{got:?}");
+    assert_eq!(distinct_distances(&got), 3);
+}
+
 /// A tank of SeaWorld's water (still, a floor, gravity) holding food and
 /// two of the thesis's jellyfish, each placed, weighed and given a
 /// ceiling from `rng`; `[evolve]` scores the first one's dome rising.
