@@ -349,6 +349,104 @@ fn bodies_falling_onto_terrain_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Particles that start in the ground or exactly on it, where the
+/// terrain's nearest point (`Terrain::probe`, `an_probe`) takes the paths
+/// a body dropped from above never takes: inside a flight of steps (up
+/// and down) or under a heightfield, the normal turned to face out from
+/// below; exactly on a riser's face (no distance: the riser's own
+/// normal); exactly on a heightfield's vertex (the face's normal). Random
+/// bodies centred on the surface (about half their particles in the
+/// ground), and bodies of two particles put on a riser's face and on a
+/// vertex, with and without the contact force, under symplectic Euler
+/// and RK4.
+#[test]
+fn particles_starting_in_or_on_the_terrain_are_the_engine_s_to_the_bit() {
+    use animats_engine::{Heightfield, Steps, Terrain};
+    let mut rng = Random::for_entry(23, 0);
+    let steps = |height: f64| {
+        Terrain::Steps(Steps {
+            direction: DVec3::X,
+            start: -0.25,
+            height,
+            depth: 0.125,
+            count: 8,
+        })
+    };
+    let field = Terrain::Heightfield(Heightfield::new(
+        animats_engine::DVec2::new(-1.5, -1.5),
+        0.125,
+        25,
+        25,
+        (0..25 * 25).map(|_| rng.between(-0.15, 0.15)).collect(),
+    ));
+    for (t, (ground, terrain)) in [
+        ("steps up", steps(0.08)),
+        ("steps down", steps(-0.08)),
+        ("heightfield", field),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for (b, kind) in [IntegratorKind::Symplectic, IntegratorKind::Rk4]
+            .into_iter()
+            .enumerate()
+        {
+            let contact = (b + t) % 2 == 0;
+            let floor = FloorDef {
+                contact,
+                terrain: terrain.clone(),
+                ..FloorDef::default()
+            };
+            let mut worlds: Vec<World> = (0..6)
+                .map(|k| {
+                    let n = 2 + (rng.uniform() * 20.0) as usize;
+                    let mut w = random_body(&mut rng, n, true, k % 2 == 0, kind).unwrap();
+                    let ids: Vec<_> = w.particle_ids().collect();
+                    let centre = ids.iter().map(|&p| w.position(p)).sum::<DVec3>() / n as f64;
+                    let at = DVec3::new(rng.between(-0.2, 0.6), 0.0, rng.between(-0.5, 0.5));
+                    let lift = terrain.height(at.x, at.z) - centre.y;
+                    for &p in &ids {
+                        let x = w.position(p) - DVec3::new(centre.x, 0.0, centre.z) + at;
+                        w.set_position(p, x + DVec3::new(0.0, lift, 0.0)).unwrap();
+                    }
+                    w.add_floor(floor.clone()).unwrap();
+                    w
+                })
+                .collect();
+            // Two particles joined by a spring, the first exactly on the
+            // third riser's face (halfway up it) or on a vertex.
+            let mut pair = World::new();
+            pair.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+            pair.set_integrator(kind);
+            let on = match &terrain {
+                Terrain::Steps(s) => DVec3::new(s.start + 2.0 * s.depth, 2.5 * s.height, 0.0),
+                _ => DVec3::new(-0.25, terrain.height(-0.25, 0.5), 0.5),
+            };
+            let p0 = pair
+                .add_particle(ParticleDef::new(0.2).at(on).with_radius(0.02))
+                .unwrap();
+            let p1 = pair
+                .add_particle(ParticleDef::new(0.3).at(on + DVec3::new(0.05, 0.3, 0.02)))
+                .unwrap();
+            pair.add_spring(SpringDef::new(p0, p1, 400.0, 2.0)).unwrap();
+            pair.add_floor(floor.clone()).unwrap();
+            let (off, _) = terrain.probe(on, 1.0).unwrap();
+            assert!(off.abs() < 1e-12, "{ground}: the particle is {off} m off");
+            worlds.push(pair);
+            let inside = worlds
+                .iter()
+                .filter(|w| w.particle_ids().any(|p| w.clearance(p) < -0.01))
+                .count();
+            assert!(
+                inside >= 4,
+                "{ground}: only {inside} of 7 start in the ground"
+            );
+            let what = format!("particles in and on {ground}, {kind:?}, contact {contact}");
+            assert_same(&mut worlds, 1e-3, 200, 2, &what);
+        }
+    }
+}
+
 /// Bodies held in planes (events/plane_constraint.rs, the roobot's planar
 /// motion) falling onto the floor: half in a vertical plane at a random
 /// heading (the roobot's), half in a plane slanted at random, which the
