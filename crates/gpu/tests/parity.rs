@@ -447,6 +447,133 @@ fn particles_starting_in_or_on_the_terrain_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// A fixed particle (no inverse mass) in the ground, a body tethered to
+/// it by springs falling around it: the floor's check, handling and
+/// contact force leave the fixed one alone, on the flat floor and on
+/// terrain (`an_floor_check`, `an_terrain_check`, `an_terrain_handle`,
+/// `an_terrain_contact`, each `w == 0`), with and without the contact
+/// force, and with gravity off (the bodies thrown at the ground), which
+/// the terrain's handling reads.
+#[test]
+fn fixed_particles_in_the_ground_are_left_there_as_the_engine_leaves_them() {
+    use animats_engine::{Heightfield, Steps, Terrain};
+    let mut rng = Random::for_entry(29, 0);
+    let grounds = [
+        ("flat floor", Terrain::Flat),
+        (
+            "steps",
+            Terrain::Steps(Steps {
+                direction: DVec3::new(0.6, 0.0, 0.8),
+                start: -0.3,
+                height: 0.07,
+                depth: 0.2,
+                count: 6,
+            }),
+        ),
+        (
+            "heightfield",
+            Terrain::Heightfield(Heightfield::new(
+                animats_engine::DVec2::new(-2.0, -2.0),
+                0.2,
+                21,
+                21,
+                (0..21 * 21).map(|_| rng.between(-0.1, 0.1)).collect(),
+            )),
+        ),
+    ];
+    for (t, (ground, terrain)) in grounds.into_iter().enumerate() {
+        for (b, kind) in [IntegratorKind::Symplectic, IntegratorKind::Rk4]
+            .into_iter()
+            .enumerate()
+        {
+            for gravity in [true, false] {
+                let contact = (b + t + usize::from(gravity)) % 2 == 0;
+                let floor = FloorDef {
+                    contact,
+                    terrain: terrain.clone(),
+                    ..FloorDef::default()
+                };
+                let mut worlds: Vec<World> = (0..6)
+                    .map(|k| {
+                        let mut w = World::new();
+                        if gravity {
+                            w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+                        }
+                        w.set_integrator(kind);
+                        let (x, z) = (rng.between(-0.5, 0.8), rng.between(-0.5, 0.5));
+                        let r0 = rng.between(0.03, 0.1);
+                        let at = DVec3::new(x, terrain.height(x, z) - 0.5 * r0, z);
+                        let anchor = w
+                            .add_particle(ParticleDef::new(1.0).with_radius(r0).at(at).fixed())
+                            .unwrap();
+                        let n = 2 + (rng.uniform() * 6.0) as usize;
+                        let ids: Vec<_> = (0..n)
+                            .map(|_| {
+                                let up = DVec3::new(0.0, rng.between(0.1, 0.5), 0.0);
+                                let def = ParticleDef::new(rng.between(0.1, 1.0))
+                                    .with_radius(rng.between(0.02, 0.08))
+                                    .at(at + up + random_vec(&mut rng, 0.4))
+                                    .with_velocity(random_vec(&mut rng, 1.0) - DVec3::Y);
+                                w.add_particle(def).unwrap()
+                            })
+                            .collect();
+                        for (k, &p) in ids.iter().enumerate() {
+                            for q in [anchor, ids[(k + 1) % n]] {
+                                let def = SpringDef::new(
+                                    p,
+                                    q,
+                                    rng.between(50.0, 300.0),
+                                    rng.between(0.0, 1.0),
+                                )
+                                .with_rest_length(rng.between(0.2, 0.6));
+                                w.add_spring(def).unwrap();
+                            }
+                        }
+                        if terrain.is_flat() && k % 2 == 1 {
+                            // Held in a vertical plane, checked before the
+                            // floor: the floor handles what its check found.
+                            let a = rng.between(0.0, std::f64::consts::TAU);
+                            let normal = DVec3::new(
+                                animats_engine::math::sin(a),
+                                0.0,
+                                animats_engine::math::cos(a),
+                            );
+                            w.add_event(Box::new(animats_engine::PlaneConstraint::new(
+                                at,
+                                normal,
+                                ids.clone(),
+                            )));
+                        }
+                        w.add_floor(floor.clone()).unwrap();
+                        assert!(w.clearance(anchor) < 0.0, "{ground}: the anchor is not in");
+                        w
+                    })
+                    .collect();
+                let what = format!(
+                    "tethered on the {ground}, {kind:?}, contact {contact}, gravity {gravity}"
+                );
+                assert_same(&mut worlds, 1e-3, 300, 4, &what);
+                // Each body met the ground: a collision located, or resting
+                // on it at the end.
+                let met = worlds
+                    .iter()
+                    .filter(|w| {
+                        w.stats().backtracks > 0
+                            || w.particle_ids().skip(1).any(|p| w.clearance(p) < 0.01)
+                    })
+                    .count();
+                // (Without gravity, thrown, most bounce off the contact
+                // force's cushion or the ground and fly on.)
+                let least = if gravity { 4 } else { 1 };
+                assert!(
+                    met >= least,
+                    "{what}: only {met} of 6 bodies met the ground"
+                );
+            }
+        }
+    }
+}
+
 /// Bodies held in planes (events/plane_constraint.rs, the roobot's planar
 /// motion) falling onto the floor: half in a vertical plane at a random
 /// heading (the roobot's), half in a plane slanted at random, which the
