@@ -812,6 +812,91 @@ fn spheres_colliding_as_events_are_the_engine_s_to_the_bit() {
     }
 }
 
+/// Sphere contact's corner cases, each a world of its own in one batch
+/// with the floor: two fixed spheres sunk into each other and into the
+/// floor, a free one dropped onto them (a fixed pair is never handled;
+/// the floor holds no fixed sphere up); two spheres meeting head on along
+/// a line (no sliding: no friction's impulse); two at one place (no
+/// normal: left alone); two small fast ones flying side by side at one
+/// velocity, 5 mm apart (the swept test with no relative motion); points (no radius)
+/// among spheres; a world of points only (no sphere at all).
+#[test]
+fn sphere_contact_s_corner_cases_are_the_engine_s_to_the_bit() {
+    for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
+        let world = |spheres: &[(f64, f64, DVec3, DVec3, bool)]| {
+            let mut w = World::new();
+            w.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+            w.set_integrator(kind);
+            for &(mass, radius, at, v, fixed) in spheres {
+                let mut def = ParticleDef::new(mass)
+                    .with_radius(radius)
+                    .at(at)
+                    .with_velocity(v);
+                def.fixed = fixed;
+                def.restitution = 0.6;
+                def.mu_s = 0.5;
+                def.mu_k = 0.3;
+                w.add_particle(def).unwrap();
+            }
+            w.add_floor(FloorDef::default()).unwrap();
+            w.add_sphere_contact(animats_engine::SphereContactDef::default())
+                .unwrap();
+            w
+        };
+        let z = DVec3::ZERO;
+        let xyz = DVec3::new;
+        let mut worlds = vec![
+            world(&[
+                (1.0, 0.2, xyz(0.0, 0.1, 0.0), z, true),
+                (1.0, 0.2, xyz(0.3, 0.15, 0.0), z, true),
+                (0.5, 0.1, xyz(0.12, 0.8, 0.03), z, false),
+            ]),
+            world(&[
+                (1.0, 0.1, xyz(-0.5, 0.5, 0.0), xyz(3.0, 0.0, 0.0), false),
+                (2.0, 0.1, xyz(0.5, 0.5, 0.0), xyz(-3.0, 0.0, 0.0), false),
+            ]),
+            world(&[
+                (1.0, 0.1, xyz(0.0, 0.5, 0.0), z, false),
+                (1.0, 0.15, xyz(0.0, 0.5, 0.0), z, false),
+            ]),
+            world(&[
+                (0.1, 0.02, xyz(0.0, 0.6, 0.0), xyz(80.0, 0.0, 0.0), false),
+                (
+                    0.1,
+                    0.02,
+                    xyz(0.0, 0.635, 0.035),
+                    xyz(80.0, 0.0, 0.0),
+                    false,
+                ),
+                (1.0, 0.1, xyz(0.4, 0.6, 0.3), z, false),
+            ]),
+            world(&[
+                (1.0, 0.0, xyz(0.0, 0.3, 0.0), z, false),
+                (1.0, 0.1, xyz(0.05, 0.7, 0.0), z, false),
+                (1.0, 0.0, xyz(0.1, 1.0, 0.0), z, false),
+            ]),
+            world(&[
+                (1.0, 0.0, xyz(0.0, 0.3, 0.0), z, false),
+                (1.0, 0.0, xyz(0.0, 0.3, 0.0), xyz(0.1, 0.0, 0.0), false),
+            ]),
+        ];
+        assert_same(
+            &mut worlds,
+            1e-3,
+            300,
+            3,
+            &format!("sphere contact's corners, {kind:?}"),
+        );
+        // The fixed pair stayed where it was, sunk into each other, and
+        // the free sphere, dropped onto it, is not inside either.
+        let pos = &worlds[0].state().pos;
+        assert_eq!((pos[0], pos[1]), (xyz(0.0, 0.1, 0.0), xyz(0.3, 0.15, 0.0)));
+        for fixed in [pos[0], pos[1]] {
+            assert!((pos[2] - fixed).length() > 0.3 - 1e-3, "{pos:?}");
+        }
+    }
+}
+
 /// Bodies in water dragged across their springs (`[fluid] springs`,
 /// forces/rod_drag.rs), their spheres touching each other too (the C
 /// applies soft contact, then rod drag, as the engine's list of user forces
