@@ -186,11 +186,25 @@ fn end_rules_and_blow_ups_end_as_the_engine_s() {
         .filter(|e| matches!(e.ended, Ended::Stretch(_)))
         .count();
     assert!(touch > 0 && stretch > 0, "{got:?}");
-    // Explicit Euler at 5 ms with stiff springs: blow-ups (non-finite
-    // states or the guard's speed limit), at the engine's steps.
+    // Explicit Euler at 5 ms with stiff springs: blow-ups at the engine's
+    // steps, found by the guard's speed limit (checked every 64 steps:
+    // each ends at step 63 or 127); with springs 10⁴ times as stiff,
+    // found sooner, by the step that refuses a state no longer finite.
     let text = walker(2.0, "euler", "").replace("dt = 0.0005", "dt = 0.005");
-    let got = assert_same(genomes(&text, 8, 3), "walker, Euler at 5 ms");
-    assert!(got.iter().any(|e| e.ended == Ended::BlowUp), "{got:?}");
+    let stiff = text.replace("stiffness = 800.0", "stiffness = 8000000.0");
+    for (what, text, guard) in [
+        ("Euler at 5 ms", text, true),
+        ("springs of 8 MN/m", stiff, false),
+    ] {
+        let got = assert_same(genomes(&text, 8, 3), &format!("walker, {what}"));
+        for e in &got {
+            let steps = (e.time / 0.005).round() as u64;
+            assert!(
+                e.ended == Ended::BlowUp && ((steps + 1) % 64 == 0) == guard,
+                "{what}: {got:?}"
+            );
+        }
+    }
 }
 
 #[test]
