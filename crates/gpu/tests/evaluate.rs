@@ -200,7 +200,7 @@ fn end_rules_and_blow_ups_end_as_the_engine_s() {
         for e in &got {
             let steps = (e.time / 0.005).round() as u64;
             assert!(
-                e.ended == Ended::BlowUp && ((steps + 1) % 64 == 0) == guard,
+                e.ended == Ended::BlowUp && (steps + 1).is_multiple_of(64) == guard,
                 "{what}: {got:?}"
             );
         }
