@@ -205,6 +205,70 @@ fn end_rules_and_blow_ups_end_as_the_engine_s() {
             );
         }
     }
+    // Two particles at 8.98·10³⁰⁷ m flying on along x: every coordinate
+    // stays finite, but their centre overflows in the first step, which
+    // ends the evaluation as a blow-up there (that step counted).
+    let far = r#"
+[world]
+dt = 0.01
+integrator = "symplectic"
+duration = 1.0
+
+[[particle]]
+name = "a"
+position = [8.98e307, 0.0, 0.0]
+velocity = [1e307, 0.0, 0.0]
+mass = 1.0
+radius = 0.05
+
+[[particle]]
+name = "b"
+position = [8.98e307, 1.0, 0.0]
+velocity = [1e307, 0.0, 0.0]
+mass = 1.0
+radius = 0.05
+
+[[spring]]
+name = "s"
+a = "a"
+b = "b"
+stiffness = 10.0
+
+[[actuator]]
+name = "s"
+spring = "s"
+min = 0.9
+max = 1.1
+rate = 4.0
+
+[[controller]]
+name = "c"
+kind = "oscillator"
+outputs = ["s"]
+frequency = 1.0
+amplitude = [0.2]
+phase = [0.0]
+offset = [0.5]
+
+[evolve]
+controller = "c"
+duration = 1.0
+particles = ["a", "b"]
+axis = [1.0, 0.0, 0.0]
+distance_weight = 1.0
+time_weight = 1.0
+"#;
+    let scene = SceneProblem::parse(far, "far.toml")
+        .unwrap()
+        .fresh()
+        .unwrap();
+    assert!(scene.world.state().pos.iter().all(|p| p.is_finite()));
+    let got = assert_same(vec![scene], "a centre that overflows");
+    assert_eq!(
+        (&got[0].ended, got[0].time),
+        (&Ended::BlowUp, 0.01),
+        "{got:?}"
+    );
 }
 
 #[test]
