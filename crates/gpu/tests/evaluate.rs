@@ -304,6 +304,16 @@ ranges = [[0.0, 1.0], [0.0, 6.0], [-1.0, 1.0], [-1.0, 1.0], [0.0, 0.3], [-1.0, 1
         v.dedup();
         assert!(v.len() > 3, "measure {m}: {got:?}");
     }
+    // Ended before its first step (a hip within 10 m of the floor
+    // touches it): every measure and term of no steps and no time.
+    assert!(!text.contains("touch_tolerance"));
+    let at_once = text.replace("[evolve]\n", "[evolve]\ntouch_tolerance = 10.0\n");
+    let got = assert_same(genomes(&at_once, 3, 4), "walker ended at once");
+    assert!(
+        got.iter()
+            .all(|e| e.time == 0.0 && matches!(e.ended, Ended::Touch(_)) && e.measures.len() == 10),
+        "{got:?}"
+    );
 }
 
 /// `n` scenes of `problem`'s random bodies (unchecked), drawn from
