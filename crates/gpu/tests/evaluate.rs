@@ -548,6 +548,11 @@ clock = 2.0
         .replace("duration = 10.0", "duration = 2.0");
     let got = assert_same(genomes(&text, 12, 6), "neural walker");
     assert!(distinct_distances(&got) > 6, "{got:?}");
+    // Without its clock: the sensors' levels only.
+    let unclocked = text.replace("clock = 2.0\n", "");
+    assert_ne!(unclocked, text);
+    let got = assert_same(genomes(&unclocked, 6, 6), "neural walker without a clock");
+    assert!(distinct_distances(&got) > 3, "{got:?}");
     // Evolved bodies with neural brains: touch sensors on every particle
     // that can touch the floor, one output a muscle.
     let text = BODIES_WALK
