@@ -453,7 +453,8 @@ fn particles_starting_in_or_on_the_terrain_are_the_engine_s_to_the_bit() {
 /// terrain (`an_floor_check`, `an_terrain_check`, `an_terrain_handle`,
 /// `an_terrain_contact`, each `w == 0`), with and without the contact
 /// force, and with gravity off (the bodies thrown at the ground), which
-/// the terrain's handling reads.
+/// the terrain's handling reads; on the flat floor every other body held
+/// in a vertical plane checked before the floor (`an_floor_note`).
 #[test]
 fn fixed_particles_in_the_ground_are_left_there_as_the_engine_leaves_them() {
     use animats_engine::{Heightfield, Steps, Terrain};
@@ -845,8 +846,8 @@ fn spheres_colliding_as_events_are_the_engine_s_to_the_bit() {
 /// the floor holds no fixed sphere up); two spheres meeting head on along
 /// a line (no sliding: no friction's impulse); two at one place (no
 /// normal: left alone); two small fast ones flying side by side at one
-/// velocity, 5 mm apart (the swept test with no relative motion); points (no radius)
-/// among spheres; a world of points only (no sphere at all).
+/// velocity, 1 cm apart (the swept test with no relative motion); points
+/// (no radius) among spheres; a world of points only (no sphere at all).
 #[test]
 fn sphere_contact_s_corner_cases_are_the_engine_s_to_the_bit() {
     for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
