@@ -1419,3 +1419,41 @@ fn fast_mode_ranks_a_population_as_strict_mode_does() {
     // The typical fitness: moved far less than by halving the step.
     assert!(m_fast < 0.1 * m_step, "{m_fast} against {m_step}");
 }
+
+/// Every scene shipped in `scenes/` that `animats evaluate` or `evolve`
+/// can take: as shipped (the whole evaluation), or, for a body task
+/// (`[morphology]`), two of its random starts; each evaluated by the C as
+/// by the engine, to the bit. A scene added to `scenes/` is in this test
+/// without a line of it, so a shipped scene the GPU cannot run (refused)
+/// or runs otherwise fails CI.
+#[test]
+fn every_shipped_scene_evaluates_in_the_c_as_in_the_engine() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes");
+    let mut files: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    files.sort();
+    let mut tried = Vec::new();
+    for path in files {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        if !text.contains("\n[evolve]") {
+            continue;
+        }
+        let scenes = if text.contains("\n[morphology]") {
+            let problem = MorphologyProblem::parse(&text, &name).unwrap();
+            random_bodies(&problem, 31, 2)
+        } else {
+            vec![animats_scene::parse(&text, &name).unwrap()]
+        };
+        let refs: Vec<&Scene> = scenes.iter().collect();
+        if let Err(e) = Batch::pack_scenes(&refs) {
+            panic!("{name}: the GPU refuses it: {e}");
+        }
+        assert_same(scenes, &name);
+        tried.push(name);
+    }
+    assert!(tried.len() >= 20, "{tried:?}");
+}
