@@ -17,9 +17,11 @@
 # mode (fused multiply-adds: its drift and the ranking's correlation); the throughput of each; last the
 # soft walker evolved on the GPU, 16,384 candidates a generation, against
 # the README's CPU run (scenes/walker.toml's header), wall time and
-# distance of each; and short evolutions of the walker and of bodies
+# distance of each; short evolutions of the walker and of bodies
 # (MAP-Elites, the archive's measures) on the GPU and on the CPU with the
-# same seed: log.csv and best.toml compared byte for byte.
+# same seed: log.csv and best.toml compared byte for byte; and every
+# shipped scene `animats evaluate` takes, evaluated on each: the same
+# printed fitness.
 #
 # Each GPU run is timed with each creature's state in the thread's local
 # memory (Layout::Local, the default) and in the batch's arrays
@@ -119,5 +121,27 @@ for run in "scenes/walker.toml --optimiser cma-es --generations 20" "scenes/bodi
   fi
   rm -rf "$T/same-cuda" "$T/same-cpu"
 done
+# Every shipped scene that `animats evaluate` takes (a body task's
+# [morphology] scene is a task, not a creature: left out), on the GPU
+# and on the CPU: the printed fitness, distance, time and end the same
+# bytes.
+echo "== evaluate each shipped scene: --device cuda against --device cpu"
+same=0
+differ=0
+for f in scenes/*.toml; do
+  grep -q '^\[evolve\]' "$f" || continue
+  grep -q '^\[morphology\]' "$f" && continue
+  cpu=$("$A" evaluate "$f" --device cpu 2>&1) || { echo "$f: on the CPU: $cpu"; status=1; continue; }
+  gpu=$("$A" evaluate "$f" --device cuda 2>&1) || { echo "$f: on the GPU: $gpu"; [ $status -gt 2 ] || status=2; continue; }
+  if [ "$cpu" = "$gpu" ]; then
+    same=$((same + 1))
+  else
+    differ=$((differ + 1))
+    echo "$f: DIFFERS"
+    diff <(echo "$cpu") <(echo "$gpu") | head -8
+    status=1
+  fi
+done
+echo "$same shipped scenes the same on the GPU as on the CPU, $differ differ"
 rm -rf "$T"
 exit $status
