@@ -944,6 +944,12 @@ fn about(text: &str, n: usize, seed: u64, spread: f64) -> Vec<Scene> {
         .collect()
 }
 
+/// The state of the roobot's Raibert controller (its scene's first).
+fn raibert_of(scene: &Scene) -> Raibert {
+    let any = scene.nervous.controllers[0].brain.as_any().unwrap();
+    any.downcast_ref::<Raibert>().unwrap().clone()
+}
+
 #[test]
 fn raibert_s_controller_on_the_roobot_is_the_engine_s_to_the_bit() {
     // scenes/hop_evolver.toml with Raibert's controller for the thesis's
@@ -1005,10 +1011,6 @@ fn raibert_s_controller_on_the_roobot_is_the_engine_s_to_the_bit() {
             .fresh()
             .unwrap()
     };
-    let raibert_of = |scene: &Scene| -> Raibert {
-        let any = scene.nervous.controllers[0].brain.as_any().unwrap();
-        any.downcast_ref::<Raibert>().unwrap().clone()
-    };
     let mut states = std::collections::BTreeSet::new();
     let mut later = Vec::new();
     for text in [&raibert, &servo] {
@@ -1054,10 +1056,6 @@ fn a_stance_past_raibert_s_one_second_cap_places_the_next_foot_as_the_engine_doe
     let raibert = HOP_EVOLVER
         .replace("params = \"initial\"", "brain = \"raibert\"")
         .replace("fail_on_touch", "# fail_on_touch");
-    let raibert_of = |scene: &Scene| -> Raibert {
-        let any = scene.nervous.controllers[0].brain.as_any().unwrap();
-        any.downcast_ref::<Raibert>().unwrap().clone()
-    };
     let mut scenes = Vec::new();
     for gains in [
         "[0.014310244352763695, 0.6790795984793772, 0.18211216627695972, 0.5550689905788553, \
