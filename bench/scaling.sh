@@ -11,7 +11,9 @@
 # a many-core machine in an ignored folder):
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
-# About 4 minutes on 16 cores; prints a Markdown table for PERFORMANCE.md.
+# About 2.5 minutes on 16 cores (137 s on the H200 machine's Xeon,
+# 2026-11-30); prints a Markdown table for PERFORMANCE.md. Needs bash and
+# awk only (the lent machines have no bc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ANIMATS:-target/carry/animats}
@@ -47,7 +49,7 @@ for row in "${rows[@]}"; do
     start=$(date +%s.%N)
     # shellcheck disable=SC2086
     "$B" evolve $args --threads "$t" $sched --out "$OUT/$name-$t" > "$OUT/$name-$t.txt" 2>&1
-    wall=$(echo "$(date +%s.%N) - $start" | bc -l)
+    wall=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
     [ -z "$first" ] && first=$wall
     last=$wall
     if ! cmp -s "$OUT/$name-${THREADS%% *}/log.csv" "$OUT/$name-$t/log.csv"; then
@@ -55,7 +57,7 @@ for row in "${rows[@]}"; do
     fi
     line+=" $(printf '%.2f' "$wall") s |"
   done
-  echo "$line $(printf '%.1f' "$(echo "$first / $last" | bc -l)")× |"
+  echo "$line $(awk -v a="$first" -v b="$last" 'BEGIN { printf "%.1f", a / b }')× |"
 done
 echo
 echo "schedule model (evolve --schedule), from each row's ${THREADS%% *}-thread run above:"
