@@ -687,7 +687,8 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     // A checked.toml of an earlier part of this run no longer stands.
     let _ = std::fs::remove_file(dir.join("checked.toml"));
-    let checked = !args.no_check && check_best(&dir, &state)?;
+    // On the run's own threads (its two runs side by side where there are two).
+    let checked = !args.no_check && pool.install(|| check_best(&dir, &state))?;
     if let Some((by, kept)) = state.refusals() {
         let total: u64 = by.values().sum();
         let reasons: Vec<String> = by.iter().map(|(r, n)| format!("{r} {n}")).collect();

@@ -604,8 +604,8 @@ pub fn check_finer(
 /// two are the same (implicit Euler); `make` builds the scene afresh for
 /// each. The two runs are independent and run side by side (at the end
 /// of an evolution they are all there is to do: one after the other they
-/// were an eighth of a 16-lane quadruped run's 1-thread time, and most of
-/// its 16-thread time). Returns each run's integrator, step and
+/// were a fifth of a 16-lane quadruped run's 1-thread time, and most of
+/// its 16-thread time; on the caller's rayon pool). Returns each run's integrator, step and
 /// evaluation.
 pub fn checks_finer(
     make: impl Fn() -> Result<Scene, String> + Sync,
