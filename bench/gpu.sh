@@ -47,6 +47,7 @@
 # Two parts, for two calls of at most 5 minutes each: `bench/gpu.sh check`
 # (gpu_check and gpu_evaluate: bits and throughput) and `bench/gpu.sh
 # evolve` (the evolutions and the shipped scenes); no argument runs both.
+# A third, `bench/gpu.sh tune`, sweeps the kernel's knobs (below).
 # The C on the CPU is left out (ANIMATS_SKIP_C=1: CI proves it the
 # engine's bits, and its 16-core times were measured on 2026-11-27,
 # docs/PERFORMANCE.md): the GPU is compared with the engine. Each section
@@ -54,7 +55,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 part=${1:-all}
-case $part in check|evolve|all) ;; *) echo "usage: bench/gpu.sh [check|evolve|all]" >&2; exit 2 ;; esac
+case $part in check|evolve|tune|all) ;; *) echo "usage: bench/gpu.sh [check|evolve|tune|all]" >&2; exit 2 ;; esac
 export ANIMATS_SKIP_C=${ANIMATS_SKIP_C:-1}
 SECONDS=0
 bin() {
@@ -74,6 +75,24 @@ export LD_LIBRARY_PATH="/usr/local/cuda/targets/x86_64-linux/lib:/usr/local/cuda
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%dT%H:%MZ)"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 status=0
+# `tune` (a third call, not part of `all`): the kernel's registers and
+# block size (animats_gpu::Tuning) swept on 32,768 walkers, 8,192 random
+# land bodies and 32,768 dropped 20-particle bodies, each way's bits
+# checked against the engine as above. About 4.5 minutes (an estimate:
+# not yet run on a GPU).
+if [ "$part" = tune ]; then
+  for knobs in "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256"; do
+    for run in "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"; do
+      echo "== [${SECONDS} s] ${knobs:-defaults}: ${run#target/*/}"
+      # shellcheck disable=SC2086
+      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU)"
+      rc=${PIPESTATUS[0]}
+      [ "$rc" -gt $status ] && status=$rc
+    done
+  done
+  echo "[${SECONDS} s] done, exit $status"
+  exit $status
+fi
 if [ "$part" != evolve ]; then
 for run in "65536 1000 20" "16384 1000 0" "4096 500 0 implicit"; do
   echo "== [${SECONDS} s] gpu_check $run"

@@ -10,6 +10,9 @@
 //! scene's `integrator` (default `rk4`; `implicit` runs implicit Euler's
 //! kernels). Exit 2 where no GPU
 //! can be used (the message says why), 1 if any bit differs.
+//! `ANIMATS_SKIP_C=1` leaves the C on the CPU out (the GPU compared with
+//! the engine); `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune the kernel
+//! (`animats_gpu::Tuning`).
 
 use animats_creatures::random::Random;
 use animats_engine::{FloorDef, IntegratorKind, World};
@@ -156,6 +159,7 @@ fn main() {
             std::process::exit(if bad == 0 { 2 } else { 1 });
         }
     };
+    println!("GPU tuning: {:?}", device.tuning());
     // Once to warm (the module is loaded; the first launch pays for it).
     let mut warm = packed.clone();
     if let Err(e) = device.run(&mut warm, 1) {

@@ -36,7 +36,10 @@
 //!
 //!     cargo run --release -p animats-gpu --example gpu_evaluate -- [walker|bodies|neural|quadruped|roobot|raibert|jellyfish|rough|rocks] [COUNT] [SECONDS]
 //!
-//! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too.
+//! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too;
+//! `ANIMATS_SKIP_C=1` leaves the C on the CPU out, `ANIMATS_SKIP_FAST=1`
+//! the GPU's fast mode; `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune
+//! the kernel (`animats_gpu::Tuning`).
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -278,6 +281,7 @@ fn main() {
             std::process::exit(if bad == 0 { 2 } else { 1 });
         }
     };
+    println!("GPU tuning: {:?}", device.tuning());
     // Once to warm (the module is loaded; the first launch pays for it).
     let one = scene(kind, seconds, 0).unwrap_or_else(|e| fail(e));
     let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
@@ -312,7 +316,14 @@ fn main() {
     }
     // Fast mode (fused multiply-adds): its own kernel; not the engine's
     // bits, so its fitnesses' drift and the population's ranking.
-    match Device::open_in(Mode::Fast) {
+    // (`ANIMATS_SKIP_FAST=1` leaves it out: bench/gpu.sh's sweep of the
+    // tuning knobs.)
+    let fast = if std::env::var_os("ANIMATS_SKIP_FAST").is_some() {
+        Err("left out (ANIMATS_SKIP_FAST)".to_string())
+    } else {
+        Device::open_in(Mode::Fast)
+    };
+    match fast {
         Ok(fast) => {
             let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
             fast.evaluate(&mut warm).unwrap_or_else(|e| fail(e));

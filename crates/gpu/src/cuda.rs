@@ -61,6 +61,67 @@ pub struct Device {
     arch: (i32, i32),
     mode: Mode,
     schedule: Schedule,
+    tuning: Tuning,
+}
+
+/// Two knobs for measuring on a GPU, read by [`Device::open`] from the
+/// environment: `ANIMATS_GPU_REGS` (16 to 255: NVRTC's `--maxrregcount`,
+/// the registers a thread may hold, the rest spilled to local memory; part
+/// of a kept kernel's name) and `ANIMATS_GPU_BLOCK` (32 to 1024, a
+/// multiple of 32: threads a block, [`BLOCK`] unless set). Neither
+/// changes a bit of a result: they decide where values are kept and which
+/// threads run together, not the arithmetic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tuning {
+    /// `--maxrregcount`, if set.
+    pub regs: Option<u32>,
+    /// Threads a block.
+    pub block: u32,
+}
+
+impl Tuning {
+    /// The knobs from `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK`; `Err`
+    /// names the variable and the value it refuses.
+    pub fn from_env() -> Result<Tuning, String> {
+        let get = |name| std::env::var(name).ok();
+        Tuning::parse(
+            get("ANIMATS_GPU_REGS").as_deref(),
+            get("ANIMATS_GPU_BLOCK").as_deref(),
+        )
+    }
+
+    /// The knobs from the variables' values (`None`: unset).
+    pub fn parse(regs: Option<&str>, block: Option<&str>) -> Result<Tuning, String> {
+        let number = |name: &str, v: &str, ok: &dyn Fn(u32) -> bool, what: &str| {
+            v.trim()
+                .parse::<u32>()
+                .ok()
+                .filter(|&n| ok(n))
+                .ok_or_else(|| format!("{name}: {what}, got {v:?}"))
+        };
+        let regs = regs
+            .map(|v| {
+                number(
+                    "ANIMATS_GPU_REGS",
+                    v,
+                    &|n| (16..=255).contains(&n),
+                    "a whole number from 16 to 255",
+                )
+            })
+            .transpose()?;
+        let block = block
+            .map(|v| {
+                number(
+                    "ANIMATS_GPU_BLOCK",
+                    v,
+                    &|n| (32..=1024).contains(&n) && n % 32 == 0,
+                    "a multiple of 32 from 32 to 1024",
+                )
+            })
+            .transpose()?
+            .unwrap_or(BLOCK);
+        Ok(Tuning { regs, block })
+    }
 }
 
 /// One compiled kernel's entries.
@@ -68,7 +129,7 @@ struct Kernels {
     step: CudaFunction,
     evaluate: CudaFunction,
     /// Evaluation threads the GPU holds at once (its multiprocessors
-    /// times the blocks of the evaluation each holds, times [`BLOCK`]):
+    /// times the blocks of the evaluation each holds, times the block's threads):
     /// the threads of a [`Schedule::Queue`] launch.
     resident: i64,
 }
@@ -122,7 +183,8 @@ impl Device {
             .compute_capability()
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
-        let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode)?;
+        let tuning = Tuning::from_env()?;
+        let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode, tuning)?;
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
@@ -134,6 +196,7 @@ impl Device {
             arch,
             mode,
             schedule: Schedule::default(),
+            tuning,
         })
     }
 
@@ -156,7 +219,13 @@ impl Device {
         };
         cell.get_or_init(|| {
             kernels(
-                &self.ctx, self.arch, &self.name, variant, implicit, self.mode,
+                &self.ctx,
+                self.arch,
+                &self.name,
+                variant,
+                implicit,
+                self.mode,
+                self.tuning,
             )
         })
         .as_ref()
@@ -171,6 +240,11 @@ impl Device {
     /// The device's name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// The knobs it was opened with ([`Tuning`]).
+    pub fn tuning(&self) -> Tuning {
+        self.tuning
     }
 
     /// How [`Device::evaluate`] shares a batch's evaluations among the
@@ -193,7 +267,8 @@ impl Device {
         // SAFETY: the kernel reads and writes within the arrays just
         // uploaded, at the offsets `Batch::pack` checked; the arguments
         // match its signature (an_batch by value, two long longs, an int).
-        unsafe { launch.launch(config(creatures)?) }.map_err(err("launching the step"))?;
+        unsafe { launch.launch(config(creatures, self.tuning.block)?) }
+            .map_err(err("launching the step"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
@@ -235,7 +310,8 @@ impl Device {
         // SAFETY: as in `run`; the kernel takes an_batch by value, one
         // long long, an int, the counter's device pointer and an int; with
         // the queue, threads take evaluations below `creatures` only.
-        unsafe { launch.launch(config(threads)?) }.map_err(err("launching the evaluation"))?;
+        unsafe { launch.launch(config(threads, self.tuning.block)?) }
+            .map_err(err("launching the evaluation"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
@@ -289,9 +365,13 @@ fn kernels(
     variant: Variant,
     implicit: bool,
     mode: Mode,
+    tuning: Tuning,
 ) -> Result<Kernels, String> {
     let src = source();
     let mut options = options(arch, mode);
+    if let Some(n) = tuning.regs {
+        options.push(format!("--maxrregcount={n}"));
+    }
     if variant != Variant::Terrain {
         options.push("-DAN_FLAT_ONLY".into());
     }
@@ -333,13 +413,13 @@ fn kernels(
         )
         .map_or(1, |n| i64::from(n.max(1)));
     let per_sm = evaluate
-        .occupancy_max_active_blocks_per_multiprocessor(BLOCK, 0, None)
+        .occupancy_max_active_blocks_per_multiprocessor(tuning.block, 0, None)
         .map_err(|e| format!("the evaluation's occupancy: {e}"))?
         .max(1);
     Ok(Kernels {
         step,
         evaluate,
-        resident: sms * i64::from(per_sm) * i64::from(BLOCK),
+        resident: sms * i64::from(per_sm) * i64::from(tuning.block),
     })
 }
 
@@ -382,12 +462,11 @@ fn upload(s: &Arc<CudaStream>, batch: &Batch) -> Result<(Vec<OnDevice>, DeviceBa
     Ok((on_device, raw))
 }
 
-/// Threads in a block.
+/// Threads in a block (unless `ANIMATS_GPU_BLOCK` says otherwise).
 const BLOCK: u32 = 128;
 
-/// One thread per creature, in blocks of [`BLOCK`].
-fn config(creatures: i64) -> Result<LaunchConfig, String> {
-    let threads = BLOCK;
+/// One thread per creature, in blocks of `threads`.
+fn config(creatures: i64, threads: u32) -> Result<LaunchConfig, String> {
     let blocks = (creatures.max(0) as u64).div_ceil(threads as u64).max(1);
     Ok(LaunchConfig {
         grid_dim: (
@@ -515,5 +594,70 @@ mod tests {
             assert!(s.contains(needle), "{needle}");
         }
         assert!(!s.contains("#include"));
+    }
+
+    use super::{config, Tuning, BLOCK};
+
+    #[test]
+    fn the_tuning_knobs_take_what_a_gpu_can_run_and_name_what_they_refuse() {
+        let t = |r, b| Tuning::parse(r, b);
+        assert_eq!(
+            t(None, None),
+            Ok(Tuning {
+                regs: None,
+                block: BLOCK
+            })
+        );
+        assert_eq!(
+            t(Some("128"), Some("256")),
+            Ok(Tuning {
+                regs: Some(128),
+                block: 256
+            })
+        );
+        assert_eq!(
+            t(Some(" 16 "), Some("1024")),
+            Ok(Tuning {
+                regs: Some(16),
+                block: 1024
+            })
+        );
+        assert_eq!(
+            t(Some("255"), Some("32")),
+            Ok(Tuning {
+                regs: Some(255),
+                block: 32
+            })
+        );
+        for (r, b, name) in [
+            (Some("15"), None, "ANIMATS_GPU_REGS"),
+            (Some("256"), None, "ANIMATS_GPU_REGS"),
+            (Some("lots"), None, "ANIMATS_GPU_REGS"),
+            (Some("-1"), None, "ANIMATS_GPU_REGS"),
+            (None, Some("100"), "ANIMATS_GPU_BLOCK"),
+            (None, Some("0"), "ANIMATS_GPU_BLOCK"),
+            (None, Some("2048"), "ANIMATS_GPU_BLOCK"),
+            (None, Some(""), "ANIMATS_GPU_BLOCK"),
+        ] {
+            let e = t(r, b).expect_err("refused");
+            assert!(e.starts_with(name), "{e}");
+            assert!(e.contains("got"), "{e}");
+        }
+    }
+
+    #[test]
+    fn a_launch_covers_every_creature_in_blocks_of_the_size_asked() {
+        for (creatures, block, blocks) in [
+            (0, 128, 1),
+            (1, 128, 1),
+            (128, 128, 1),
+            (129, 128, 2),
+            (65_536, 64, 1024),
+            (65_537, 256, 257),
+        ] {
+            let c = config(creatures, block).unwrap();
+            assert_eq!(c.block_dim, (block, 1, 1));
+            assert_eq!(c.grid_dim, (blocks, 1, 1));
+        }
     }
 }
