@@ -56,6 +56,30 @@ pub fn batches(
     }
 }
 
+/// Evaluations a batch below which the GPU is no faster than a host's
+/// cores: on the H200 beside 16 Xeon cores (docs/GPU.md), 4,096 roobots or
+/// jellyfish a batch ran 1.8× the cores and 2,048 rough walkers 0.1×;
+/// 8,192 and more, 2.8–6.2×.
+pub const SMALL_BATCH: usize = 4096;
+
+/// `batches` that say, on stderr, when the run's first batch is smaller
+/// than [`SMALL_BATCH`] (one GPU thread runs one evaluation, far slower
+/// than a CPU core: a GPU pays only with thousands at once). Later
+/// batches are not judged: a generation's runs at half the step are few
+/// by design.
+pub fn note_small_batches(batches: Batches) -> Batches {
+    let first = std::sync::atomic::AtomicBool::new(true);
+    Batches(std::sync::Arc::new(move |scenes: Vec<Scene>| {
+        let n = scenes.len();
+        if first.swap(false, std::sync::atomic::Ordering::Relaxed) && n < SMALL_BATCH {
+            eprintln!(
+                "note: a batch of {n} evaluations leaves most of the GPU idle (one thread each); the GPU pays from about {SMALL_BATCH} a batch: raise --population (docs/GPU.md)"
+            );
+        }
+        (batches.0)(scenes)
+    }))
+}
+
 /// A scene of the problem as evolution builds them: the scene's own
 /// brain, or a `[morphology]` scene's start body (a random one if it
 /// starts from random bodies).

@@ -433,7 +433,8 @@ fn evolve(
     // generation.
     let spec = &state.config.problem;
     let batches = crate::device::batches(args.device, &spec.file, || crate::device::probe(spec))
-        .map_err(input)?;
+        .map_err(input)?
+        .map(crate::device::note_small_batches);
     // Built once for the whole run (a scene is parsed and checked here).
     let problem = state.config.problem.build_on(batches).map_err(input)?;
     let mut progress = Progress::new(state);
