@@ -1,5 +1,8 @@
 #!/usr/bin/env bash
 # Evolution's scaling with threads (issue 41): the issue's three runs,
+# the quadruped's and the walker's again without the winner's checks at
+# the end (the issue's figures were measured before evolve checked its
+# winner: the checks are serial work the evaluations' scaling leaves out),
 # [morphology] runs (bodies and brains evolving: 16 lanes of the body GA;
 # the shipped land task, MAP-Elites in one lane, 36 bodies a generation,
 # 144, and 36 with its generations overlapping)
@@ -11,8 +14,8 @@
 # a many-core machine in an ignored folder):
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
-# About 2.5 minutes on 16 cores (137 s on the H200 machine's Xeon,
-# 2026-11-30); prints a Markdown table for PERFORMANCE.md. Needs bash and
+# About 3 minutes on 16 cores (137 s on the H200 machine's Xeon,
+# 2026-11-30, before the two rows without checks); prints a Markdown table for PERFORMANCE.md. Needs bash and
 # awk only (the lent machines have no bc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,6 +33,8 @@ rows=(
   "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
   "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
   "quadruped3|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1"
+  "quadruped3_no_check|scenes/quadruped3_gait.toml --optimiser cma-es --lanes 16 --generations 5 --seed 1 --no-check"
+  "walker_no_check|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1 --no-check"
   "bodies_walk|scenes/bodies_walk.toml --optimiser body-ga --lanes 16 --generations 2 --seed 1"
   "bodies_map|scenes/bodies_walk.toml --generations 20 --seed 1 --no-check"
   "bodies_map_144|scenes/bodies_walk.toml --population 144 --generations 5 --seed 1 --no-check"
