@@ -68,16 +68,78 @@ pub const SMALL_BATCH: usize = 4096;
 /// batches are not judged: a generation's runs at half the step are few
 /// by design.
 pub fn note_small_batches(batches: Batches) -> Batches {
+    note_small_batches_with(batches, |note| eprintln!("{note}"))
+}
+
+/// [`note_small_batches`], the note given to `say`.
+fn note_small_batches_with(
+    batches: Batches,
+    say: impl Fn(String) + Send + Sync + 'static,
+) -> Batches {
     let first = std::sync::atomic::AtomicBool::new(true);
     Batches(std::sync::Arc::new(move |scenes: Vec<Scene>| {
         let n = scenes.len();
         if first.swap(false, std::sync::atomic::Ordering::Relaxed) && n < SMALL_BATCH {
-            eprintln!(
+            say(format!(
                 "note: a batch of {n} evaluations leaves most of the GPU idle (one thread each); the GPU pays from about {SMALL_BATCH} a batch: raise --population (docs/GPU.md)"
-            );
+            ));
         }
         (batches.0)(scenes)
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::{Arc, Mutex};
+
+    const SCENE: &str = include_str!("../../../scenes/bouncing_ball.toml");
+
+    /// Batches that count the scenes they are given, and the notes said.
+    fn counting() -> (Batches, Arc<Mutex<Vec<usize>>>, Arc<Mutex<Vec<String>>>) {
+        let seen = Arc::new(Mutex::new(Vec::new()));
+        let notes = Arc::new(Mutex::new(Vec::new()));
+        let s = seen.clone();
+        let inner = Batches(Arc::new(move |scenes: Vec<Scene>| {
+            s.lock().unwrap().push(scenes.len());
+            Ok(Vec::new())
+        }));
+        let n = notes.clone();
+        let b = note_small_batches_with(inner, move |note| n.lock().unwrap().push(note));
+        (b, seen, notes)
+    }
+
+    fn scenes(n: usize) -> Vec<Scene> {
+        (0..n)
+            .map(|_| animats_scene::parse(SCENE, "scenes/bouncing_ball.toml").unwrap())
+            .collect()
+    }
+
+    #[test]
+    fn a_small_first_batch_is_noted_once_and_every_batch_still_runs() {
+        let (b, seen, notes) = counting();
+        for n in [12, 3, 12] {
+            (b.0)(scenes(n)).unwrap();
+        }
+        assert_eq!(*seen.lock().unwrap(), vec![12, 3, 12]);
+        let notes = notes.lock().unwrap();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("a batch of 12 evaluations"),
+            "{}",
+            notes[0]
+        );
+        assert!(notes[0].contains("--population"), "{}", notes[0]);
+    }
+
+    #[test]
+    fn a_first_batch_of_thousands_is_not_noted_nor_a_small_one_after_it() {
+        let (b, seen, notes) = counting();
+        (b.0)(scenes(SMALL_BATCH)).unwrap();
+        (b.0)(scenes(7)).unwrap();
+        assert_eq!(*seen.lock().unwrap(), vec![SMALL_BATCH, 7]);
+        assert!(notes.lock().unwrap().is_empty());
+    }
 }
 
 /// A scene of the problem as evolution builds them: the scene's own
