@@ -88,6 +88,22 @@ fn note_small_batches_with(
     }))
 }
 
+/// A scene of the problem as evolution builds them: the scene's own
+/// brain, or a `[morphology]` scene's start body (a random one if it
+/// starts from random bodies).
+pub fn probe(spec: &ProblemSpec) -> Result<Scene, String> {
+    if !spec.has_morphology()? {
+        return spec.parse()?.fresh();
+    }
+    let m = MorphologyProblem::parse(&spec.text, &spec.file).map_err(|e| e.to_string())?;
+    let genes = match m.start() {
+        Some(g) => g.to_vec(),
+        None => m.random(&mut Random::for_entry(0, 0)),
+    };
+    let text = m.develop(&genes, "")?;
+    animats_scene::parse(&text, &spec.file).map_err(|e| e.to_string())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -95,8 +111,11 @@ mod tests {
 
     const SCENE: &str = include_str!("../../../scenes/bouncing_ball.toml");
 
+    /// What the batches were given (their sizes) and the notes said.
+    type Log<T> = Arc<Mutex<Vec<T>>>;
+
     /// Batches that count the scenes they are given, and the notes said.
-    fn counting() -> (Batches, Arc<Mutex<Vec<usize>>>, Arc<Mutex<Vec<String>>>) {
+    fn counting() -> (Batches, Log<usize>, Log<String>) {
         let seen = Arc::new(Mutex::new(Vec::new()));
         let notes = Arc::new(Mutex::new(Vec::new()));
         let s = seen.clone();
@@ -140,20 +159,4 @@ mod tests {
         assert_eq!(*seen.lock().unwrap(), vec![SMALL_BATCH, 7]);
         assert!(notes.lock().unwrap().is_empty());
     }
-}
-
-/// A scene of the problem as evolution builds them: the scene's own
-/// brain, or a `[morphology]` scene's start body (a random one if it
-/// starts from random bodies).
-pub fn probe(spec: &ProblemSpec) -> Result<Scene, String> {
-    if !spec.has_morphology()? {
-        return spec.parse()?.fresh();
-    }
-    let m = MorphologyProblem::parse(&spec.text, &spec.file).map_err(|e| e.to_string())?;
-    let genes = match m.start() {
-        Some(g) => g.to_vec(),
-        None => m.random(&mut Random::for_entry(0, 0)),
-    };
-    let text = m.develop(&genes, "")?;
-    animats_scene::parse(&text, &spec.file).map_err(|e| e.to_string())
 }
