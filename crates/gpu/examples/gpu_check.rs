@@ -111,7 +111,7 @@ fn main() {
     // `ANIMATS_SKIP_C=1` leaves the C on the CPU out (CI proves it the
     // engine's bits; bench/gpu.sh saves the device's time so): the GPU is
     // then compared with the engine.
-    let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some();
+    let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some_and(|v| !v.is_empty());
     let mut cpu = packed.clone();
     if !skip_c {
         let t = Instant::now();

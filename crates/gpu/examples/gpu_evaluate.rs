@@ -38,6 +38,7 @@
 //!
 //! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too;
 //! `ANIMATS_SKIP_C=1` leaves the C on the CPU out, `ANIMATS_SKIP_FAST=1`
+//! (either set and not empty)
 //! the GPU's fast mode; `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune
 //! the kernel (`animats_gpu::Tuning`).
 //!
@@ -229,7 +230,7 @@ fn main() {
 
     // `ANIMATS_SKIP_C=1` leaves the C on the CPU out (CI proves it the
     // engine's bits; bench/gpu.sh saves the device's time so).
-    let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some();
+    let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some_and(|v| !v.is_empty());
     let c_cpu = if skip_c {
         Vec::new()
     } else {
@@ -318,7 +319,7 @@ fn main() {
     // bits, so its fitnesses' drift and the population's ranking.
     // (`ANIMATS_SKIP_FAST=1` leaves it out: bench/gpu.sh's sweep of the
     // tuning knobs.)
-    let fast = if std::env::var_os("ANIMATS_SKIP_FAST").is_some() {
+    let fast = if std::env::var_os("ANIMATS_SKIP_FAST").is_some_and(|v| !v.is_empty()) {
         Err("left out (ANIMATS_SKIP_FAST)".to_string())
     } else {
         Device::open_in(Mode::Fast)
