@@ -14,7 +14,7 @@
 # among rocks (sphere contact, the event: its own kernel) for 2 s (so
 # few threads leave the GPU idling: each thread's 10 s took 52 s there),
 # the rest evaluated for 10 s, by the engine on every core and by the
-# GPU, every fitness compared as bits, and but for those two once more by the GPU in fast
+# GPU, every fitness compared as bits, and (but for those two) once more by the GPU in fast
 # mode (fused multiply-adds: its drift and the ranking's correlation); the throughput of each; last the
 # soft walker evolved on the GPU, 16,384 candidates a generation, against
 # the README's CPU run (scenes/walker.toml's header), wall time and
