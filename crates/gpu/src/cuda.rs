@@ -70,7 +70,9 @@ pub struct Device {
 /// of a kept kernel's name) and `ANIMATS_GPU_BLOCK` (32 to 1024, a
 /// multiple of 32: threads a block, [`BLOCK`] unless set). Neither
 /// changes a bit of a result: they decide where values are kept and which
-/// threads run together, not the arithmetic.
+/// threads run together, not the arithmetic. A block whose threads need
+/// more registers than a multiprocessor has (1,024 threads at 255) is
+/// refused by the launch, with the driver's error.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Tuning {
     /// `--maxrregcount`, if set.
