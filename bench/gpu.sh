@@ -41,7 +41,9 @@
 # On the H200 machine with 16 cores (2026-11-30): `check` 212 s up to
 # the rough walkers (10 s of theirs took 52 s a GPU run; the call's limit
 # ended the third), `evolve` 112 s up
-# to the shipped scenes (about 40 s more). Exit 1 if any bit
+# to the shipped scenes (about 40 s more); since then the kernels are
+# compiled side by side first and the rough walkers run 2 s: about 4
+# minutes for `check` by the same figures (not yet run so). Exit 1 if any bit
 # differs, 2 if no GPU can be used (the message says why).
 #
 # Two parts, for two calls of at most 5 minutes each: `bench/gpu.sh check`
@@ -75,12 +77,32 @@ export LD_LIBRARY_PATH="/usr/local/cuda/targets/x86_64-linux/lib:/usr/local/cuda
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%dT%H:%MZ)"
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 status=0
+# NVRTC takes 20 s or so for each kernel (the flat floor's, terrain's,
+# sphere contact's, implicit Euler's; strict and fast): compiled side by
+# side into the cache first, each by a tiny run, rather than one after
+# another inside the timed ones (on 2026-11-30 they were: seven of them,
+# about 140 s of the `check` part).
+warm() {
+  echo "== [${SECONDS} s] the kernels compiled side by side into $ANIMATS_CACHE"
+  "$B" 32 1 20 >/dev/null 2>&1 &
+  "$B" 32 1 0 implicit >/dev/null 2>&1 &
+  "$E" walker 32 0.01 >/dev/null 2>&1 &
+  ANIMATS_SKIP_FAST=1 "$E" rough 32 0.01 >/dev/null 2>&1 &
+  ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &
+  wait
+}
 # `tune` (a third call, not part of `all`): the kernel's registers and
 # block size (animats_gpu::Tuning) swept on 32,768 walkers, 8,192 random
 # land bodies and 32,768 dropped 20-particle bodies, each way's bits
 # checked against the engine as above. About 4.5 minutes (an estimate:
 # not yet run on a GPU).
 if [ "$part" = tune ]; then
+  echo "== [${SECONDS} s] the flat floor's kernel compiled for each register count, side by side"
+  for knobs in "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96"; do
+    # shellcheck disable=SC2086
+    env $knobs "$B" 32 1 20 >/dev/null 2>&1 &
+  done
+  wait
   for knobs in "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256"; do
     for run in "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"; do
       echo "== [${SECONDS} s] ${knobs:-defaults}: ${run#target/*/}"
@@ -93,6 +115,7 @@ if [ "$part" = tune ]; then
   echo "[${SECONDS} s] done, exit $status"
   exit $status
 fi
+warm
 if [ "$part" != evolve ]; then
 for run in "65536 1000 20" "16384 1000 0" "4096 500 0 implicit"; do
   echo "== [${SECONDS} s] gpu_check $run"
