@@ -665,7 +665,6 @@ pub fn run(args: Args) -> Result<(), Failure> {
         tracer.as_ref(),
     )?;
     let wall = start.elapsed().as_secs_f64();
-    save(&dir, &state, true)?;
     let evals = state.evaluations - evals_at_start;
     say!(
         "{} lanes, generation {} of {}, seed {}: {evals} evaluations in {wall:.2} s ({:.0}/s, {threads} threads)",
@@ -688,8 +687,24 @@ pub fn run(args: Args) -> Result<(), Failure> {
     }
     // A checked.toml of an earlier part of this run no longer stands.
     let _ = std::fs::remove_file(dir.join("checked.toml"));
-    // On the run's own threads (its two runs side by side where there are two).
-    let checked = !args.no_check && pool.install(|| check_best(&dir, &state))?;
+    // The end's files (fitness.png: some 100 M instructions of drawing and
+    // compressing) and the winner's checks (two runs side by side) both
+    // only read the state: side by side on the run's own threads, the
+    // serial work that follows the evaluations.
+    let (saved, checked) = pool.install(|| {
+        rayon::join(
+            || save(&dir, &state, true),
+            || {
+                if args.no_check {
+                    Ok(false)
+                } else {
+                    check_best(&dir, &state)
+                }
+            },
+        )
+    });
+    saved?;
+    let checked = checked?;
     if let Some((by, kept)) = state.refusals() {
         let total: u64 = by.values().sum();
         let reasons: Vec<String> = by.iter().map(|(r, n)| format!("{r} {n}")).collect();
