@@ -112,8 +112,8 @@ fn main() {
     // engine's bits; bench/gpu.sh saves the device's time so): the GPU is
     // then compared with the engine.
     let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some_and(|v| !v.is_empty());
-    let mut cpu = packed.clone();
-    if !skip_c {
+    let cpu = (!skip_c).then(|| {
+        let mut cpu = packed.clone();
         let t = Instant::now();
         cpu.run_cpu(steps);
         let c_cpu = t.elapsed().as_secs_f64();
@@ -121,7 +121,8 @@ fn main() {
             "C, every core:       {c_cpu:8.3} s  {:.3e} creature-steps/s",
             rate(c_cpu)
         );
-    }
+        cpu
+    });
     // Every creature's particles, the engine's, as bits.
     let sizes: Vec<usize> = worlds.iter().map(World::len).collect();
     let bits = |v: animats_engine::DVec3| v.to_array().map(f64::to_bits);
@@ -144,13 +145,11 @@ fn main() {
             })
             .count()
     };
-    let bad = if skip_c {
-        0
-    } else {
-        let bad = differ(&cpu, &|c, i| engine_bits[c][i]);
+    let bad = cpu.as_ref().map_or(0, |cpu| {
+        let bad = differ(cpu, &|c, i| engine_bits[c][i]);
         println!("C on the CPU against the engine: {bad} of {creatures} creatures differ");
         bad
-    };
+    });
 
     let device = match Device::open() {
         Ok(d) => d,
@@ -184,17 +183,18 @@ fn main() {
             rate(on_gpu),
             engine / on_gpu
         );
-        let differ = if skip_c {
-            differ(&gpu, &|c, i| engine_bits[c][i])
-        } else {
-            differ(&gpu, &|c, i| {
-                let (x, v) = cpu.state(c, i).unwrap_or_default();
-                [bits(x), bits(v)]
-            })
+        let (differ, against) = match &cpu {
+            Some(cpu) => (
+                differ(&gpu, &|c, i| {
+                    let (x, v) = cpu.state(c, i).unwrap_or_default();
+                    [bits(x), bits(v)]
+                }),
+                "C on the CPU",
+            ),
+            None => (differ(&gpu, &|c, i| engine_bits[c][i]), "engine"),
         };
         println!(
-            "GPU, {layout:?}, against the {}: {differ} of {creatures} creatures differ",
-            if skip_c { "engine" } else { "C on the CPU" }
+            "GPU, {layout:?}, against the {against}: {differ} of {creatures} creatures differ"
         );
         bad_gpu += differ;
     }

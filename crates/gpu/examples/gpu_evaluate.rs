@@ -231,15 +231,13 @@ fn main() {
     // `ANIMATS_SKIP_C=1` leaves the C on the CPU out (CI proves it the
     // engine's bits; bench/gpu.sh saves the device's time so).
     let skip_c = std::env::var_os("ANIMATS_SKIP_C").is_some_and(|v| !v.is_empty());
-    let c_cpu = if skip_c {
-        Vec::new()
-    } else {
+    let c_cpu = (!skip_c).then(|| {
         let mut cpu = packed.clone();
         let t = Instant::now();
         let c_cpu = cpu.evaluate_cpu().unwrap_or_else(|e| fail(e));
         report("C, every core:", t.elapsed().as_secs_f64());
         c_cpu
-    };
+    });
     // The C in fast mode on the CPU, where asked (it costs a whole CPU
     // run more: bench/gpu.sh does not ask).
     if std::env::var_os("ANIMATS_CPU_FAST").is_some() && animats_gpu::cpu_has_fma() {
@@ -262,13 +260,11 @@ fn main() {
             .filter(|(a, b)| bits(a) != bits(b))
             .count()
     };
-    let bad = if skip_c {
-        0
-    } else {
-        let bad = differ(&c_cpu);
+    let bad = c_cpu.as_deref().map_or(0, |c_cpu| {
+        let bad = differ(c_cpu);
         println!("C on the CPU against the engine: {bad} of {count} evaluations differ");
         bad
-    };
+    });
     let best = engine
         .iter()
         .map(|e| e.fitness)
