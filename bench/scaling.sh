@@ -14,8 +14,10 @@
 # a many-core machine in an ignored folder):
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
-# About 3 minutes on 16 cores (137 s on the H200 machine's Xeon,
-# 2026-11-30, before the two rows without checks); prints a Markdown table for PERFORMANCE.md. Needs bash and
+# Then the machine's ceiling (CEILING=0 leaves it out): the roobot and the
+# walker as N independent 1-thread processes at once, N the last thread count.
+# About 4 minutes on 16 cores (137 s on the H200 machine's Xeon,
+# 2026-11-30, before the two rows without checks and the ceiling); prints a Markdown table for PERFORMANCE.md. Needs bash and
 # awk only (the lent machines have no bc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,6 +31,12 @@ trap 'rm -rf "$OUT"' EXIT
 sed 's/^tournament = 4.*/&\noverlap = true/' scenes/bodies_walk.toml > "$OUT/bodies_walk_overlap.toml"
 grep -q '^overlap = true' "$OUT/bodies_walk_overlap.toml" || { echo "scenes/bodies_walk.toml: no tournament line to add overlap after" >&2; exit 2; }
 echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores; $(date -u +%Y-%m-%d)"
+# Whether the "cores" are hyperthreads of fewer physical cores (two threads
+# of one core share its units: a 16-thread speed-up is then bounded well
+# under 16 by the machine, whatever the program does).
+if command -v lscpu > /dev/null; then
+  lscpu | grep -E '^(Thread\(s\) per core|Core\(s\) per socket|Socket\(s\)|NUMA node\(s\)|CPU max MHz|L2 cache|L3 cache):' | tr -s ' ' | paste -sd ';' -
+fi
 rows=(
   "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1"
   "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"
@@ -64,6 +72,40 @@ for row in "${rows[@]}"; do
   done
   echo "$line $(awk -v a="$first" -v b="$last" 'BEGIN { printf "%.1f", a / b }')× |"
 done
+# The machine's own ceiling: N independent copies of a 1-thread run at once
+# (separate processes, nothing shared but the machine) against one alone.
+# N × alone / together is the most N threads can give this workload here:
+# shared caches, memory, hyperthreads and clocks that drop with more busy
+# cores all show in it; the rows above are judged against it.
+N=${THREADS##* }
+if [ "${CEILING:-1}" != 0 ] && [ "$N" -gt 1 ]; then
+  echo
+  echo "machine ceiling: $N copies of a 1-thread run at once, against one alone (--no-check)"
+  echo "| run | one alone | $N at once | ceiling at $N |"
+  echo "|---|---|---|---|"
+  for row in "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1" \
+             "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"; do
+    name=${row%%|*}; args=${row#*|}
+    start=$(date +%s.%N)
+    # shellcheck disable=SC2086
+    "$B" evolve $args --no-check --threads 1 --out "$OUT/ceiling-$name-alone" > /dev/null 2>&1
+    alone=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
+    start=$(date +%s.%N)
+    pids=()
+    for k in $(seq 1 "$N"); do
+      # shellcheck disable=SC2086
+      "$B" evolve $args --no-check --threads 1 --out "$OUT/ceiling-$name-$k" > /dev/null 2>&1 &
+      pids+=($!)
+    done
+    for p in "${pids[@]}"; do wait "$p"; done
+    together=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN { print b - a }')
+    for k in $(seq 1 "$N"); do
+      cmp -s "$OUT/ceiling-$name-alone/log.csv" "$OUT/ceiling-$name-$k/log.csv" ||
+        { echo "$name: copy $k's log differs from the run alone" >&2; exit 1; }
+    done
+    echo "| $name | $(printf '%.2f' "$alone") s | $(printf '%.2f' "$together") s | $(awk -v n="$N" -v a="$alone" -v t="$together" 'BEGIN { printf "%.1f", n * a / t }')× |"
+  done
+fi
 echo
 echo "schedule model (evolve --schedule), from each row's ${THREADS%% *}-thread run above:"
 for row in "${rows[@]}"; do
