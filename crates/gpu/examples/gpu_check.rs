@@ -11,7 +11,8 @@
 //! kernels). Exit 2 where no GPU
 //! can be used (the message says why), 1 if any bit differs.
 //! `ANIMATS_SKIP_C=1` leaves the C on the CPU out (the GPU compared with
-//! the engine); `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune the kernel
+//! the engine); `ANIMATS_GPU_SORT=1` puts the creatures in order of size
+//! (`animats_gpu::order`) before anything runs; `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune the kernel
 //! (`animats_gpu::Tuning`).
 
 use animats_creatures::random::Random;
@@ -48,7 +49,7 @@ fn main() {
     }
     let dt = 1e-3;
     let mut rng = Random::for_entry(42, 0);
-    let mut worlds: Vec<World> = (0..creatures)
+    let worlds: Vec<World> = (0..creatures)
         .map(|k| {
             let n = if particles == 0 {
                 2 + (rng.uniform() * 39.0) as usize
@@ -77,6 +78,19 @@ fn main() {
             w
         })
         .collect();
+    // ANIMATS_GPU_SORT=1: the creatures in order of size (animats_gpu::order),
+    // for the engine and the GPU alike, so that the bits still compare.
+    let sorted = match animats_gpu::order::sort_from_env() {
+        Ok(sort) => sort,
+        Err(e) => {
+            eprintln!("gpu_check: {e}");
+            std::process::exit(2);
+        }
+    };
+    let mut worlds = worlds;
+    if sorted {
+        worlds.sort_by_key(|w| (w.len(), w.forces().springs.len()));
+    }
     let total_particles: usize = worlds.iter().map(World::len).sum();
     let refs: Vec<&World> = worlds.iter().collect();
     let packed = match Batch::pack(&refs, dt) {
@@ -87,10 +101,15 @@ fn main() {
         }
     };
     println!(
-        "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} {} steps of {dt} s, {} CPU threads",
+        "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} {} steps of {dt} s, {} CPU threads{}",
         if particles == 0 { "2 to 40 particles each".to_string() } else { format!("{particles} particles each") },
         kind.name(),
-        rayon::current_num_threads()
+        rayon::current_num_threads(),
+        if sorted { "; in order of size (ANIMATS_GPU_SORT)" } else { "" }
+    );
+    println!(
+        "warps of 32: {:.1} % of their lanes busy in loops over particles (sizes differ)",
+        100.0 * animats_gpu::order::warp_busy(&worlds.iter().map(World::len).collect::<Vec<_>>())
     );
     let rate = |secs: f64| (creatures * steps) as f64 / secs;
 

@@ -39,8 +39,9 @@
 //! `ANIMATS_CPU_FAST=1` times the C in fast mode on the CPU too;
 //! `ANIMATS_SKIP_C=1` leaves the C on the CPU out, `ANIMATS_SKIP_FAST=1`
 //! (either set and not empty)
-//! the GPU's fast mode; `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune
-//! the kernel (`animats_gpu::Tuning`).
+//! the GPU's fast mode; `ANIMATS_GPU_SORT=1` puts the scenes in order of
+//! size (`animats_gpu::order`) before anything runs; `ANIMATS_GPU_REGS`
+//! and `ANIMATS_GPU_BLOCK` tune the kernel (`animats_gpu::Tuning`).
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -185,17 +186,25 @@ fn main() {
             .collect()
     };
     let t = Instant::now();
-    let scenes = build();
+    let mut scenes = build();
     let built = t.elapsed().as_secs_f64();
+    // ANIMATS_GPU_SORT=1: the scenes in order of size (animats_gpu::order)
+    // for the engine and the GPU alike, so that the bits still compare.
+    let sorted = animats_gpu::order::sort_from_env().unwrap_or_else(|e| fail(e));
+    if sorted {
+        scenes.sort_by_key(animats_gpu::order::size);
+    }
     let refs: Vec<&Scene> = scenes.iter().collect();
     let t = Instant::now();
     let packed = Batch::pack_scenes(&refs).unwrap_or_else(|e| fail(e));
     let pack = t.elapsed().as_secs_f64();
-    let particles: usize = scenes.iter().map(|s| s.world.len()).sum();
+    let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
+    let particles: usize = sizes.iter().sum();
     let dt = scenes[0].dt;
     println!(
-        "{count} {kind} evaluations of {seconds} s ({particles} particles, steps of {dt} s), {} CPU threads; scenes built in {built:.2} s, packed in {pack:.2} s",
-        rayon::current_num_threads()
+        "{count} {kind} evaluations of {seconds} s ({particles} particles, steps of {dt} s), {} CPU threads; scenes built in {built:.2} s, packed in {pack:.2} s{}",
+        rayon::current_num_threads(),
+        if sorted { "; in order of size (ANIMATS_GPU_SORT)" } else { "" }
     );
 
     let t = Instant::now();
@@ -224,8 +233,9 @@ fn main() {
         .sum::<f64>()
         / lengths.len().div_ceil(32) as f64;
     println!(
-        "warps of 32 busy {:.1} % of their steps (evaluations end at different times)",
-        100.0 * busy
+        "warps of 32 busy {:.1} % of their steps (evaluations end at different times); {:.1} % of their lanes in loops over particles (sizes differ)",
+        100.0 * busy,
+        100.0 * animats_gpu::order::warp_busy(&sizes)
     );
 
     // `ANIMATS_SKIP_C=1` leaves the C on the CPU out (CI proves it the

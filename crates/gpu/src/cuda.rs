@@ -62,6 +62,9 @@ pub struct Device {
     mode: Mode,
     schedule: Schedule,
     tuning: Tuning,
+    /// Whether [`Device::into_batches`] packs each batch in order of size
+    /// (`ANIMATS_GPU_SORT`, [`crate::order`]).
+    sort: bool,
 }
 
 /// Two knobs for measuring on a GPU, read by [`Device::open`] from the
@@ -186,6 +189,7 @@ impl Device {
             .map_err(|e| format!("the device's architecture: {e}"))?;
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
         let tuning = Tuning::from_env()?;
+        let sort = crate::order::sort_from_env()?;
         let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode, tuning)?;
         Ok(Device {
             stream: ctx.default_stream(),
@@ -199,6 +203,7 @@ impl Device {
             mode,
             schedule: Schedule::default(),
             tuning,
+            sort,
         })
     }
 
@@ -247,6 +252,12 @@ impl Device {
     /// The knobs it was opened with ([`Tuning`]).
     pub fn tuning(&self) -> Tuning {
         self.tuning
+    }
+
+    /// Whether its batches of scenes are packed in order of size
+    /// (`ANIMATS_GPU_SORT=1`, [`crate::order`]).
+    pub fn sorts(&self) -> bool {
+        self.sort
     }
 
     /// How [`Device::evaluate`] shares a batch's evaluations among the
@@ -330,16 +341,21 @@ impl Device {
 impl Device {
     /// The device as a problem's evaluation runner
     /// ([`animats_scene::evaluate::Batches`]): each batch of scenes packed
-    /// ([`Batch::pack_scenes`]) and evaluated here, one batch at a time.
+    /// ([`Batch::pack_scenes`]) and evaluated here, one batch at a time;
+    /// in order of size where [`Device::sorts`], the evaluations handed
+    /// back in the scenes' own order either way.
     pub fn into_batches(self) -> animats_scene::evaluate::Batches {
+        let sort = self.sort;
         let device = std::sync::Mutex::new(self);
         animats_scene::evaluate::Batches(Arc::new(move |scenes| {
             let refs: Vec<&animats_scene::Scene> = scenes.iter().collect();
-            let mut batch = Batch::pack_scenes(&refs)?;
-            let device = device
-                .lock()
-                .map_err(|_| "an earlier evaluation on the GPU panicked".to_string())?;
-            device.evaluate(&mut batch)
+            crate::order::evaluate_in_order(&refs, sort, |refs| {
+                let mut batch = Batch::pack_scenes(refs)?;
+                let device = device
+                    .lock()
+                    .map_err(|_| "an earlier evaluation on the GPU panicked".to_string())?;
+                device.evaluate(&mut batch)
+            })
         }))
     }
 }

@@ -343,6 +343,46 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
 }
 
 #[test]
+fn bodies_packed_in_order_of_size_answer_in_their_own_order_with_the_same_bits() {
+    // What `ANIMATS_GPU_SORT=1` does on a GPU, with the C on the CPU:
+    // random bodies of unlike sizes packed smallest first, the answers
+    // handed back in the scenes' order, each one's bits as packed as they
+    // came.
+    let text = BODIES_WALK.replace("duration = 10.0", "duration = 1.0");
+    let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
+    let scenes = random_bodies(&problem, 5, 24);
+    let refs: Vec<&Scene> = scenes.iter().collect();
+    let sizes: Vec<(usize, usize)> = refs.iter().map(|s| animats_gpu::order::size(s)).collect();
+    let order = animats_gpu::order::by_size(&sizes);
+    assert_ne!(
+        order,
+        (0..refs.len()).collect::<Vec<_>>(),
+        "already in order: {sizes:?}"
+    );
+    let packed_order = std::cell::RefCell::new(Vec::new());
+    let run = |refs: &[&Scene]| {
+        packed_order.replace(
+            refs.iter()
+                .map(|s| animats_gpu::order::size(s))
+                .collect::<Vec<_>>(),
+        );
+        Batch::pack_scenes(refs)?.evaluate_cpu()
+    };
+    let plain = animats_gpu::order::evaluate_in_order(&refs, false, run).unwrap();
+    assert_eq!(*packed_order.borrow(), sizes);
+    let sorted = animats_gpu::order::evaluate_in_order(&refs, true, run).unwrap();
+    let mut increasing = sizes.clone();
+    increasing.sort();
+    assert_eq!(
+        *packed_order.borrow(),
+        increasing,
+        "not packed in order of size"
+    );
+    assert_eq!(format!("{plain:?}"), format!("{sorted:?}"));
+    assert!(distinct_distances(&plain) > 12, "{plain:?}");
+}
+
+#[test]
 fn skewed_oscillators_are_the_engine_s_to_the_bit() {
     // The walker with a duty per output (a quick stroke and a slow return),
     // its own genome and random ones, duties across [0.1, 0.9]; and the
