@@ -50,9 +50,11 @@
 # Two parts, for two calls of at most 5 minutes each: `bench/gpu.sh check`
 # (gpu_check and gpu_evaluate: bits and throughput) and `bench/gpu.sh
 # evolve` (the evolutions and the shipped scenes); no argument runs both.
-# A third, `bench/gpu.sh tune`, sweeps the kernel's knobs, and a fourth,
-# `bench/gpu.sh sort`, packs bodies of unlike sizes in order of size
-# (below). Device time is 15 minutes a session: check and evolve first.
+# A third, `bench/gpu.sh tune`, sweeps the kernel's knobs; a fourth,
+# `bench/gpu.sh sort`, packs bodies of unlike sizes in order of size; a
+# fifth, `bench/gpu.sh spread`, times small batches in blocks of 128 and
+# spread over every multiprocessor (below). Device time is 15 minutes a
+# session: check and evolve first, then spread and sort (2-3 minutes).
 # The C on the CPU is left out (ANIMATS_SKIP_C=1: CI proves it the
 # engine's bits; on the 16 cores, 2026-11-27, it took 15.69 s for 65,536
 # walkers against the engine's 19.12, 12.89 for 16,384 random bodies
@@ -62,7 +64,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 part=${1:-all}
-case $part in check|evolve|tune|sort|all) ;; *) echo "usage: bench/gpu.sh [check|evolve|tune|sort|all]" >&2; exit 2 ;; esac
+case $part in check|evolve|tune|sort|spread|all) ;; *) echo "usage: bench/gpu.sh [check|evolve|tune|sort|spread|all]" >&2; exit 2 ;; esac
 export ANIMATS_SKIP_C=${ANIMATS_SKIP_C:-1}
 SECONDS=0
 bin() {
@@ -134,6 +136,27 @@ if [ "$part" = sort ]; then
       echo "== [${SECONDS} s] ${knobs:-as they come}: ${run#target/*/}"
       # shellcheck disable=SC2086
       env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU|warps)"
+      rc=${PIPESTATUS[0]}
+      [ "$rc" -gt $status ] && status=$rc
+    done
+  done
+  echo "[${SECONDS} s] done, exit $status"
+  exit $status
+fi
+# `spread` (a call of its own, about 2 minutes; not part of `all`): small
+# batches in blocks of 128 threads (ANIMATS_GPU_BLOCK=128, as before
+# 2026-11-30) and as launched now, each block a warp or more so that every
+# multiprocessor gets one (animats_gpu::cuda::threads_a_block: 4,096
+# creatures on 128 of an H200's 132 multiprocessors instead of 32).
+if [ "$part" = spread ]; then
+  ANIMATS_SKIP_FAST=1 "$E" roobot 32 0.01 >/dev/null 2>&1 &
+  ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &
+  wait
+  for knobs in "ANIMATS_GPU_BLOCK=128" ""; do
+    for run in "$E raibert 4096 20" "$E jellyfish 4096 20" "$E rocks 512 2"; do
+      echo "== [${SECONDS} s] ${knobs:-spread}: ${run#target/*/}"
+      # shellcheck disable=SC2086
+      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU)"
       rc=${PIPESTATUS[0]}
       [ "$rc" -gt $status ] && status=$rc
     done

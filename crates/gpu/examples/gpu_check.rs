@@ -177,7 +177,11 @@ fn main() {
             std::process::exit(if bad == 0 { 2 } else { 1 });
         }
     };
-    println!("GPU tuning: {:?}", device.tuning());
+    println!(
+        "GPU tuning: {:?}; {} threads a block for this batch",
+        device.tuning(),
+        device.threads_a_block(creatures as usize)
+    );
     // Once to warm (the module is loaded; the first launch pays for it).
     let mut warm = packed.clone();
     if let Err(e) = device.run(&mut warm, 1) {

@@ -288,7 +288,11 @@ fn main() {
             std::process::exit(if bad == 0 { 2 } else { 1 });
         }
     };
-    println!("GPU tuning: {:?}", device.tuning());
+    println!(
+        "GPU tuning: {:?}; {} threads a block for this batch",
+        device.tuning(),
+        device.threads_a_block(count as usize)
+    );
     // Once to warm (the module is loaded; the first launch pays for it).
     let one = scene(kind, seconds, 0).unwrap_or_else(|e| fail(e));
     let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));

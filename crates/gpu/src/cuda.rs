@@ -71,7 +71,9 @@ pub struct Device {
 /// environment: `ANIMATS_GPU_REGS` (16 to 255: NVRTC's `--maxrregcount`,
 /// the registers a thread may hold, the rest spilled to local memory; part
 /// of a kept kernel's name) and `ANIMATS_GPU_BLOCK` (32 to 1024, a
-/// multiple of 32: threads a block, [`BLOCK`] unless set). Neither
+/// multiple of 32: threads a block; unless set, [`BLOCK`], or fewer for a
+/// launch too small to give every multiprocessor a block: see
+/// [`threads_a_block`]). Neither
 /// changes a bit of a result: they decide where values are kept and which
 /// threads run together, not the arithmetic. A block whose threads need
 /// more registers than a multiprocessor has (1,024 threads at 255) is
@@ -80,8 +82,8 @@ pub struct Device {
 pub struct Tuning {
     /// `--maxrregcount`, if set.
     pub regs: Option<u32>,
-    /// Threads a block.
-    pub block: u32,
+    /// Threads a block, if set; `None`: [`threads_a_block`] chooses.
+    pub block: Option<u32>,
 }
 
 impl Tuning {
@@ -123,8 +125,7 @@ impl Tuning {
                     "a multiple of 32 from 32 to 1024",
                 )
             })
-            .transpose()?
-            .unwrap_or(BLOCK);
+            .transpose()?;
         Ok(Tuning { regs, block })
     }
 }
@@ -137,6 +138,8 @@ struct Kernels {
     /// times the blocks of the evaluation each holds, times the block's threads):
     /// the threads of a [`Schedule::Queue`] launch.
     resident: i64,
+    /// The GPU's multiprocessors.
+    sms: i64,
 }
 
 /// How a GPU's threads share the evaluations of a batch. Either gives the
@@ -254,6 +257,13 @@ impl Device {
         self.tuning
     }
 
+    /// Threads a block in a launch of one thread per creature of
+    /// `creatures` ([`threads_a_block`] on this GPU, with its knob).
+    pub fn threads_a_block(&self, creatures: usize) -> u32 {
+        let n = i64::try_from(creatures).unwrap_or(i64::MAX);
+        threads_a_block(n, self.flat.sms, self.tuning.block)
+    }
+
     /// Whether its batches of scenes are packed in order of size
     /// (`ANIMATS_GPU_SORT=1`, [`crate::order`]).
     pub fn sorts(&self) -> bool {
@@ -280,8 +290,8 @@ impl Device {
         // SAFETY: the kernel reads and writes within the arrays just
         // uploaded, at the offsets `Batch::pack` checked; the arguments
         // match its signature (an_batch by value, two long longs, an int).
-        unsafe { launch.launch(config(creatures, self.tuning.block)?) }
-            .map_err(err("launching the step"))?;
+        let block = threads_a_block(creatures, kernels.sms, self.tuning.block);
+        unsafe { launch.launch(config(creatures, block)?) }.map_err(err("launching the step"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
         let failed = download_i64(s, &on_device, Array::Failed)?;
@@ -323,7 +333,8 @@ impl Device {
         // SAFETY: as in `run`; the kernel takes an_batch by value, one
         // long long, an int, the counter's device pointer and an int; with
         // the queue, threads take evaluations below `creatures` only.
-        unsafe { launch.launch(config(threads, self.tuning.block)?) }
+        let block = threads_a_block(threads, kernels.sms, self.tuning.block);
+        unsafe { launch.launch(config(threads, block)?) }
             .map_err(err("launching the evaluation"))?;
         let pos = download_f64(s, &on_device, Array::Pos)?;
         let vel = download_f64(s, &on_device, Array::Vel)?;
@@ -430,14 +441,16 @@ fn kernels(
             cudarc::driver::sys::CUdevice_attribute::CU_DEVICE_ATTRIBUTE_MULTIPROCESSOR_COUNT,
         )
         .map_or(1, |n| i64::from(n.max(1)));
+    let block = tuning.block.unwrap_or(BLOCK);
     let per_sm = evaluate
-        .occupancy_max_active_blocks_per_multiprocessor(tuning.block, 0, None)
+        .occupancy_max_active_blocks_per_multiprocessor(block, 0, None)
         .map_err(|e| format!("the evaluation's occupancy: {e}"))?
         .max(1);
     Ok(Kernels {
         step,
         evaluate,
-        resident: sms * i64::from(per_sm) * i64::from(tuning.block),
+        resident: sms * i64::from(per_sm) * i64::from(block),
+        sms,
     })
 }
 
@@ -482,6 +495,24 @@ fn upload(s: &Arc<CudaStream>, batch: &Batch) -> Result<(Vec<OnDevice>, DeviceBa
 
 /// Threads in a block (unless `ANIMATS_GPU_BLOCK` says otherwise).
 const BLOCK: u32 = 128;
+
+/// Threads a block for a launch of `threads` on a GPU of `sms`
+/// multiprocessors: `set` where `ANIMATS_GPU_BLOCK` set it; else
+/// [`BLOCK`], or, for a launch of fewer than `sms` × [`BLOCK`] threads,
+/// the most whole warps a block that still make a block for every
+/// multiprocessor (one warp where even that makes fewer). The GPU places a launch's blocks on its
+/// multiprocessors one by one, so 4,096 creatures in blocks of 128 run
+/// on 32 of an H200's 132 multiprocessors, four warps on each, the rest
+/// idle; in blocks of 32, on 128 of them. A thread's work, its arithmetic
+/// and its bits are the same in any block.
+pub fn threads_a_block(threads: i64, sms: i64, set: Option<u32>) -> u32 {
+    if let Some(block) = set {
+        return block;
+    }
+    // The most warps a block with at least `sms` blocks in all.
+    let warps = (threads.max(0) as u64) / (32 * sms.max(1) as u64);
+    32 * warps.clamp(1, u64::from(BLOCK / 32)) as u32
+}
 
 /// One thread per creature, in blocks of `threads`.
 fn config(creatures: i64, threads: u32) -> Result<LaunchConfig, String> {
@@ -614,7 +645,7 @@ mod tests {
         assert!(!s.contains("#include"));
     }
 
-    use super::{config, Tuning, BLOCK};
+    use super::{config, threads_a_block, Tuning, BLOCK};
 
     #[test]
     fn the_tuning_knobs_take_what_a_gpu_can_run_and_name_what_they_refuse() {
@@ -623,28 +654,28 @@ mod tests {
             t(None, None),
             Ok(Tuning {
                 regs: None,
-                block: BLOCK
+                block: None
             })
         );
         assert_eq!(
             t(Some("128"), Some("256")),
             Ok(Tuning {
                 regs: Some(128),
-                block: 256
+                block: Some(256)
             })
         );
         assert_eq!(
             t(Some(" 16 "), Some("1024")),
             Ok(Tuning {
                 regs: Some(16),
-                block: 1024
+                block: Some(1024)
             })
         );
         assert_eq!(
             t(Some("255"), Some("32")),
             Ok(Tuning {
                 regs: Some(255),
-                block: 32
+                block: Some(32)
             })
         );
         for (r, b, name) in [
@@ -661,6 +692,44 @@ mod tests {
             assert!(e.starts_with(name), "{e}");
             assert!(e.contains("got"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_small_launch_is_spread_over_every_multiprocessor_in_whole_warps() {
+        // An H200's 132 multiprocessors.
+        for (threads, block) in [
+            (1, 32),
+            (512, 32),
+            (2_048, 32),
+            (4_096, 32),
+            (4_225, 32),
+            (8_192, 32),
+            (8_448, 64),
+            (16_384, 96),
+            (16_896, 128),
+            (65_536, BLOCK),
+            (10_000_000, BLOCK),
+        ] {
+            let b = threads_a_block(threads, 132, None);
+            assert_eq!(b, block, "{threads} threads");
+            let blocks = (threads as u64).div_ceil(u64::from(b));
+            // Every multiprocessor gets a block where there are enough
+            // warps, and a smaller block would not give more of them one.
+            assert!(
+                blocks >= 132.min((threads as u64).div_ceil(32)),
+                "{threads}: {blocks} blocks"
+            );
+            // And no larger block would.
+            if b < BLOCK {
+                assert!(
+                    (threads as u64).div_ceil(u64::from(b + 32)) < 132,
+                    "{threads}"
+                );
+            }
+        }
+        // Set by ANIMATS_GPU_BLOCK: as set, whatever the launch.
+        assert_eq!(threads_a_block(512, 132, Some(256)), 256);
+        assert_eq!(threads_a_block(0, 0, None), 32);
     }
 
     #[test]

@@ -128,12 +128,12 @@ mod tests {
         let mut sizes = vec![1; 31];
         sizes.push(32);
         assert_eq!(warp_busy(&sizes), 63.0 / 1024.0);
-        // Sorted, two warps: 31 of 1 and one 32; 32 of 32 each at full.
-        let mut two = sizes.clone();
-        two.extend(vec![32; 32]);
-        let unsorted = warp_busy(&two);
+        // 1, 32, 1, 32, …: each warp (16 + 16 × 32) / (32 × 32); in
+        // order, a warp of ones and a warp of 32s, both full.
+        let mut two: Vec<usize> = (0..64).map(|k| if k % 2 == 0 { 1 } else { 32 }).collect();
+        assert_eq!(warp_busy(&two), 528.0 / 1024.0);
         two.sort();
-        assert!(warp_busy(&two) > unsorted, "{} {unsorted}", warp_busy(&two));
+        assert_eq!(warp_busy(&two), 1.0);
         // A last warp of fewer than 32 counts its empty lanes as idle.
         assert_eq!(warp_busy(&[4; 16]), 0.5);
         assert_eq!(warp_busy(&[]), 0.0);
