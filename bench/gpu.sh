@@ -145,9 +145,10 @@ if [ "$part" = sort ]; then
 fi
 # `spread` (a call of its own, about 2 minutes; not part of `all`): small
 # batches in blocks of 128 threads (ANIMATS_GPU_BLOCK=128, as before
-# 2026-11-30) and as launched now, each block a warp or more so that every
-# multiprocessor gets one (animats_gpu::cuda::threads_a_block: 4,096
-# creatures on 128 of an H200's 132 multiprocessors instead of 32).
+# 2026-11-30) and as launched now, in blocks that put the fewest warps on
+# the busiest multiprocessor (animats_gpu::cuda::threads_a_block: 4,096
+# creatures in blocks of 32 on 128 of an H200's 132 multiprocessors
+# instead of 32 blocks of 128).
 if [ "$part" = spread ]; then
   ANIMATS_SKIP_FAST=1 "$E" roobot 32 0.01 >/dev/null 2>&1 &
   ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &

@@ -497,21 +497,38 @@ fn upload(s: &Arc<CudaStream>, batch: &Batch) -> Result<(Vec<OnDevice>, DeviceBa
 const BLOCK: u32 = 128;
 
 /// Threads a block for a launch of `threads` on a GPU of `sms`
-/// multiprocessors: `set` where `ANIMATS_GPU_BLOCK` set it; else
-/// [`BLOCK`], or, for a launch of fewer than `sms` × [`BLOCK`] threads,
-/// the most whole warps a block that still make a block for every
-/// multiprocessor (one warp where even that makes fewer). The GPU places a launch's blocks on its
-/// multiprocessors one by one, so 4,096 creatures in blocks of 128 run
-/// on 32 of an H200's 132 multiprocessors, four warps on each, the rest
-/// idle; in blocks of 32, on 128 of them. A thread's work, its arithmetic
-/// and its bits are the same in any block.
+/// multiprocessors: `set` where `ANIMATS_GPU_BLOCK` set it; else the
+/// whole warps a block, up to [`BLOCK`], that put the fewest warps on the
+/// busiest multiprocessor, the larger block where two tie. The GPU deals
+/// a launch's blocks out to its multiprocessors in turn, so `b` warps a
+/// block put ⌈⌈warps / b⌉ / sms⌉ × b on the busiest, and with warps that
+/// take alike the launch lasts as long as that one's. 4,096 creatures in
+/// blocks of 128 ran on 32 of an H200's 132 multiprocessors, four warps
+/// on each, the rest idle; in blocks of 32, one warp on each of 128. A
+/// large launch keeps [`BLOCK`] (65,536: 16 warps on the busiest in
+/// blocks of one warp or four alike). A thread's work, its arithmetic and
+/// its bits are the same in any block.
 pub fn threads_a_block(threads: i64, sms: i64, set: Option<u32>) -> u32 {
     if let Some(block) = set {
         return block;
     }
-    // The most warps a block with at least `sms` blocks in all.
-    let warps = (threads.max(0) as u64) / (32 * sms.max(1) as u64);
-    32 * warps.clamp(1, u64::from(BLOCK / 32)) as u32
+    let warps = (threads.max(1) as u64).div_ceil(32);
+    let sms = sms.max(1) as u64;
+    let busiest = |b: u64| warps.div_ceil(b).div_ceil(sms) * b;
+    let most = u64::from(BLOCK / 32);
+    // Ties go to the larger block: searched from the largest down, a
+    // smaller one taken only when it puts strictly fewer on the busiest.
+    let b = (1..=most).rev().fold(
+        most,
+        |best, b| {
+            if busiest(b) < busiest(best) {
+                b
+            } else {
+                best
+            }
+        },
+    );
+    32 * b as u32
 }
 
 /// One thread per creature, in blocks of `threads`.
@@ -695,38 +712,39 @@ mod tests {
     }
 
     #[test]
-    fn a_small_launch_is_spread_over_every_multiprocessor_in_whole_warps() {
-        // An H200's 132 multiprocessors.
-        for (threads, block) in [
-            (1, 32),
-            (512, 32),
-            (2_048, 32),
-            (4_096, 32),
-            (4_225, 32),
-            (8_192, 32),
-            (8_448, 64),
-            (16_384, 96),
-            (16_896, 128),
-            (65_536, BLOCK),
-            (10_000_000, BLOCK),
+    fn a_launch_puts_the_fewest_warps_on_its_busiest_multiprocessor() {
+        // An H200's 132 multiprocessors: (threads, block, warps on the
+        // busiest multiprocessor).
+        for (threads, block, busiest) in [
+            (1, 32, 1),
+            (512, 32, 1),
+            (2_048, 32, 1),
+            (4_096, 32, 1),
+            (4_225, 64, 2),
+            (8_192, 64, 2),
+            (8_448, 64, 2),
+            (16_384, 128, 4),
+            (16_896, 128, 4),
+            (65_536, BLOCK, 16),
+            (10_000_000, BLOCK, 2_368),
         ] {
             let b = threads_a_block(threads, 132, None);
             assert_eq!(b, block, "{threads} threads");
-            let blocks = (threads as u64).div_ceil(u64::from(b));
-            // Every multiprocessor gets a block where there are enough
-            // warps, and a smaller block would not give more of them one.
-            assert!(
-                blocks >= 132.min((threads as u64).div_ceil(32)),
-                "{threads}: {blocks} blocks"
-            );
-            // And no larger block would.
-            if b < BLOCK {
-                assert!(
-                    (threads as u64).div_ceil(u64::from(b + 32)) < 132,
-                    "{threads}"
-                );
+            let on_busiest = |b: u32| {
+                let blocks = (threads as u64).div_ceil(u64::from(b));
+                blocks.div_ceil(132) * u64::from(b / 32)
+            };
+            assert_eq!(on_busiest(b), busiest, "{threads} threads");
+            // No other block puts fewer there, nor as few in a larger block.
+            for other in (32..=BLOCK).step_by(32) {
+                assert!(on_busiest(other) >= on_busiest(b), "{threads}: {other}");
+                if other > b {
+                    assert!(on_busiest(other) > on_busiest(b), "{threads}: {other}");
+                }
             }
         }
+        // Blocks of 128 left 100 of the 132 idle for 4,096 creatures.
+        assert_eq!((4_096u64).div_ceil(128), 32);
         // Set by ANIMATS_GPU_BLOCK: as set, whatever the launch.
         assert_eq!(threads_a_block(512, 132, Some(256)), 256);
         assert_eq!(threads_a_block(0, 0, None), 32);
