@@ -227,6 +227,7 @@ for device in cpu cuda; do
   rc=$?
   t1=$(date +%s.%N)
   tail -3 "$T/$device.txt"
+  grep -E "^(GPU layout|note):" "$T/$device.txt" || true
   echo "wall $(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.2f", b - a }') s, exit $rc"
   if [ $rc -eq 0 ]; then
     echo "best distance $(best_of "$T/$device") m"

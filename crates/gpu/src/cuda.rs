@@ -65,6 +65,9 @@ pub struct Device {
     /// Whether [`Device::into_batches`] packs each batch in order of size
     /// (`ANIMATS_GPU_SORT`, [`crate::order`]).
     sort: bool,
+    /// The layout [`Device::into_batches`] fixes (`ANIMATS_GPU_LAYOUT`);
+    /// `None`: learned ([`crate::layout_choice`]).
+    layout: Option<crate::Layout>,
 }
 
 /// Two knobs for measuring on a GPU, read by [`Device::open`] from the
@@ -193,6 +196,7 @@ impl Device {
         let name = ctx.name().unwrap_or_else(|_| "an NVIDIA GPU".into());
         let tuning = Tuning::from_env()?;
         let sort = crate::order::sort_from_env()?;
+        let layout = crate::layout_choice::layout_from_env()?;
         let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode, tuning)?;
         Ok(Device {
             stream: ctx.default_stream(),
@@ -207,6 +211,7 @@ impl Device {
             schedule: Schedule::default(),
             tuning,
             sort,
+            layout,
         })
     }
 
@@ -354,18 +359,42 @@ impl Device {
     /// ([`animats_scene::evaluate::Batches`]): each batch of scenes packed
     /// ([`Batch::pack_scenes`]) and evaluated here, one batch at a time;
     /// in order of size where [`Device::sorts`], the evaluations handed
-    /// back in the scenes' own order either way.
+    /// back in the scenes' own order either way; each layout tried on one
+    /// batch and the faster kept ([`crate::layout_choice`]) unless
+    /// `ANIMATS_GPU_LAYOUT` fixes one.
     pub fn into_batches(self) -> animats_scene::evaluate::Batches {
+        self.into_batches_with(|_| ())
+    }
+
+    /// [`Device::into_batches`], the line saying which layout was chosen,
+    /// and why, given to `say` once.
+    pub fn into_batches_with(
+        self,
+        say: impl Fn(String) + Send + Sync + 'static,
+    ) -> animats_scene::evaluate::Batches {
         let sort = self.sort;
-        let device = std::sync::Mutex::new(self);
+        let choice = crate::layout_choice::LayoutChoice::new(self.layout);
+        let runner = std::sync::Mutex::new((self, choice));
         animats_scene::evaluate::Batches(Arc::new(move |scenes| {
             let refs: Vec<&animats_scene::Scene> = scenes.iter().collect();
             crate::order::evaluate_in_order(&refs, sort, |refs| {
                 let mut batch = Batch::pack_scenes(refs)?;
-                let device = device
+                let mut runner = runner
                     .lock()
                     .map_err(|_| "an earlier evaluation on the GPU panicked".to_string())?;
-                device.evaluate(&mut batch)
+                let (device, choice) = &mut *runner;
+                let layout = choice.next();
+                batch.set_layout(layout);
+                // The kernel compiled first (a batch's first needs it), so
+                // that the clock times the evaluation alone.
+                device.kernels(&batch)?;
+                let t = std::time::Instant::now();
+                let evaluations = device.evaluate(&mut batch)?;
+                let simulated: f64 = evaluations.iter().map(|e| e.time).sum();
+                if let Some(line) = choice.record(layout, t.elapsed().as_secs_f64(), simulated) {
+                    say(line);
+                }
+                Ok(evaluations)
             })
         }))
     }

@@ -37,6 +37,7 @@
 pub mod bodies;
 pub mod cache;
 pub mod cuda;
+pub mod layout_choice;
 pub mod order;
 mod pack;
 pub mod ported;
