@@ -74,8 +74,8 @@ pub struct Device {
 /// environment: `ANIMATS_GPU_REGS` (16 to 255: NVRTC's `--maxrregcount`,
 /// the registers a thread may hold, the rest spilled to local memory; part
 /// of a kept kernel's name) and `ANIMATS_GPU_BLOCK` (32 to 1024, a
-/// multiple of 32: threads a block; unless set, [`BLOCK`], or fewer for a
-/// launch too small to give every multiprocessor a block: see
+/// multiple of 32: threads a block; unless set, [`BLOCK`], or fewer where
+/// that puts fewer warps on the busiest multiprocessor: see
 /// [`threads_a_block`]). Neither
 /// changes a bit of a result: they decide where values are kept and which
 /// threads run together, not the arithmetic. A block whose threads need

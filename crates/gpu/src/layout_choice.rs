@@ -4,9 +4,9 @@
 //! jellyfish 2.3×, in the batch's arrays the walker 20 % faster and
 //! bodies of mixed sizes 39 %; docs/GPU.md), and both give the same bits.
 //! So, unless `ANIMATS_GPU_LAYOUT` fixes one, a run tries each on one
-//! batch, in turn, and keeps the one that took less time per simulated
-//! creature-second for the rest: the first batches of an evolution are
-//! the generations that measure it.
+//! batch, in turn, after a first batch that warms the GPU, and keeps the
+//! one that took less time per simulated creature-second for the rest:
+//! an evolution's first three generations measure it.
 
 use crate::Layout;
 
@@ -17,6 +17,9 @@ const ORDER: [Layout; 2] = [Layout::Local, Layout::Batch];
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LayoutChoice {
     fixed: Option<Layout>,
+    /// Whether a batch has run: the first is not timed (it pays for the
+    /// kernel's first launch, loading it onto the GPU, whichever layout).
+    warm: bool,
     /// Each layout tried, with its seconds per simulated creature-second.
     tried: Vec<(Layout, f64)>,
 }
@@ -26,6 +29,7 @@ impl LayoutChoice {
     pub fn new(fixed: Option<Layout>) -> LayoutChoice {
         LayoutChoice {
             fixed,
+            warm: false,
             tried: Vec::new(),
         }
     }
@@ -49,10 +53,14 @@ impl LayoutChoice {
     }
 
     /// A batch in `layout` took `seconds` to simulate `simulated`
-    /// creature-seconds. Learned while the layout is untried (a batch
-    /// that simulated nothing teaches nothing); when the last is learned,
-    /// a line saying what was measured and chosen.
+    /// creature-seconds. Learned while the layout is untried, but for the
+    /// run's first batch (a batch that simulated nothing teaches nothing
+    /// either); when the last is learned, a line saying what was measured
+    /// and chosen.
     pub fn record(&mut self, layout: Layout, seconds: f64, simulated: f64) -> Option<String> {
+        if !std::mem::replace(&mut self.warm, true) {
+            return None;
+        }
         if self.fixed.is_some()
             || self.tried.iter().any(|(t, _)| *t == layout)
             || !(simulated > 0.0 && seconds.is_finite() && seconds >= 0.0)
@@ -102,6 +110,9 @@ mod tests {
     fn each_layout_is_tried_once_then_the_faster_kept() {
         let mut c = LayoutChoice::new(None);
         assert_eq!(c.next(), Layout::Local);
+        // The first batch warms the GPU: not timed, Local again next.
+        assert_eq!(c.record(Layout::Local, 90.0, 1000.0), None);
+        assert_eq!(c.next(), Layout::Local);
         assert_eq!(c.record(Layout::Local, 2.0, 1000.0), None);
         assert_eq!(c.next(), Layout::Batch);
         let line = c.record(Layout::Batch, 1.5, 1000.0).unwrap();
@@ -121,11 +132,13 @@ mod tests {
     fn the_slower_per_simulated_second_loses_whatever_the_batch_s_size() {
         // Batch took less time, but for a tenth of the simulation.
         let mut c = LayoutChoice::new(None);
+        c.record(Layout::Local, 1.0, 1.0);
         c.record(Layout::Local, 10.0, 10_000.0);
         c.record(Layout::Batch, 2.0, 1_000.0);
         assert_eq!(c.next(), Layout::Local);
         // A tie keeps the first tried.
         let mut c = LayoutChoice::new(None);
+        c.record(Layout::Local, 9.0, 1.0);
         c.record(Layout::Local, 1.0, 1.0);
         c.record(Layout::Batch, 1.0, 1.0);
         assert_eq!(c.next(), Layout::Local);
@@ -134,9 +147,12 @@ mod tests {
     #[test]
     fn a_batch_that_simulated_nothing_is_tried_again() {
         let mut c = LayoutChoice::new(None);
+        c.record(Layout::Local, 1.0, 1.0);
         assert_eq!(c.record(Layout::Local, 0.1, 0.0), None);
         assert_eq!(c.record(Layout::Local, f64::NAN, 1.0), None);
         assert_eq!(c.next(), Layout::Local);
+        assert_eq!(c.record(Layout::Local, 1.0, 1.0), None);
+        assert_eq!(c.next(), Layout::Batch);
     }
 
     #[test]
@@ -144,6 +160,8 @@ mod tests {
         let mut c = LayoutChoice::new(Some(Layout::Batch));
         assert_eq!(c.next(), Layout::Batch);
         assert_eq!(c.record(Layout::Batch, 1.0, 1.0), None);
+        assert_eq!(c.record(Layout::Batch, 1.0, 1.0), None);
+        assert_eq!(c.record(Layout::Local, 1.0, 1.0), None);
         assert_eq!(c.next(), Layout::Batch);
     }
 
