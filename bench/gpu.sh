@@ -53,7 +53,7 @@
 # A third, `bench/gpu.sh tune`, sweeps the kernel's knobs; a fourth,
 # `bench/gpu.sh sort`, packs bodies of unlike sizes in order of size; a
 # fifth, `bench/gpu.sh spread`, times small batches in blocks of 128 and
-# spread over every multiprocessor (below). Device time is 15 minutes a
+# in the smaller blocks launched now (below). Device time is 15 minutes a
 # session: check and evolve first, then spread and sort (2-3 minutes).
 # The C on the CPU is left out (ANIMATS_SKIP_C=1: CI proves it the
 # engine's bits; on the 16 cores, 2026-11-27, it took 15.69 s for 65,536
