@@ -89,7 +89,7 @@ fn main() {
     };
     let mut worlds = worlds;
     if sorted {
-        worlds.sort_by_key(|w| (w.len(), w.forces().springs.len()));
+        worlds.sort_by_key(animats_gpu::order::world_size);
     }
     let total_particles: usize = worlds.iter().map(World::len).sum();
     let refs: Vec<&World> = worlds.iter().collect();

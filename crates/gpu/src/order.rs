@@ -16,7 +16,12 @@ use animats_scene::Scene;
 
 /// A scene's size as a GPU thread's loops see it: particles, then springs.
 pub fn size(scene: &Scene) -> (usize, usize) {
-    (scene.world.len(), scene.world.forces().springs.len())
+    world_size(&scene.world)
+}
+
+/// [`size`] of a world.
+pub fn world_size(world: &animats_engine::World) -> (usize, usize) {
+    (world.len(), world.forces().springs.len())
 }
 
 /// The indices of `keys` in increasing order of key, equal keys in their

@@ -346,8 +346,8 @@ fn random_evolved_bodies_are_the_engine_s_to_the_bit() {
 fn bodies_packed_in_order_of_size_answer_in_their_own_order_with_the_same_bits() {
     // What `ANIMATS_GPU_SORT=1` does on a GPU, with the C on the CPU:
     // random bodies of unlike sizes packed smallest first, the answers
-    // handed back in the scenes' order, each one's bits as packed as they
-    // came.
+    // handed back in the scenes' order, each the same bits as when the
+    // scenes are packed in the order they came.
     let text = BODIES_WALK.replace("duration = 10.0", "duration = 1.0");
     let problem = MorphologyProblem::parse(&text, "bodies_walk.toml").unwrap();
     let scenes = random_bodies(&problem, 5, 24);
