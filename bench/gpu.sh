@@ -85,6 +85,26 @@ echo "machine: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //
 command -v lscpu >/dev/null && lscpu | grep -E '^(Thread\(s\) per core|Core\(s\) per socket|Socket\(s\)):' | tr -s ' ' | paste -sd ';' -
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 status=0
+# `sweep LABEL KEEP KNOBS... -- RUNS...`: each run under each setting of
+# the knobs (an empty setting printed as LABEL), fast mode left out, the
+# lines matching KEEP printed; then exit with the worst exit status.
+sweep() {
+  local label=$1 keep=$2 settings=() knobs run rc
+  shift 2
+  while [ "$1" != -- ]; do settings+=("$1"); shift; done
+  shift
+  for knobs in "${settings[@]}"; do
+    for run in "$@"; do
+      echo "== [${SECONDS} s] ${knobs:-$label}: ${run#target/*/}"
+      # shellcheck disable=SC2086
+      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^($keep)"
+      rc=${PIPESTATUS[0]}
+      [ "$rc" -gt $status ] && status=$rc
+    done
+  done
+  echo "[${SECONDS} s] done, exit $status"
+  exit $status
+}
 # NVRTC takes 20 s or so for each kernel (the flat floor's, terrain's,
 # sphere contact's, implicit Euler's; strict and fast): compiled side by
 # side into the cache first, each by a tiny run, rather than one after
@@ -111,17 +131,8 @@ if [ "$part" = tune ]; then
     env $knobs "$B" 32 1 20 >/dev/null 2>&1 &
   done
   wait
-  for knobs in "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256"; do
-    for run in "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"; do
-      echo "== [${SECONDS} s] ${knobs:-defaults}: ${run#target/*/}"
-      # shellcheck disable=SC2086
-      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU)"
-      rc=${PIPESTATUS[0]}
-      [ "$rc" -gt $status ] && status=$rc
-    done
-  done
-  echo "[${SECONDS} s] done, exit $status"
-  exit $status
+  sweep defaults "engine|GPU" "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256" \
+    -- "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"
 fi
 # `sort` (a call of its own, about a minute; not part of `all`): bodies of
 # unlike sizes packed as they come and in order of size
@@ -131,17 +142,7 @@ fi
 # in order; random land bodies 70.5 % and 99.2 %).
 if [ "$part" = sort ]; then
   "$B" 32 1 20 >/dev/null 2>&1
-  for knobs in "" "ANIMATS_GPU_SORT=1"; do
-    for run in "$B 16384 1000 0" "$E bodies 16384 10"; do
-      echo "== [${SECONDS} s] ${knobs:-as they come}: ${run#target/*/}"
-      # shellcheck disable=SC2086
-      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU|warps)"
-      rc=${PIPESTATUS[0]}
-      [ "$rc" -gt $status ] && status=$rc
-    done
-  done
-  echo "[${SECONDS} s] done, exit $status"
-  exit $status
+  sweep "as they come" "engine|GPU|warps" "" "ANIMATS_GPU_SORT=1" -- "$B 16384 1000 0" "$E bodies 16384 10"
 fi
 # `spread` (a call of its own, about 2 minutes; not part of `all`): small
 # batches in blocks of 128 threads (ANIMATS_GPU_BLOCK=128, as before
@@ -153,17 +154,7 @@ if [ "$part" = spread ]; then
   ANIMATS_SKIP_FAST=1 "$E" roobot 32 0.01 >/dev/null 2>&1 &
   ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &
   wait
-  for knobs in "ANIMATS_GPU_BLOCK=128" ""; do
-    for run in "$E raibert 4096 20" "$E jellyfish 4096 20" "$E rocks 512 2"; do
-      echo "== [${SECONDS} s] ${knobs:-spread}: ${run#target/*/}"
-      # shellcheck disable=SC2086
-      env $knobs ANIMATS_SKIP_FAST=1 $run | grep -E "^(engine|GPU)"
-      rc=${PIPESTATUS[0]}
-      [ "$rc" -gt $status ] && status=$rc
-    done
-  done
-  echo "[${SECONDS} s] done, exit $status"
-  exit $status
+  sweep spread "engine|GPU" "ANIMATS_GPU_BLOCK=128" "" -- "$E raibert 4096 20" "$E jellyfish 4096 20" "$E rocks 512 2"
 fi
 warm
 if [ "$part" != evolve ]; then
