@@ -224,14 +224,11 @@ fn main() {
     report("engine, every core:", on_engine);
     // A warp's 32 threads step until its longest evaluation ends: the share
     // of their steps that evaluate something (creatures in batch order).
-    let lengths: Vec<f64> = engine.iter().map(|e| (e.time / dt).round()).collect();
-    let busy: f64 = lengths
-        .chunks(32)
-        .map(|w| {
-            w.iter().sum::<f64>() / (32.0 * w.iter().fold(0.0, |a: f64, &b| a.max(b))).max(1.0)
-        })
-        .sum::<f64>()
-        / lengths.len().div_ceil(32) as f64;
+    let lengths: Vec<usize> = engine
+        .iter()
+        .map(|e| (e.time / dt).round() as usize)
+        .collect();
+    let busy = animats_gpu::order::warp_busy(&lengths);
     println!(
         "warps of 32 busy {:.1} % of their steps (evaluations end at different times); {:.1} % of their lanes in loops over particles (sizes differ)",
         100.0 * busy,
