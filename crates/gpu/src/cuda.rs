@@ -269,12 +269,6 @@ impl Device {
         threads_a_block(n, self.flat.sms, self.tuning.block)
     }
 
-    /// Whether its batches of scenes are packed in order of size
-    /// (`ANIMATS_GPU_SORT=1`, [`crate::order`]).
-    pub fn sorts(&self) -> bool {
-        self.sort
-    }
-
     /// How [`Device::evaluate`] shares a batch's evaluations among the
     /// GPU's threads ([`Schedule::Static`] unless set).
     pub fn set_schedule(&mut self, schedule: Schedule) {
@@ -358,7 +352,7 @@ impl Device {
     /// The device as a problem's evaluation runner
     /// ([`animats_scene::evaluate::Batches`]): each batch of scenes packed
     /// ([`Batch::pack_scenes`]) and evaluated here, one batch at a time;
-    /// in order of size where [`Device::sorts`], the evaluations handed
+    /// in order of size where `ANIMATS_GPU_SORT=1` ([`crate::order`]), the evaluations handed
     /// back in the scenes' own order either way; each layout tried on one
     /// batch and the faster kept ([`crate::layout_choice`]) unless
     /// `ANIMATS_GPU_LAYOUT` fixes one.
