@@ -74,7 +74,7 @@ pub struct Device {
 /// environment: `ANIMATS_GPU_REGS` (16 to 255: NVRTC's `--maxrregcount`,
 /// the registers a thread may hold, the rest spilled to local memory; part
 /// of a kept kernel's name) and `ANIMATS_GPU_BLOCK` (32 to 1024, a
-/// multiple of 32: threads a block; unless set, [`BLOCK`], or fewer where
+/// multiple of 32: threads a block; unless set, 128 (`BLOCK`), or fewer where
 /// that puts fewer warps on the busiest multiprocessor: see
 /// [`threads_a_block`]). Neither
 /// changes a bit of a result: they decide where values are kept and which
@@ -521,14 +521,14 @@ const BLOCK: u32 = 128;
 
 /// Threads a block for a launch of `threads` on a GPU of `sms`
 /// multiprocessors: `set` where `ANIMATS_GPU_BLOCK` set it; else the
-/// whole warps a block, up to [`BLOCK`], that put the fewest warps on the
+/// whole warps a block, up to 128 (`BLOCK`), that put the fewest warps on the
 /// busiest multiprocessor, the larger block where two tie. The GPU deals
 /// a launch's blocks out to its multiprocessors in turn, so `b` warps a
 /// block put ⌈⌈warps / b⌉ / sms⌉ × b on the busiest, and with warps that
 /// take alike the launch lasts as long as that one's. 4,096 creatures in
 /// blocks of 128 ran on 32 of an H200's 132 multiprocessors, four warps
 /// on each, the rest idle; in blocks of 32, one warp on each of 128. A
-/// large launch keeps [`BLOCK`] (65,536: 16 warps on the busiest in
+/// large launch keeps 128 (65,536: 16 warps on the busiest in
 /// blocks of one warp or four alike). A thread's work, its arithmetic and
 /// its bits are the same in any block.
 pub fn threads_a_block(threads: i64, sms: i64, set: Option<u32>) -> u32 {
