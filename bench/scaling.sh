@@ -83,8 +83,8 @@ if [ "${CEILING:-1}" != 0 ] && [ "$N" -gt 1 ]; then
   echo "machine ceiling: $N copies of a 1-thread run at once, against one alone (--no-check)"
   echo "| run | one alone | $N at once | ceiling at $N |"
   echo "|---|---|---|---|"
-  for row in "roobot|--optimiser cma-es --lanes 16 --generations 40 --seed 1" \
-             "walker|scenes/walker.toml --optimiser cma-es --lanes 16 --generations 10 --seed 1"; do
+  # The first two rows: the roobot and the walker.
+  for row in "${rows[0]}" "${rows[1]}"; do
     name=${row%%|*}; args=${row#*|}
     start=$(date +%s.%N)
     # shellcheck disable=SC2086
