@@ -96,10 +96,19 @@ impl Force for NBodyGravity {
         self.resolve(ctx.pos.len());
         let eps2 = self.softening * self.softening;
         let (pos, mass) = (ctx.pos, &ctx.particles.mass);
-        let s = &mut self.scratch;
+        let g = self.g;
         // A set that fills no more than one block of lanes is summed
-        // straight from the particles (the same bits, none of the
-        // kernel's copying and padding); a larger one by the kernel.
+        // straight from the particles into the forces (the same bits,
+        // none of the kernel's copying and padding); a larger one by the
+        // kernel.
+        let indices = &self.indices;
+        if pairs::for_small(indices, pos, mass, eps2, &mut |k, a| {
+            let i = indices[k] as usize;
+            forces[i] += DVec3::from_array(a) * (g * mass[i]);
+        }) {
+            return;
+        }
+        let s = &mut self.scratch;
         s.sum_small(&self.indices, pos, mass, eps2);
         for (k, &i) in self.indices.iter().enumerate() {
             let i = i as usize;
@@ -128,5 +137,69 @@ impl Force for NBodyGravity {
 
     fn name(&self) -> &str {
         "n-body gravity"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{ParticleDef, ParticleId, World};
+
+    /// Sets of 1 to 9 bodies, out of order, two of them at one place: what
+    /// `apply` adds to each body's force is the kernel's sum (copied into
+    /// padded lanes, `Pairs::load` and `Pairs::sum`) times G mᵢ, bit for
+    /// bit, softened or not; the other particles' forces are untouched.
+    #[test]
+    fn small_sets_add_the_kernel_s_forces() {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut u = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        let mut world = World::new();
+        for _ in 0..12 {
+            let def = ParticleDef::new(1.0 + u()).at(DVec3::new(u(), u(), u()));
+            world.add_particle(def).expect("a valid particle");
+        }
+        let mut pos: Vec<DVec3> = world.state().pos.clone();
+        pos[3] = pos[7];
+        let vel = vec![DVec3::ZERO; pos.len()];
+        let start: Vec<DVec3> = (0..pos.len()).map(|_| DVec3::new(u(), u(), u())).collect();
+        let ctx = ForceContext {
+            t: 0.0,
+            dt: 1e-3,
+            pos: &pos,
+            vel: &vel,
+            particles: world.particles(),
+            gravity: DVec3::ZERO,
+        };
+        let mass = &world.particles().mass;
+        for n in 1..=9 {
+            for softening in [0.0, 0.03] {
+                let idx = [7u32, 3, 11, 0, 5, 9, 1, 10, 4][..n].to_vec();
+                let ids = idx.iter().map(|&i| ParticleId(i));
+                let mut force = NBodyGravity::new(0.7, softening, Targets::only(ids));
+                let mut got = start.clone();
+                force.apply(&ctx, &mut got);
+                let mut kernel = Pairs::default();
+                kernel.load(&idx, &pos, mass);
+                kernel.sum(softening * softening);
+                let mut want = start.clone();
+                for (k, &i) in idx.iter().enumerate() {
+                    let a = DVec3::new(kernel.ax[k], kernel.ay[k], kernel.az[k]);
+                    want[i as usize] += a * (0.7 * mass[i as usize]);
+                }
+                let bits = |f: &[DVec3]| -> Vec<[u64; 3]> {
+                    f.iter().map(|v| v.to_array().map(f64::to_bits)).collect()
+                };
+                assert_eq!(bits(&got), bits(&want), "{n} bodies, softening {softening}");
+                // (The first two are at one place.)
+                if n > 2 {
+                    assert_ne!(bits(&got), bits(&start), "{n} bodies pull");
+                }
+            }
+        }
     }
 }

@@ -167,37 +167,58 @@ impl Pairs {
     /// and summed by the kernel.
     pub fn sum_small(&mut self, indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) {
         let n = indices.len();
-        const { assert!(LANES == 8, "one arm of `sum_small` a size") };
         for v in [&mut self.ax, &mut self.ay, &mut self.az] {
             if v.len() != n {
                 v.clear();
                 v.resize(n, 0.0);
             }
         }
-        let out = [&mut self.ax[..], &mut self.ay[..], &mut self.az[..]];
-        match n {
-            0 => {}
-            1 => out.into_iter().for_each(|a| a[0] = 0.0),
-            2 => small::<2>(indices, pos, mass, eps2, out),
-            3 => small::<3>(indices, pos, mass, eps2, out),
-            4 => small::<4>(indices, pos, mass, eps2, out),
-            5 => small::<5>(indices, pos, mass, eps2, out),
-            6 => small::<6>(indices, pos, mass, eps2, out),
-            7 => small::<7>(indices, pos, mass, eps2, out),
-            8 => small::<8>(indices, pos, mass, eps2, out),
+        let mut out = |k: usize, a: [f64; 3]| {
+            (self.ax[k], self.ay[k], self.az[k]) = (a[0], a[1], a[2]);
+        };
+        if n == 1 {
+            out(0, [0.0; 3]);
+        } else if !for_small(indices, pos, mass, eps2, &mut out) && n > 0 {
             // More than a block of lanes: the kernel (the same bits).
-            _ => {
-                self.load(indices, pos, mass);
-                self.sum(eps2);
-                return;
-            }
+            self.load(indices, pos, mass);
+            self.sum(eps2);
+            return;
         }
         // The kernel's buffers are sized again by its next `load`.
         self.bounds.clear();
     }
 }
 
-/// [`Pairs::sum_small`] for `N` bodies: every array a fixed size, so the
+/// For a set of 2 to [`LANES`] bodies, hands `out` each body's Σ mⱼ dᵢⱼ /
+/// r³ (x, y, z; by its place in `indices`), summed straight from the
+/// particles by code of the set's size ([`small`]), and returns true;
+/// returns false, having done nothing, for any other size.
+#[inline(always)]
+pub(super) fn for_small(
+    indices: &[u32],
+    pos: &[DVec3],
+    mass: &[f64],
+    eps2: f64,
+    out: &mut impl FnMut(usize, [f64; 3]),
+) -> bool {
+    const { assert!(LANES == 8, "one arm of `for_small` a size") };
+    fn each<const N: usize>(a: [[f64; 3]; N], out: &mut impl FnMut(usize, [f64; 3])) -> bool {
+        a.into_iter().enumerate().for_each(|(k, a)| out(k, a));
+        true
+    }
+    match indices.len() {
+        2 => each(small::<2>(indices, pos, mass, eps2), out),
+        3 => each(small::<3>(indices, pos, mass, eps2), out),
+        4 => each(small::<4>(indices, pos, mass, eps2), out),
+        5 => each(small::<5>(indices, pos, mass, eps2), out),
+        6 => each(small::<6>(indices, pos, mass, eps2), out),
+        7 => each(small::<7>(indices, pos, mass, eps2), out),
+        8 => each(small::<8>(indices, pos, mass, eps2), out),
+        _ => false,
+    }
+}
+
+/// [`Pairs::sum_small`] for `N` bodies, each body's Σ mⱼ dᵢⱼ / r³ (x, y, z): every array a fixed size, so the
 /// loops unroll and the lanes no pair writes (the row's own and those
 /// before it, and padding) are constants. Those lanes hold −0 and a pair's
 /// lane its term as it is, where the kernel's hold +0 and `+0 + term`:
@@ -206,13 +227,7 @@ impl Pairs {
 /// changed by a ±0 operand only when it is itself zero), which the final
 /// `+ 0.0` makes the kernel's +0.
 #[inline(always)]
-fn small<const N: usize>(
-    indices: &[u32],
-    pos: &[DVec3],
-    mass: &[f64],
-    eps2: f64,
-    [ax, ay, az]: [&mut [f64]; 3],
-) {
+fn small<const N: usize>(indices: &[u32], pos: &[DVec3], mass: &[f64], eps2: f64) -> [[f64; 3]; N] {
     let (mut p, mut m) = ([DVec3::ZERO; N], [0.0f64; N]);
     for q in 0..N {
         let i = indices[q] as usize;
@@ -240,13 +255,15 @@ fn small<const N: usize>(
             react[q][2] -= dz * wi;
         }
     }
+    let mut a = [[0.0f64; 3]; N];
     for k in 0..N {
-        for (c, out) in [&mut *ax, &mut *ay, &mut *az].into_iter().enumerate() {
+        for c in 0..3 {
             let own = tree(&lanes[k][c]) + 0.0;
             // The reactions of the rows before it (none for the first).
-            out[k] = if k > 0 { own + react[k][c] } else { own };
+            a[k][c] = if k > 0 { own + react[k][c] } else { own };
         }
     }
+    a
 }
 
 /// Whether `n` bodies are summed in parallel (more than one task's rows).
