@@ -91,8 +91,16 @@ pub(crate) fn step_small(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mu
     let f = &mut d.scratch.force;
     d.forces
         .evaluate(t, h, &from.pos, &from.vel, d.particles, f);
-    let w = &d.particles.inv_mass;
-    update(&from.pos, &from.vel, f, w, h, &mut to.pos, &mut to.vel)
+    let w3 = &d.particles.inv_mass3;
+    update(
+        flat(&from.pos),
+        flat(&from.vel),
+        flat(f),
+        w3,
+        h,
+        flat_mut(&mut to.pos),
+        flat_mut(&mut to.vel),
+    )
 }
 
 /// [`update`] of the particles `first..first + x1.len()` from `from`, with
