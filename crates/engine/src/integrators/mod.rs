@@ -177,8 +177,10 @@ impl Scratch {
     }
 }
 
-/// Worlds with fewer particles update particle by particle, as vectors
-/// (`DVec3`), in symplectic Euler and RK4: the positions are then stored as
+/// Worlds with fewer particles update particle by particle in RK4, as
+/// vectors (`DVec3`; symplectic Euler's small step runs over the flat
+/// coordinates, which measured faster with a force that does something,
+/// `symplectic::step_small`): the positions are then stored as
 /// the force loops read them (x and y together, then z), so each read is
 /// served from the store just made instead of waiting for it to reach the
 /// cache, and finiteness is checked as they are written. From about this

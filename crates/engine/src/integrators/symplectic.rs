@@ -84,8 +84,16 @@ pub(crate) fn step_then(
     }
 }
 
-/// [`step`] of a world of fewer than [`SMALL`] particles, particle by
-/// particle; true if every new coordinate is finite.
+/// [`step`] of a world of fewer than [`SMALL`] particles, over the flat
+/// coordinates (as a large world's pieces, in one loop); true if every new
+/// coordinate is finite. Particle by particle (`DVec3`, one inverse mass
+/// each) LLVM vectorised the loop with shuffles across the components:
+/// nbody5's step took 72 more instructions, and, alternated on an Intel
+/// Xeon (2 cores, 2026-11-30), 2 M steps with the built-in n-body force
+/// 0.236 against 0.208 s (medians of 21) and with the tutorial's user
+/// force 0.211 against 0.163 s (of 15); only a force that adds nothing
+/// (the `step_floor` example) stepped faster particle by particle, 41
+/// against 48 ns a step (medians of 10).
 #[inline(always)]
 pub(crate) fn step_small(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
     let f = &mut d.scratch.force;
