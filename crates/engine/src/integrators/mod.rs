@@ -402,6 +402,25 @@ mod tests {
             stepped.set_integrator(kind);
             stepped.step(1e-3).unwrap();
             assert_eq!(&to, stepped.state(), "{kind}");
+            // Each integrator's own `step` too (the small worlds' updates
+            // read the per-coordinate inverse masses).
+            let mut by_own = from.clone();
+            let mut d = Dynamics {
+                forces: &mut forces,
+                particles: &hand,
+                scratch: &mut scratch,
+                solver: Solver::default(),
+            };
+            match kind {
+                IntegratorKind::Euler => euler::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
+                IntegratorKind::Midpoint => midpoint::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
+                IntegratorKind::Rk4 => rk4::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
+                IntegratorKind::Symplectic => {
+                    symplectic::step(&mut d, 0.0, 1e-3, &from, &mut by_own)
+                }
+                IntegratorKind::Implicit => implicit::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
+            };
+            assert_eq!(&by_own, stepped.state(), "{kind}, its own step");
         }
     }
 }

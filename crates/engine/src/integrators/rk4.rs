@@ -10,9 +10,10 @@ use crate::simd::{chosen, Use};
 use glam::DVec3;
 
 /// One RK4 step of size `h` from time `t`; true if it knows every new
-/// coordinate to be finite (see [`super::integrate`]).
+/// coordinate to be finite: [`super::integrate`] with RK4 (which also
+/// takes properties filled in by hand).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    step_then(d, t, h, from, to, None).finite()
+    super::integrate(super::IntegratorKind::Rk4, d, t, h, from, to)
 }
 
 /// [`step`], then `finish` on each piece of the last stage (see

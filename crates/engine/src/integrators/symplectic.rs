@@ -9,9 +9,10 @@ use crate::simd::{chosen, Use};
 use glam::DVec3;
 
 /// One symplectic Euler step of size `h` from time `t`; true if it knows
-/// every new coordinate to be finite (see [`super::integrate`]).
+/// every new coordinate to be finite: [`super::integrate`] with
+/// symplectic Euler (which also takes properties filled in by hand).
 pub fn step(d: &mut Dynamics, t: f64, h: f64, from: &State, to: &mut State) -> bool {
-    step_then(d, t, h, from, to, None).finite()
+    super::integrate(super::IntegratorKind::Symplectic, d, t, h, from, to)
 }
 
 /// [`step`], then `finish` on each piece it wrote (see
