@@ -405,12 +405,6 @@ mod tests {
             // Each integrator's own `step` too (the small worlds' updates
             // read the per-coordinate inverse masses).
             let mut by_own = from.clone();
-            let mut d = Dynamics {
-                forces: &mut forces,
-                particles: &hand,
-                scratch: &mut scratch,
-                solver: Solver::default(),
-            };
             match kind {
                 IntegratorKind::Euler => euler::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
                 IntegratorKind::Midpoint => midpoint::step(&mut d, 0.0, 1e-3, &from, &mut by_own),
