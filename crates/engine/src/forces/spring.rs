@@ -235,23 +235,27 @@ impl Springs {
         }
     }
     /// Sets the rest length of spring `id` (the muscle's activation).
+    #[inline]
     pub fn set_rest_length(&mut self, id: SpringId, rest_length: f64) {
         self.table.rest_length[id.index()] = rest_length;
         self.changed(id);
     }
     /// Sets the stiffness of spring `id`.
+    #[inline]
     pub fn set_stiffness(&mut self, id: SpringId, stiffness: f64) {
         self.table.stiffness[id.index()] = stiffness;
         self.table.note(id.index());
         self.changed(id);
     }
     /// Sets the damping of spring `id`.
+    #[inline]
     pub fn set_damping(&mut self, id: SpringId, damping: f64) {
         self.table.damping[id.index()] = damping;
         self.table.note(id.index());
         self.changed(id);
     }
     /// Keeps the mesh's copy of spring `id`'s parameters (if any) up to date.
+    #[inline]
     fn changed(&mut self, id: SpringId) {
         if let Some((_, Some(grid))) = &mut self.scratch.grid {
             grid.set(self.table.all(), id.index());
