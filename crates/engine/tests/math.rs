@@ -1,6 +1,6 @@
 //! `math::sin_lanes` and `math::exp_lanes` against `math::sin` and
-//! `math::exp` (the `libm` crate's musl port), bit for bit, lane by lane: the edges of musl's ranges and their
-//! neighbours, each in every lane beside ordinary arguments; the multiples
+//! `math::exp` (the `libm` crate's musl port), bit for bit, lane by lane: the edges of musl's ranges, its
+//! thresholds and their neighbours, each in every lane beside ordinary arguments; the multiples
 //! of π/2 where its reduction cancels; 10⁷ random arguments, spread over
 //! every binade up to 2²⁴ and over an oscillator's phases; random bit
 //! patterns.
@@ -75,14 +75,42 @@ fn edges_and_special_values_in_any_lane_are_libm_s() {
         1e-300,
         1e300,
     ];
-    // musl's range edges, as high words, and multiples of π/2 (where the
-    // reduction cancels), with their neighbours.
-    for high in [0x401c_463bu64, 0x401c_463c, 0x4139_21fb, 0x4139_21fa] {
+    // musl's range edges and thresholds, as high words (2⁻²⁶, ~π/4,
+    // ~3π/4, ~5π/4, ~7π/4, ~9π/4 and 2²⁰ π/2; the medium path's ~π/2, ~π,
+    // ~3π/2 and ~2π), and multiples of π/2 (where the reduction cancels),
+    // with their neighbours.
+    for high in [
+        0x3e50_0000u64,
+        0x3e4f_ffff,
+        0x3fe9_21fb,
+        0x3fe9_21fc,
+        0x3ff9_21fb,
+        0x4002_d97c,
+        0x4002_d97d,
+        0x4009_21fb,
+        0x400f_6a7a,
+        0x400f_6a7b,
+        0x4012_d97c,
+        0x4015_fdbc,
+        0x4015_fdbd,
+        0x4019_21fb,
+        0x401c_463b,
+        0x401c_463c,
+        0x4139_21fb,
+        0x4139_21fa,
+    ] {
         v.push(f64::from_bits(high << 32));
         v.push(f64::from_bits((high << 32) | 0xffff_ffff));
     }
     for k in 1..2000 {
         v.push(k as f64 * (pi / 2.0));
+    }
+    // Odd multiples of π/4 up to 9π/4, where musl's thresholds on the high
+    // word and the nearest n part: a sweep of 2⁻³⁰ steps either side.
+    for k in [1.0, 3.0, 5.0, 7.0, 9.0] {
+        for j in -64..=64 {
+            v.push(k * (pi / 4.0) * (1.0 + j as f64 * 2f64.powi(-30)));
+        }
     }
     let edges = v.clone();
     for e in edges {
