@@ -105,8 +105,9 @@ fn edges_and_special_values_in_any_lane_are_libm_s() {
     for k in 1..2000 {
         v.push(k as f64 * (pi / 2.0));
     }
-    // Odd multiples of π/4 up to 9π/4, where musl's thresholds on the high
-    // word and the nearest n part: a sweep of 2⁻³⁰ steps either side.
+    // Odd multiples of π/4 up to 9π/4, where the n musl takes from its
+    // thresholds on the high word and the integer nearest x/(π/2) can
+    // differ: a sweep of 2⁻³⁰ steps either side.
     for k in [1.0, 3.0, 5.0, 7.0, 9.0] {
         for j in -64..=64 {
             v.push(k * (pi / 4.0) * (1.0 + j as f64 * 2f64.powi(-30)));

@@ -531,9 +531,9 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     let (pos, vel) = (&pos[..n], &vel[..n]);
     // A sum of finite numbers is finite (unless it overflows, which the
     // confirming scan at the end tells apart) and any inf or NaN makes it
-    // non-finite. Sixteen independent lanes over the flat coordinates, in
-    // the vectors chosen for updates (`simd.rs`), keep the pass short next
-    // to the force loops.
+    // non-finite. In a large world sixteen independent lanes over the flat
+    // coordinates, in the vectors chosen for updates (`simd.rs`), keep the
+    // pass short next to the force loops.
     let (p, v) = (flat(pos), flat(vel));
     // A small world (the creatures of evolution: a few dozen coordinates)
     // in four lanes, and their sum checked once: no call through the
