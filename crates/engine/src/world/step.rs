@@ -541,38 +541,14 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     // that is not finite makes the sum not finite: ±∞ stays, ∞ − ∞ and
     // NaN are NaN; a sum that overflows is looked at below.)
     if p.len() < 64 {
-        let mut acc = [0.0f64; 4];
-        let (pc, vc) = (p.chunks_exact(4), v.chunks_exact(4));
-        let (pr, vr) = (pc.remainder(), vc.remainder());
-        for (p, v) in pc.zip(vc) {
-            for k in 0..4 {
-                acc[k] += p[k] + v[k];
-            }
-        }
-        for (a, (p, v)) in acc.iter_mut().zip(pr.iter().zip(vr)) {
-            *a += p + v;
-        }
+        let acc = lane_sums::<4>(p, v);
         if ((acc[0] + acc[1]) + (acc[2] + acc[3])).is_finite() {
             return true;
         }
     } else if chosen(
         Use::Updates,
         #[inline(always)]
-        || {
-            const LANES: usize = 16;
-            let mut acc = [0.0f64; LANES];
-            let (pc, vc) = (p.chunks_exact(LANES), v.chunks_exact(LANES));
-            let (pr, vr) = (pc.remainder(), vc.remainder());
-            for (p, v) in pc.zip(vc) {
-                for k in 0..LANES {
-                    acc[k] += p[k] + v[k];
-                }
-            }
-            for (a, (p, v)) in acc.iter_mut().zip(pr.iter().zip(vr)) {
-                *a += p + v;
-            }
-            acc.iter().all(|a| a.is_finite())
-        },
+        || lane_sums::<16>(p, v).iter().all(|a| a.is_finite()),
     ) {
         return true;
     }
@@ -580,6 +556,24 @@ fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     pos.iter()
         .zip(vel)
         .all(|(p, v)| p.is_finite() && v.is_finite())
+}
+
+/// `p[i] + v[i]` summed in `L` independent lanes (lane `k` takes every
+/// `L`-th coordinate from `k`).
+#[inline(always)]
+fn lane_sums<const L: usize>(p: &[f64], v: &[f64]) -> [f64; L] {
+    let mut acc = [0.0f64; L];
+    let (pc, vc) = (p.chunks_exact(L), v.chunks_exact(L));
+    let (pr, vr) = (pc.remainder(), vc.remainder());
+    for (p, v) in pc.zip(vc) {
+        for k in 0..L {
+            acc[k] += p[k] + v[k];
+        }
+    }
+    for (a, (p, v)) in acc.iter_mut().zip(pr.iter().zip(vr)) {
+        *a += p + v;
+    }
+    acc
 }
 
 #[cfg(test)]

@@ -220,8 +220,9 @@ pub(super) fn for_small(
 
 /// [`Pairs::sum_small`] for `N` bodies: each body's Σ mⱼ dᵢⱼ / r³ (x, y,
 /// z). Every array a fixed size, so the loops unroll and the lanes no pair
-/// writes (the row's own and those before it, and padding) are constants. Those lanes hold −0 and a pair's
-/// lane its term as it is, where the kernel's hold +0 and `+0 + term`:
+/// writes (the row's own and those before it, and padding) are constants.
+/// Those lanes hold −0 and a pair's lane its term as it is, where the
+/// kernel's hold +0 and `+0 + term`:
 /// `x + (−0) = x` for every `x`, so the compiler drops those additions,
 /// and the two trees differ at most in the sign of a zero (a sum is
 /// changed by a ±0 operand only when it is itself zero), which the final
