@@ -158,6 +158,70 @@ fn evolve_writes_its_outputs_and_is_identical_on_one_or_two_threads() {
     );
 }
 
+/// The winner's checks choose the same candidate on any thread count,
+/// though on four threads or more they check candidates a round at a
+/// time (half as many as threads; the first round beside the best's own
+/// checks). Seed 1's best fails its check with symplectic Euler, and so
+/// does the next best lane: the second after the best is chosen, so the
+/// rounds of one (1 and 2 threads), two (4) and eight (16) candidates
+/// each end elsewhere.
+#[test]
+fn the_checked_candidate_is_the_same_on_any_thread_count() {
+    let base = scratch("evolve-check-threads");
+    let mut seen: Option<(Vec<String>, Vec<u8>)> = None;
+    for threads in ["1", "2", "4", "16"] {
+        let dir = base.join(threads);
+        let o = evolve(&[
+            "--generations",
+            "10",
+            "--lanes",
+            "8",
+            "--seed",
+            "1",
+            "--threads",
+            threads,
+            "--out",
+            dir.to_str().unwrap(),
+        ]);
+        let (out, err) = text(&o);
+        assert!(o.status.success(), "{err}");
+        let lines: Vec<String> = out
+            .lines()
+            .filter(|l| l.contains("check:"))
+            .map(|l| l.replace(dir.to_str().unwrap(), "DIR"))
+            .collect();
+        // The best failed, and the next best lane after it too.
+        assert!(
+            lines.iter().any(|l| l.contains("not to be believed yet")),
+            "{out}"
+        );
+        let chosen = lines
+            .iter()
+            .find_map(|l| l.split("each check is lane ").nth(1))
+            .and_then(|l| l.split(' ').next())
+            .unwrap_or_else(|| panic!("no candidate chosen: {out}"));
+        let fitness = |lane: &str| -> f64 {
+            log(&dir)
+                .lines()
+                .filter(|l| l.starts_with(&format!("{lane},")))
+                .map(|l| l.split(',').nth(2).unwrap().parse::<f64>().unwrap())
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        let better = (0..8)
+            .filter(|l| fitness(&l.to_string()) > fitness(chosen))
+            .count();
+        assert_eq!(better, 2, "the best and one other lane failed: {out}");
+        let checked = std::fs::read(dir.join("checked.toml")).unwrap();
+        match &seen {
+            None => seen = Some((lines, checked)),
+            Some((l, c)) => {
+                assert_eq!(&lines, l, "{threads} threads");
+                assert!(&checked == c, "checked.toml on {threads} threads");
+            }
+        }
+    }
+}
+
 /// Waits until `dir/checkpoint.json` exists.
 fn wait_for_checkpoint(dir: &std::path::Path) {
     let t = Instant::now();

@@ -264,9 +264,36 @@ fn other_candidates<'a>(state: &'a State, best: &'a [f64]) -> Vec<Candidate<'a>>
     out
 }
 
+/// How many candidates are checked at once: half the threads of the
+/// caller's rayon pool (each check is two runs side by side), at least one.
+fn round() -> usize {
+    (rayon::current_num_threads() / 2).max(1)
+}
+
+/// Each of `candidates` checked, side by side: its scene and checks, or
+/// `None` where its scene cannot be made or run.
+fn check_all(candidates: &[Candidate], state: &State) -> Vec<Option<(String, Vec<Check>)>> {
+    use rayon::prelude::*;
+    candidates
+        .par_iter()
+        .map(|c| {
+            let text = c.text(state).ok()?;
+            let checks = c.checks(&text).ok()?;
+            Some((text, checks))
+        })
+        .collect()
+}
+
 /// Checks `state`'s best, and where it fails, its next [`CANDIDATES`] best
 /// until one passes. `None` where the run has no best yet; an error where
 /// the best's scene cannot be written out.
+///
+/// On four threads or more the candidates are checked a round at a time,
+/// half as many as threads, the first round beside the best's own checks:
+/// at the end of a run on many cores the checks are all there is to do,
+/// and a best that fails no longer leaves the cores waiting on each next
+/// candidate in turn. The verdict is the first that passes, best first,
+/// whatever the thread count.
 pub fn check(state: &State) -> Result<Option<Report>, String> {
     let Some(best) = state.best_lane().and_then(|l| l.best.as_ref()) else {
         return Ok(None);
@@ -286,7 +313,21 @@ pub fn check(state: &State) -> Result<Option<Report>, String> {
         }))
     };
     let text = first.text(state)?;
-    let checks = match first.checks(&text) {
+    // The others are tried only where the best fails with a fitness above 0.
+    let positive = !best.fitness.is_nan() && best.fitness > 0.0;
+    let mut others = if positive {
+        other_candidates(state, &best.genome)
+    } else {
+        Vec::new()
+    };
+    others.truncate(CANDIDATES);
+    let round = round();
+    let ahead = (round - 1).min(others.len());
+    let (checks, mut found) = rayon::join(
+        || first.checks(&text),
+        || check_all(&others[..ahead], state),
+    );
+    let checks = match checks {
         Ok(c) => c,
         Err(e) => return report(Vec::new(), Verdict::NotRun(e)),
     };
@@ -294,18 +335,26 @@ pub fn check(state: &State) -> Result<Option<Report>, String> {
         let checked = first.checked(text, &checks);
         return report(checks, Verdict::Checked(checked));
     }
-    if best.fitness.is_nan() || best.fitness <= 0.0 {
+    if !positive {
         return report(checks, Verdict::NotPositive);
     }
-    let others = other_candidates(state, &best.genome);
-    let tried = others.len().min(CANDIDATES);
-    for c in others.into_iter().take(CANDIDATES) {
-        let Ok(text) = c.text(state) else { continue };
-        let Ok(kept) = c.checks(&text) else { continue };
-        if believed(&kept) {
-            let checked = c.checked(text, &kept);
+    let tried = others.len();
+    let mut from = 0;
+    loop {
+        let next = from + found.len();
+        let pass = found
+            .into_iter()
+            .enumerate()
+            .find_map(|(k, f)| f.filter(|(_, kept)| believed(kept)).map(|f| (k, f)));
+        if let Some((k, (text, kept))) = pass {
+            let checked = others.swap_remove(from + k).checked(text, &kept);
             return report(checks, Verdict::Checked(checked));
         }
+        if next >= tried {
+            break;
+        }
+        from = next;
+        found = check_all(&others[from..(from + round).min(tried)], state);
     }
     report(
         checks,
