@@ -148,55 +148,72 @@ fn check_best(dir: &Path, state: &State) -> Result<bool, Failure> {
 }
 
 /// Writes log.csv, best.toml and the checkpoint; at the end of a run (or
-/// of this part of it) fitness.png and each lane's best, lanes/K.toml, too.
+/// of this part of it) fitness.png, each lane's best (lanes/K.toml) and an
+/// archive's elites too. The files are independent of each other and are
+/// written side by side on the caller's rayon pool (at the end of a run on
+/// many cores they are, with the winner's checks, all there is to do); the
+/// checkpoint last, so that one on disk never stands for more than the
+/// files beside it. The first error in that order is returned.
 fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
+    use rayon::prelude::*;
+    type Job<'a> = Box<dyn Fn() -> Result<(), Failure> + Send + Sync + 'a>;
     let io = Failure::Other;
-    animats_files::write_atomically(&dir.join("log.csv"), state.log_csv().as_bytes())
-        .map_err(io)?;
-    if let Some(best) = state.best_toml().map_err(Failure::Other)? {
-        animats_files::write_atomically(&dir.join("best.toml"), best.as_bytes()).map_err(io)?;
-    }
+    let write =
+        |path: PathBuf, bytes: &[u8]| animats_files::write_atomically(&path, bytes).map_err(io);
+    let mut jobs: Vec<Job> = vec![
+        Box::new(|| write(dir.join("log.csv"), state.log_csv().as_bytes())),
+        Box::new(|| match state.best_toml().map_err(io)? {
+            Some(best) => write(dir.join("best.toml"), best.as_bytes()),
+            None => Ok(()),
+        }),
+        Box::new(|| match state.archive_csv() {
+            Some(csv) => write(dir.join("archive.csv"), csv.as_bytes()),
+            None => Ok(()),
+        }),
+    ];
     if at_end && state.config.lanes > 1 {
         let lanes = dir.join("lanes");
         std::fs::create_dir_all(&lanes)
             .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", lanes.display())))?;
         for l in &state.lanes {
-            if let Some(text) = state.lane_toml(l.lane).map_err(Failure::Other)? {
-                let path = lanes.join(format!("{}.toml", l.lane));
-                animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
-            }
+            let lanes = lanes.clone();
+            jobs.push(Box::new(move || {
+                match state.lane_toml(l.lane).map_err(io)? {
+                    Some(text) => write(lanes.join(format!("{}.toml", l.lane)), text.as_bytes()),
+                    None => Ok(()),
+                }
+            }));
         }
     }
-    if let Some(csv) = state.archive_csv() {
-        animats_files::write_atomically(&dir.join("archive.csv"), csv.as_bytes()).map_err(io)?;
-    }
     if at_end && state.archive().is_some() {
-        save_elites(dir, state)?;
+        jobs.push(Box::new(|| save_elites(dir, state)));
     }
     if at_end {
-        let y_label = "best fitness";
-        let plot = Plot {
-            title: format!(
-                "Best fitness per lane ({}, seed {})",
-                state.config.optimiser.name(),
-                state.config.seed
-            ),
-            x_label: "generation".into(),
-            y_label: y_label.into(),
-            series: state
-                .fitness_curves()
-                .into_iter()
-                .enumerate()
-                .map(|(k, c)| Series {
-                    label: format!("lane {k}"),
-                    points: c.into_iter().map(|(g, f)| (g as f64, f)).collect(),
-                })
-                .collect(),
-            size: (900, 600),
-        };
-        let png = step_plot_png(&plot).map_err(io)?;
-        animats_files::write_atomically(&dir.join("fitness.png"), &png).map_err(io)?;
+        jobs.push(Box::new(|| {
+            let plot = Plot {
+                title: format!(
+                    "Best fitness per lane ({}, seed {})",
+                    state.config.optimiser.name(),
+                    state.config.seed
+                ),
+                x_label: "generation".into(),
+                y_label: "best fitness".into(),
+                series: state
+                    .fitness_curves()
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, c)| Series {
+                        label: format!("lane {k}"),
+                        points: c.into_iter().map(|(g, f)| (g as f64, f)).collect(),
+                    })
+                    .collect(),
+                size: (900, 600),
+            };
+            write(dir.join("fitness.png"), &step_plot_png(&plot).map_err(io)?)
+        }));
     }
+    let done: Vec<Result<(), Failure>> = jobs.par_iter().map(|job| job()).collect();
+    done.into_iter().collect::<Result<(), Failure>>()?;
     checkpoint::save(&dir.join(CHECKPOINT), state).map_err(io)
 }
 
@@ -483,7 +500,7 @@ fn evolve(
         }
         progress.show(state);
         if !state.done() {
-            save(dir, state, false)?;
+            pool.install(|| save(dir, state, false))?;
         }
     }
     progress.bar.finish_and_clear();
