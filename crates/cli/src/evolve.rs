@@ -227,12 +227,27 @@ fn save_elites(dir: &Path, state: &State) -> Result<(), Failure> {
     let elites = dir.join("elites");
     std::fs::create_dir_all(&elites)
         .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", elites.display())))?;
-    for (index, text) in state.elite_tomls().map_err(io)? {
-        let path = elites.join(format!("{index}.toml"));
-        animats_files::write_atomically(&path, text.as_bytes()).map_err(io)?;
-    }
-    let png = animats_render::heatmap_png(&heatmap(state, archive)).map_err(io)?;
-    animats_files::write_atomically(&dir.join("archive.png"), &png).map_err(io)
+    use rayon::prelude::*;
+    // The elites' files and the heat map side by side; the first error
+    // in that order.
+    let (written, png) = rayon::join(
+        || -> Result<(), Failure> {
+            let tomls = state.elite_tomls().map_err(io)?;
+            let done: Vec<Result<(), Failure>> = tomls
+                .par_iter()
+                .map(|(index, text)| {
+                    let path = elites.join(format!("{index}.toml"));
+                    animats_files::write_atomically(&path, text.as_bytes()).map_err(io)
+                })
+                .collect();
+            done.into_iter().collect()
+        },
+        || -> Result<(), Failure> {
+            let png = animats_render::heatmap_png(&heatmap(state, archive)).map_err(io)?;
+            animats_files::write_atomically(&dir.join("archive.png"), &png).map_err(io)
+        },
+    );
+    written.and(png)
 }
 
 /// The archive's heat map: the first two measures, each cell coloured by

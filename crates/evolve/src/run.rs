@@ -857,18 +857,21 @@ impl State {
     /// Every elite of a quality-diversity run as a whole scene
     /// (`elites/<index>.toml`), with its cell index, in the order the
     /// cells were first filled: `animats evaluate` reproduces each one's
-    /// fitness and measures bit for bit. Empty for any other run.
+    /// fitness and measures bit for bit. Empty for any other run. Made
+    /// side by side on the caller's rayon pool.
     pub fn elite_tomls(&self) -> Result<Vec<(u64, String)>, String> {
+        use rayon::prelude::*;
         let Some(archive) = self.archive() else {
             return Ok(Vec::new());
         };
         // Built once for all the elites.
         let problem = self.config.problem.build()?;
-        archive
+        let made: Vec<Result<(u64, String), String>> = archive
             .elites()
-            .iter()
+            .par_iter()
             .map(|e| Ok((e.index, self.elite_scene(problem.as_ref(), archive, e)?)))
-            .collect()
+            .collect();
+        made.into_iter().collect()
     }
 
     /// One elite of the archive as a whole scene, as [`State::elite_tomls`]
