@@ -15,10 +15,14 @@
 #   cargo build --release && mkdir -p target/carry && cp target/release/animats target/carry/
 #   bench/scaling.sh                    # ANIMATS=path/to/animats to choose another
 # Then the machine's ceiling (CEILING=0 leaves it out): the roobot and the
-# walker as N independent 1-thread processes at once, N the last thread count.
+# walker as N independent 1-thread processes at once, N the last thread count;
+# and each row once more on N threads with --schedule, whose summed work
+# against the first run's says how much slower an evaluation runs with every
+# thread busy (about 10 s more on 16 cores).
 # About 4 minutes on 16 cores (137 s on the H200 machine's Xeon,
-# 2026-11-30, before the two rows without checks and the ceiling); prints a Markdown table for PERFORMANCE.md. Needs bash and
-# awk only (the lent machines have no bc).
+# 2026-11-30, before the two rows without checks, the ceiling and the
+# work); prints Markdown tables for PERFORMANCE.md. Needs bash and awk only
+# (the lent machines have no bc).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 B=${ANIMATS:-target/carry/animats}
@@ -104,6 +108,26 @@ if [ "${CEILING:-1}" != 0 ] && [ "$N" -gt 1 ]; then
         { echo "$name: copy $k's log differs from the run alone" >&2; exit 1; }
     done
     echo "| $name | $(printf '%.2f' "$alone") s | $(printf '%.2f' "$together") s | $(awk -v n="$N" -v a="$alone" -v t="$together" 'BEGIN { printf "%.1f", n * a / t }')× |"
+  done
+fi
+# How much slower each evaluation runs with every thread busy: the work
+# the schedule records (every piece's own wall time, summed) in a run on
+# the most threads, against the first run's. 1.0× is no slowdown; what is
+# above it is contention (caches, memory, clocks), not waiting.
+if [ "$N" != "${THREADS%% *}" ]; then
+  echo
+  echo "evaluation work at $N threads against ${THREADS%% *} (evolve --schedule, a run of its own; work summed over pieces):"
+  echo "| run | work at ${THREADS%% *} | work at $N | per-piece slowdown |"
+  echo "|---|---|---|---|"
+  work() { sed -n 's/.* \([0-9.]*\) s of work in .*/\1/p' "$1" | head -1; }
+  for row in "${rows[@]}"; do
+    name=${row%%|*}; args=${row#*|}
+    # shellcheck disable=SC2086
+    "$B" evolve $args --threads "$N" --schedule --out "$OUT/$name-work" > "$OUT/$name-work.txt" 2>&1
+    cmp -s "$OUT/$name-${THREADS%% *}/log.csv" "$OUT/$name-work/log.csv" ||
+      { echo "$name: the log of the run with --schedule at $N threads differs" >&2; exit 1; }
+    a=$(work "$OUT/$name-${THREADS%% *}.txt"); b=$(work "$OUT/$name-work.txt")
+    echo "| $name | $a s | $b s | $(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.2f", b / a }')× |"
   done
 fi
 echo
