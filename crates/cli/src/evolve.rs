@@ -220,6 +220,7 @@ fn save(dir: &Path, state: &State, at_end: bool) -> Result<(), Failure> {
 /// A quality-diversity run's `elites/<index>.toml` (each elite as a whole
 /// scene) and `archive.png` (the heat map).
 fn save_elites(dir: &Path, state: &State) -> Result<(), Failure> {
+    use rayon::prelude::*;
     let io = Failure::Other;
     let Some(archive) = state.archive() else {
         return Ok(());
@@ -227,7 +228,6 @@ fn save_elites(dir: &Path, state: &State) -> Result<(), Failure> {
     let elites = dir.join("elites");
     std::fs::create_dir_all(&elites)
         .map_err(|e| Failure::Other(format!("{}: cannot create it: {e}", elites.display())))?;
-    use rayon::prelude::*;
     // The elites' files and the heat map side by side; the first error
     // in that order.
     let (written, png) = rayon::join(

@@ -1,9 +1,9 @@
 //! `math::sin_lanes` and `math::exp_lanes` against `math::sin` and
-//! `math::exp` (the `libm` crate's musl port), bit for bit, lane by lane: the edges of musl's ranges, its
-//! thresholds and their neighbours, each in every lane beside ordinary arguments; the multiples
-//! of π/2 where its reduction cancels; 10⁷ random arguments, spread over
-//! every binade up to 2²⁴ and over an oscillator's phases; random bit
-//! patterns.
+//! `math::exp` (the `libm` crate's musl port), bit for bit, lane by lane:
+//! the edges of musl's ranges, its thresholds and their neighbours, each in
+//! every lane beside ordinary arguments; the multiples of π/2 where its
+//! reduction cancels; 10⁷ random arguments, spread over every binade up to
+//! 2²⁴ and over an oscillator's phases; random bit patterns.
 
 use animats_engine::math::{exp, exp_lanes, sin, sin_lanes, LANES};
 

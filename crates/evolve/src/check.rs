@@ -199,10 +199,10 @@ impl Candidate<'_> {
             .collect())
     }
 
-    fn checked(self, toml: String, checks: &[Check]) -> Checked {
+    fn checked(&self, toml: String, checks: &[Check]) -> Checked {
         Checked {
-            label: self.label,
-            file: self.file,
+            label: self.label.clone(),
+            file: self.file.clone(),
             fitness: self.fitness,
             shares: checks.iter().map(|c| c.share).collect(),
             toml,
@@ -270,18 +270,23 @@ fn round() -> usize {
     (rayon::current_num_threads() / 2).max(1)
 }
 
-/// Each of `candidates` checked, side by side: its scene and checks, or
-/// `None` where its scene cannot be made or run.
-fn check_all(candidates: &[Candidate], state: &State) -> Vec<Option<(String, Vec<Check>)>> {
+/// The first of `candidates`, in order, that keeps [`BELIEVED`] in each
+/// check, all of them checked side by side. A candidate whose scene cannot
+/// be made or run does not pass.
+fn first_passing(candidates: &[Candidate], state: &State) -> Option<Checked> {
     use rayon::prelude::*;
-    candidates
+    let found: Vec<Option<(String, Vec<Check>)>> = candidates
         .par_iter()
         .map(|c| {
             let text = c.text(state).ok()?;
             let checks = c.checks(&text).ok()?;
             Some((text, checks))
         })
-        .collect()
+        .collect();
+    candidates.iter().zip(found).find_map(|(c, f)| {
+        f.filter(|(_, kept)| believed(kept))
+            .map(|(t, k)| c.checked(t, &k))
+    })
 }
 
 /// Checks `state`'s best, and where it fails, its next [`CANDIDATES`] best
@@ -323,9 +328,9 @@ pub fn check(state: &State) -> Result<Option<Report>, String> {
     others.truncate(CANDIDATES);
     let round = round();
     let ahead = (round - 1).min(others.len());
-    let (checks, mut found) = rayon::join(
+    let (checks, first_round) = rayon::join(
         || first.checks(&text),
-        || check_all(&others[..ahead], state),
+        || first_passing(&others[..ahead], state),
     );
     let checks = match checks {
         Ok(c) => c,
@@ -338,24 +343,15 @@ pub fn check(state: &State) -> Result<Option<Report>, String> {
     if !positive {
         return report(checks, Verdict::NotPositive);
     }
-    let tried = others.len();
-    let mut from = 0;
-    loop {
-        let next = from + found.len();
-        let pass = found
-            .into_iter()
-            .enumerate()
-            .find_map(|(k, f)| f.filter(|(_, kept)| believed(kept)).map(|f| (k, f)));
-        if let Some((k, (text, kept))) = pass {
-            let checked = others.swap_remove(from + k).checked(text, &kept);
-            return report(checks, Verdict::Checked(checked));
-        }
-        if next >= tried {
-            break;
-        }
-        from = next;
-        found = check_all(&others[from..(from + round).min(tried)], state);
+    let passed = first_round.or_else(|| {
+        others[ahead..]
+            .chunks(round)
+            .find_map(|c| first_passing(c, state))
+    });
+    if let Some(checked) = passed {
+        return report(checks, Verdict::Checked(checked));
     }
+    let tried = others.len();
     report(
         checks,
         if tried == 0 {
