@@ -105,33 +105,51 @@ sweep() {
   echo "[${SECONDS} s] done, exit $status"
   exit $status
 }
-# NVRTC takes 20 s or so for each kernel (the flat floor's, terrain's,
-# sphere contact's, implicit Euler's; strict and fast): compiled side by
-# side into the cache first, each by a tiny run, rather than one after
-# another inside the timed ones (on 2026-11-30 they were: seven of them,
-# about 140 s of the `check` part).
+# NVRTC takes 20 s or so for each kernel: the whole kernel of each floor
+# (the flat floor's, terrain's, sphere contact's, implicit Euler's;
+# strict and fast) and, for each batch of at least 4,096 creatures, one
+# specialised for it (animats_gpu::Special: its integrator and only the
+# parts its creatures have; fewer registers). They are compiled side by
+# side into the cache first, each by its run's own batch with nothing run
+# (ANIMATS_PREPARE_ONLY=1), rather than one after another inside the
+# timed runs (on 2026-11-30 they were: seven of them, about 140 s of the
+# `check` part). The flat floor's whole kernel first: opening a device
+# compiles it.
+CHECKS=("65536 1000 20" "65536 1000 20 symplectic" "16384 1000 0" "4096 500 0 implicit")
+EVALS=("walker 65536 10" "bodies 16384 10" "quadruped 8192 10" "neural 8192 10" "roobot 16384 20" "raibert 4096 20" "jellyfish 4096 20" "rough 2048 2" "rocks 2048 2")
 warm() {
   echo "== [${SECONDS} s] the kernels compiled side by side into $ANIMATS_CACHE"
-  "$B" 32 1 20 >/dev/null 2>&1 &
-  "$B" 32 1 0 implicit >/dev/null 2>&1 &
-  "$E" walker 32 0.01 >/dev/null 2>&1 &
-  ANIMATS_SKIP_FAST=1 "$E" rough 32 0.01 >/dev/null 2>&1 &
-  ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &
+  ANIMATS_PREPARE_ONLY=1 "$E" walker 32 0.01 >/dev/null 2>&1
+  local run
+  for run in "${CHECKS[@]}"; do
+    # shellcheck disable=SC2086
+    ANIMATS_PREPARE_ONLY=1 "$B" $run >/dev/null 2>&1 &
+  done
+  for run in "${EVALS[@]}"; do
+    # (Fast mode is left out on terrain and among rocks, below.)
+    case $run in rough*|rocks*) skip_fast=1 ;; *) skip_fast="" ;; esac
+    # shellcheck disable=SC2086
+    ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=$skip_fast "$E" $run >/dev/null 2>&1 &
+  done
   wait
 }
 # `tune` (a third call, not part of `all`): the kernel's registers and
-# block size (animats_gpu::Tuning) swept on 32,768 walkers, 8,192 random
-# land bodies and 32,768 dropped 20-particle bodies, each way's bits
-# checked against the engine as above. About 4.5 minutes (an estimate:
-# not yet run on a GPU).
+# block size (animats_gpu::Tuning), and the whole kernel against one
+# specialised for the batch (ANIMATS_GPU_SPECIALISE=0), swept on 32,768
+# walkers, 8,192 random land bodies and 32,768 dropped 20-particle bodies,
+# each way's bits checked against the engine as above. About 5.5 minutes
+# (an estimate: not yet run on a GPU).
 if [ "$part" = tune ]; then
-  echo "== [${SECONDS} s] the flat floor's kernel compiled for each register count, side by side"
+  echo "== [${SECONDS} s] each run's kernels compiled for each setting, side by side"
+  ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" walker 32 0.01 >/dev/null 2>&1
   for knobs in "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96"; do
-    # shellcheck disable=SC2086
-    env $knobs "$B" 32 1 20 >/dev/null 2>&1 &
+    for run in "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"; do
+      # shellcheck disable=SC2086
+      env $knobs ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 $run >/dev/null 2>&1 &
+    done
   done
   wait
-  sweep defaults "engine|GPU" "" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256" \
+  sweep defaults "engine|GPU" "" "ANIMATS_GPU_SPECIALISE=0" "ANIMATS_GPU_REGS=128" "ANIMATS_GPU_REGS=96" "ANIMATS_GPU_BLOCK=64" "ANIMATS_GPU_BLOCK=256" \
     -- "$E walker 32768 10" "$E bodies 8192 10" "$B 32768 1000 20"
 fi
 # `sort` (a call of its own, about a minute; not part of `all`): bodies of
@@ -141,7 +159,14 @@ fi
 # particles, as ordered (2 to 40 particles: 53.6 % as they come, 99.7 %
 # in order; random land bodies 70.5 % and 99.2 %).
 if [ "$part" = sort ]; then
-  "$B" 32 1 20 >/dev/null 2>&1
+  ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" walker 32 0.01 >/dev/null 2>&1
+  for knobs in "" "ANIMATS_GPU_SORT=1"; do
+    # shellcheck disable=SC2086
+    env $knobs ANIMATS_PREPARE_ONLY=1 "$B" 16384 1000 0 >/dev/null 2>&1 &
+    # shellcheck disable=SC2086
+    env $knobs ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" bodies 16384 10 >/dev/null 2>&1 &
+  done
+  wait
   sweep "as they come" "engine|GPU|warps" "" "ANIMATS_GPU_SORT=1" -- "$B 16384 1000 0" "$E bodies 16384 10"
 fi
 # `spread` (a call of its own, about 2 minutes; not part of `all`): small
@@ -151,8 +176,11 @@ fi
 # creatures in blocks of 32 on 128 of an H200's 132 multiprocessors
 # instead of 32 blocks of 128).
 if [ "$part" = spread ]; then
-  ANIMATS_SKIP_FAST=1 "$E" roobot 32 0.01 >/dev/null 2>&1 &
-  ANIMATS_SKIP_FAST=1 "$E" rocks 32 0.01 >/dev/null 2>&1 &
+  ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" walker 32 0.01 >/dev/null 2>&1
+  for run in "raibert 4096 20" "jellyfish 4096 20" "rocks 512 2"; do
+    # shellcheck disable=SC2086
+    ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" $run >/dev/null 2>&1 &
+  done
   wait
   sweep spread "engine|GPU" "ANIMATS_GPU_BLOCK=128" "" -- "$E raibert 4096 20" "$E jellyfish 4096 20" "$E rocks 512 2"
 fi
@@ -161,14 +189,14 @@ if [ "$part" != evolve ]; then
 # The second run: the same bodies under symplectic Euler, one force
 # evaluation a step as in the issue's smoke test (a 16-particle chain at
 # 6.2x10^8 creature-steps/s), to set the 5x10^8 goal beside like work.
-for run in "65536 1000 20" "65536 1000 20 symplectic" "16384 1000 0" "4096 500 0 implicit"; do
+for run in "${CHECKS[@]}"; do
   echo "== [${SECONDS} s] gpu_check $run"
   # shellcheck disable=SC2086
   "$B" $run
   rc=$?
   [ $rc -gt $status ] && status=$rc
 done
-for run in "walker 65536 10" "bodies 16384 10" "quadruped 8192 10" "neural 8192 10" "roobot 16384 20" "raibert 4096 20" "jellyfish 4096 20" "rough 2048 2" "rocks 2048 2"; do
+for run in "${EVALS[@]}"; do
   echo "== [${SECONDS} s] gpu_evaluate $run"
   # Fast mode left out on terrain and among rocks: two more kernels to
   # compile for a mode within 2 % of strict's time elsewhere (2026-11-30).

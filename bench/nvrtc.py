@@ -3,13 +3,19 @@
 `animats_gpu::Device::open` does (the same headers in the same order, the
 same strict options) for a GPU architecture, with no GPU: NVRTC only needs
 its own libraries, which the PyPI package nvidia-cuda-nvrtc provides. Prints
-ptxas's registers, stack and spills for each entry of the three kernels
-(the flat floor's, terrain's and sphere contact's); exit 1 if NVRTC refuses
+ptxas's registers, stack and spills for each entry of the whole kernels
+(the flat floor's, terrain's and sphere contact's, the flat floor's with
+implicit Euler) and of one specialised for a batch of walkers; exit 1 if NVRTC refuses
 the kernel (its log printed), 2 if NVRTC cannot be found.
 
     python3 -m venv target/venv-nvrtc
     target/venv-nvrtc/bin/pip install nvidia-cuda-nvrtc
     target/venv-nvrtc/bin/python bench/nvrtc.py [--quick] [sm_90 ...]
+
+With options after `--` (as `gpu_evaluate` prints them for its batch, a
+kernel specialised for it: `GPU kernel options: -DAN_FLAT_ONLY
+-DAN_ONLY_INTEGRATOR=3 -DAN_ABSENT=32511`), that one kernel is compiled
+instead, through ptxas, its report printed.
 
 With --quick, every kernel is compiled to PTX only (the architecture's
 virtual `compute_XX`: NVRTC's front end and optimiser, about 12 s a kernel
@@ -86,10 +92,22 @@ def main():
     src = source()
     failed = False
     args = sys.argv[1:]
+    given = None
+    if "--" in args:
+        given = args[args.index("--") + 1:]
+        args = args[:args.index("--")]
     quick = "--quick" in args
     args = [a for a in args if a != "--quick"]
     for arch in args or ["sm_90"]:
-        # As crates/gpu/src/cuda.rs's three kernels: the flat floor's,
+        if given is not None:
+            ok, log = compile_for(lib, arch, src, given)
+            print(f"NVRTC {major.value}.{minor.value}, {arch}, {' '.join(given)}: {'compiled' if ok else 'REFUSED'}")
+            for line in log.splitlines():
+                if not ok or "entry function" in line or "registers" in line or "spill" in line or "warning" in line:
+                    print("  " + line.strip())
+            failed |= not ok
+            continue
+        # As crates/gpu/src/cuda.rs's whole kernels: the flat floor's,
         # terrain's and sphere contact's (on the flat floor); then the flat
         # floor's with implicit Euler (its other two are compiled alike).
         kinds = [
@@ -97,6 +115,9 @@ def main():
             ("terrain", []),
             ("sphere contact", ["-DAN_FLAT_ONLY", "-DAN_SPHERES"]),
             ("implicit Euler, flat floor", ["-DAN_FLAT_ONLY", "-DAN_WITH_IMPLICIT"]),
+            # A kernel specialised for a batch (src/cuda.rs, `Special`): the
+            # walker's, as gpu_evaluate prints it.
+            ("specialised for walkers", ["-DAN_FLAT_ONLY", "-DAN_ONLY_INTEGRATOR=3", "-DAN_ABSENT=32511"]),
         ]
         for i, (kernel, extra) in enumerate(kinds):
             # (--quick: PTX only but for the first.)

@@ -13,7 +13,9 @@
 //! `ANIMATS_SKIP_C=1` leaves the C on the CPU out (the GPU compared with
 //! the engine); `ANIMATS_GPU_SORT=1` puts the creatures in order of size
 //! (`animats_gpu::order`) before anything runs; `ANIMATS_GPU_REGS` and `ANIMATS_GPU_BLOCK` tune the kernel
-//! (`animats_gpu::Tuning`).
+//! (`animats_gpu::Tuning`), `ANIMATS_GPU_SPECIALISE=0` runs the whole kernel
+//! instead of one specialised for the batch (`animats_gpu::Special`);
+//! `ANIMATS_PREPARE_ONLY=1` only compiles and loads the batch's kernel.
 
 use animats_creatures::random::Random;
 use animats_engine::{FloorDef, IntegratorKind, World};
@@ -100,6 +102,23 @@ fn main() {
             std::process::exit(2);
         }
     };
+    // `ANIMATS_PREPARE_ONLY=1`: the batch's kernel compiled (into the
+    // disk's cache) and loaded, nothing run or timed: bench/gpu.sh compiles
+    // its runs' kernels side by side so.
+    if std::env::var_os("ANIMATS_PREPARE_ONLY").is_some_and(|v| !v.is_empty()) {
+        let ready = Device::open().and_then(|d| {
+            let mut warm = packed.clone();
+            d.run(&mut warm, 1).map(|()| d.kernel_options(&packed))
+        });
+        match ready {
+            Ok(options) => println!("kernel ready: {}", options.join(" ")),
+            Err(e) => {
+                eprintln!("gpu_check: {e}");
+                std::process::exit(2);
+            }
+        }
+        return;
+    }
     println!(
         "{creatures} creatures ({total_particles} particles; {}) dropped onto the floor, {steps} {} steps of {dt} s, {} CPU threads{}",
         if particles == 0 { "2 to 40 particles each".to_string() } else { format!("{particles} particles each") },
@@ -178,9 +197,10 @@ fn main() {
         }
     };
     println!(
-        "GPU tuning: {:?}; {} threads a block for this batch",
+        "GPU tuning: {:?}; {} threads a block for this batch; kernel options: {}",
         device.tuning(),
-        device.threads_a_block(creatures as usize)
+        device.threads_a_block(creatures as usize),
+        device.kernel_options(&packed).join(" ")
     );
     // Once to warm (the module is loaded; the first launch pays for it).
     let mut warm = packed.clone();

@@ -41,7 +41,10 @@
 //! (either set and not empty)
 //! the GPU's fast mode; `ANIMATS_GPU_SORT=1` puts the scenes in order of
 //! size (`animats_gpu::order`) before anything runs; `ANIMATS_GPU_REGS`
-//! and `ANIMATS_GPU_BLOCK` tune the kernel (`animats_gpu::Tuning`).
+//! and `ANIMATS_GPU_BLOCK` tune the kernel (`animats_gpu::Tuning`);
+//! `ANIMATS_GPU_SPECIALISE=0` runs the whole kernel instead of one
+//! specialised for the batch (`animats_gpu::Special`);
+//! `ANIMATS_PREPARE_ONLY=1` only compiles and loads the batch's kernels.
 //!
 //! Exit 2 where no GPU can be used (after the CPU's comparison; the
 //! message says why), 1 if any bit differs.
@@ -198,6 +201,31 @@ fn main() {
     let t = Instant::now();
     let packed = Batch::pack_scenes(&refs).unwrap_or_else(|e| fail(e));
     let pack = t.elapsed().as_secs_f64();
+    let specialise = animats_gpu::cuda::specialise_from_env().unwrap_or_else(|e| fail(e));
+    println!(
+        "GPU kernel options: {} (bench/nvrtc.py OPTIONS compiles it)",
+        animats_gpu::cuda::kernel_options(&packed, specialise).join(" ")
+    );
+    // `ANIMATS_PREPARE_ONLY=1`: the batch's kernels (strict, and fast
+    // unless ANIMATS_SKIP_FAST) compiled into the disk's cache and loaded,
+    // nothing run or timed: bench/gpu.sh compiles its runs' kernels side by
+    // side so.
+    if std::env::var_os("ANIMATS_PREPARE_ONLY").is_some_and(|v| !v.is_empty()) {
+        let skip_fast = std::env::var_os("ANIMATS_SKIP_FAST").is_some_and(|v| !v.is_empty());
+        let modes: &[Mode] = if skip_fast {
+            &[Mode::Strict]
+        } else {
+            &[Mode::Strict, Mode::Fast]
+        };
+        for &mode in modes {
+            if let Err(e) = Device::open_in(mode).and_then(|d| d.prepare(&packed)) {
+                eprintln!("gpu_evaluate: {e}");
+                std::process::exit(2);
+            }
+        }
+        println!("kernels ready ({modes:?})");
+        return;
+    }
     let sizes: Vec<usize> = scenes.iter().map(|s| s.world.len()).collect();
     let particles: usize = sizes.iter().sum();
     let dt = scenes[0].dt;
@@ -290,10 +318,9 @@ fn main() {
         device.tuning(),
         device.threads_a_block(count as usize)
     );
-    // Once to warm (the module is loaded; the first launch pays for it).
-    let one = scene(kind, seconds, 0).unwrap_or_else(|e| fail(e));
-    let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
-    device.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
+    // The batch's kernel compiled, loaded and launched once before any
+    // clock starts (the first launch pays for the loading).
+    device.prepare(&packed).unwrap_or_else(|e| fail(e));
     // Each creature's state in the thread's local memory (the default),
     // then in the batch's arrays; one thread per evaluation (the default),
     // then threads taking evaluations from a queue.
@@ -333,8 +360,7 @@ fn main() {
     };
     match fast {
         Ok(fast) => {
-            let mut warm = Batch::pack_scenes(&[&one]).unwrap_or_else(|e| fail(e));
-            fast.evaluate(&mut warm).unwrap_or_else(|e| fail(e));
+            fast.prepare(&packed).unwrap_or_else(|e| fail(e));
             let mut gpu = packed.clone();
             let t = Instant::now();
             let on_gpu = fast.evaluate(&mut gpu).unwrap_or_else(|e| fail(e));

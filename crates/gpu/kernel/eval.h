@@ -703,23 +703,23 @@ AN_FN void an_act(const an_batch *b, an_state st, long long c, double t, double 
         b->sensor_level[q] = an_sensor(b, st, q);
     }
     for (long long k = k0; k < k1; k++) {
-        if (b->ctrl_kind[k] == 0) {
+        if (AN_HAS(b, AN_P_CONTROL << 0) && b->ctrl_kind[k] == 0) {
             an_oscillator(b, c, b->ctrl_index[k], t, dt);
-        } else if (b->ctrl_kind[k] == 1) {
+        } else if (AN_HAS(b, AN_P_CONTROL << 1) && b->ctrl_kind[k] == 1) {
             an_network(b, c, b->ctrl_index[k], t, dt);
-        } else if (b->ctrl_kind[k] == 2) {
+        } else if (AN_HAS(b, AN_P_CONTROL << 2) && b->ctrl_kind[k] == 2) {
             an_ctrnn(b, c, b->ctrl_index[k], t, dt);
-        } else if (b->ctrl_kind[k] == 4) {
+        } else if (AN_HAS(b, AN_P_CONTROL << 4) && b->ctrl_kind[k] == 4) {
             an_hop(b, st, c, b->ctrl_index[k], dt);
-        } else if (b->ctrl_kind[k] == 3) {
+        } else if (AN_HAS(b, AN_P_CONTROL << 3) && b->ctrl_kind[k] == 3) {
             an_fsm(b, c, b->ctrl_index[k], t, dt);
-        } else if (b->ctrl_kind[k] == 6) {
+        } else if (AN_HAS(b, AN_P_CONTROL << 6) && b->ctrl_kind[k] == 6) {
             an_raibert(b, st, c, b->ctrl_index[k], t, dt);
         }
     }
     an_gates(b, c);
     for (long long k = k0; k < k1; k++) {
-        if (b->ctrl_kind[k] == 5) {
+        if (AN_HAS(b, AN_P_CONTROL << 5) && b->ctrl_kind[k] == 5) {
             an_jellyfish(b, st, c, b->ctrl_index[k], t, dt);
         }
     }

@@ -40,6 +40,37 @@
 /* Integrators, as IntegratorKind's order in the engine. */
 enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3, AN_IMPLICIT = 4 };
 
+/* The parts of the step a batch has: each part's code runs only where
+ * AN_HAS(b, part), so a batch whose creatures lack a part skips it whole
+ * (b->absent, the host's Batch::absent). A kernel specialised for its
+ * batches (src/cuda.rs, `Special`) is compiled with the same bits as the
+ * constant AN_ABSENT and the batch's integrator as AN_ONLY_INTEGRATOR,
+ * so that the compiler drops that code and the kernel holds fewer
+ * registers. Skipped or dropped, the code is what would have run zero
+ * times for such a batch (a loop over none of a creature's fluids, a
+ * controller kind no creature has): the C on the CPU skips by b->absent
+ * in every parity test, so a part wrongly called absent shows there. */
+#ifdef AN_ONLY_INTEGRATOR
+#define AN_INTEGRATOR(b) AN_ONLY_INTEGRATOR
+#else
+#define AN_INTEGRATOR(b) ((b)->integrator)
+#endif
+#ifndef AN_ABSENT
+#define AN_ABSENT 0
+#endif
+#define AN_HAS(b, part) (!(((AN_ABSENT) | (b)->absent) & (part)))
+enum {
+    AN_P_JOINTS = 1 << 0,  /* angle joints */
+    AN_P_MOTORS = 1 << 1,  /* torque joints */
+    AN_P_PUSHES = 1 << 2,  /* constant forces */
+    AN_P_FLUIDS = 1 << 3,  /* fluids */
+    AN_P_NBODY = 1 << 4,   /* n-body gravity */
+    AN_P_SOFT = 1 << 5,    /* soft contact */
+    AN_P_RODS = 1 << 6,    /* drag across springs */
+    AN_P_PLANES = 1 << 7,  /* plane constraints */
+    AN_P_CONTROL = 1 << 8  /* controller kind k (eval.h, an_act): AN_P_CONTROL << k, k = 0 .. 6 */
+};
+
 /*
  * A batch of creatures of any mix of sizes, as structures of arrays with
  * per-creature offsets: creature c owns particles first_particle[c] ..
@@ -203,6 +234,7 @@ typedef struct {
                                      angle joint, a creature's after the ones before it */
     double solver_tolerance;      /* implicit Euler's conjugate gradients: relative tolerance */
     long long solver_iterations;  /* and most iterations */
+    unsigned int absent;          /* the parts no creature of the batch has (AN_P_*) */
 } an_batch;
 
 /* Where one creature's state is: its positions and velocities (3 doubles
@@ -723,24 +755,34 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
         f[3 * e + 2] -= fz;
     }
     long long j0 = b->first_joint[c], m0 = b->first_motor[c];
-    an_angle_joints(b, j0, b->first_joint[c + 1] - j0, x, v, f);
-    an_motors(b, m0, b->first_motor[c + 1] - m0, x, f);
-    for (long long q = b->first_push[c]; q < b->first_push[c + 1]; q++) {
+    if (AN_HAS(b, AN_P_JOINTS)) {
+        an_angle_joints(b, j0, b->first_joint[c + 1] - j0, x, v, f);
+    }
+    if (AN_HAS(b, AN_P_MOTORS)) {
+        an_motors(b, m0, b->first_motor[c + 1] - m0, x, f);
+    }
+    for (long long q = b->first_push[c]; AN_HAS(b, AN_P_PUSHES) && q < b->first_push[c + 1]; q++) {
         long long p = b->push_particle[q];
         for (int k = 0; k < 3; k++) {
             f[3 * p + k] += b->push_force[3 * q + k];
         }
     }
     long long q0 = b->first_fluid[c];
-    an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, x, v, f, t);
+    if (AN_HAS(b, AN_P_FLUIDS)) {
+        an_fluids(b, st, p0, n, q0, b->first_fluid[c + 1] - q0, x, v, f, t);
+    }
     long long n0 = b->first_nbody[c];
-    if (b->first_nbody[c + 1] > n0) {
+    if (AN_HAS(b, AN_P_NBODY) && b->first_nbody[c + 1] > n0) {
         an_nbody(b, st, n0, b->first_nbody[c + 1] - n0, x, f);
     }
     long long c0 = b->first_pair[c];
-    an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
+    if (AN_HAS(b, AN_P_SOFT)) {
+        an_soft_contact(b, st, c0, b->first_pair[c + 1] - c0, x, v, f);
+    }
     long long r0 = b->first_rod[c];
-    an_rod_drag(b, r0, b->first_rod[c + 1] - r0, x, v, f, t);
+    if (AN_HAS(b, AN_P_RODS)) {
+        an_rod_drag(b, r0, b->first_rod[c + 1] - r0, x, v, f, t);
+    }
     if (b->floor && b->floor_contact) {
         for (long long i = 0; i < n; i++) {
             an_floor_contact(b, st, i, p0 + i, x + 3 * i, v + 3 * i, f + 3 * i, h);
@@ -748,6 +790,9 @@ AN_FN void an_forces(const an_batch *b, an_state st, long long c, long long p0, 
     }
 }
 
+#if !defined(__CUDACC_RTC__) || defined(AN_WITH_IMPLICIT)
+/* (Implicit Euler's code, from here to an_implicit: on a GPU only in the
+ * kernels for implicit batches.) */
 /* Implicit Euler's room (integrators/implicit.rs, jacobian.rs): per
  * particle, the right-hand side's h^2 (df/dx) v0 (3), the particle's own
  * block of S (9), then b, x, r, z, p, q of the conjugate gradients (3
@@ -1103,6 +1148,7 @@ AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long 
         x1[k] = x0[k] + h * v;
     }
 }
+#endif
 
 /* One integrator step of size h from (x0, v0) at time t into (x1, v1)
  * (the files of integrators/, each stage's forces at their times); f,
@@ -1113,7 +1159,7 @@ AN_FN void an_integrate(const an_batch *b, an_state st, long long c, long long p
                         double *dv) {
     long long m3 = 3 * n;
     const double *w = st.w;
-    switch (b->integrator) {
+    switch (AN_INTEGRATOR(b)) {
     case AN_EULER:
         an_forces(b, st, c, p0, n, s0, ns, x0, v0, f, h, t);
         for (long long k = 0; k < m3; k++) {
@@ -1373,7 +1419,7 @@ AN_FN unsigned long long an_planes_check(const an_batch *b, long long c, const d
                                          const double *v1) {
     unsigned long long off = 0;
     long long k0 = b->first_plane[c];
-    for (long long k = k0; k < b->first_plane[c + 1]; k++) {
+    for (long long k = k0; AN_HAS(b, AN_P_PLANES) && k < b->first_plane[c + 1]; k++) {
         const double *pt = b->plane_param + 7 * k, *nrm = pt + 3;
         for (long long j = b->plane_first_particle[k]; j < b->plane_first_particle[k + 1]; j++) {
             long long i = b->plane_particle[j];

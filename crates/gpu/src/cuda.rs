@@ -44,19 +44,19 @@ fn source() -> String {
 pub struct Device {
     ctx: Arc<CudaContext>,
     stream: Arc<CudaStream>,
-    /// The kernel for batches on the flat floor (or none), compiled with
-    /// `AN_FLAT_ONLY`: without terrain's code it holds fewer registers
-    /// (`bench/nvrtc.py`: 168 against 240 for an evaluation on sm_90).
-    flat: Kernels,
-    /// The kernel with terrain, compiled when a batch on terrain first comes.
-    terrain: std::sync::OnceLock<Result<Kernels, String>>,
-    /// The kernel with sphere contact (on the flat floor, `AN_SPHERES`),
-    /// compiled when a batch with it first comes.
-    spheres: std::sync::OnceLock<Result<Kernels, String>>,
-    /// The three again with implicit Euler (`AN_WITH_IMPLICIT`: its step spills
-    /// every kernel's registers, so only its batches carry it), each
-    /// compiled when a batch that needs it first comes.
-    implicit: [std::sync::OnceLock<Result<Kernels, String>>; 3],
+    /// The whole kernel for batches on the flat floor (or none), compiled
+    /// with `AN_FLAT_ONLY` when the device is opened (so that a kernel
+    /// NVRTC refuses is reported then): without terrain's code it holds
+    /// fewer registers.
+    flat: Arc<Kernels>,
+    /// Every other kernel a batch has needed, compiled when the first such
+    /// batch came (or the error its compilation gave), by what it was
+    /// compiled for.
+    kept: std::sync::Mutex<Vec<(KernelKey, Compiled)>>,
+    /// Whether each batch runs a kernel specialised for it ([`Special`];
+    /// `ANIMATS_GPU_SPECIALISE`, on unless `0`), or the whole one of its
+    /// floor.
+    specialise: bool,
     name: String,
     arch: (i32, i32),
     mode: Mode,
@@ -133,6 +133,9 @@ impl Tuning {
     }
 }
 
+/// A kernel compiled, or the error its compilation gave.
+type Compiled = Result<Arc<Kernels>, String>;
+
 /// One compiled kernel's entries.
 struct Kernels {
     step: CudaFunction,
@@ -197,14 +200,19 @@ impl Device {
         let tuning = Tuning::from_env()?;
         let sort = crate::order::sort_from_env()?;
         let layout = crate::layout_choice::layout_from_env()?;
-        let flat = kernels(&ctx, arch, &name, Variant::Flat, false, mode, tuning)?;
+        let specialise = specialise_from_env()?;
+        let whole = KernelKey {
+            variant: Variant::Flat,
+            implicit: false,
+            special: None,
+        };
+        let flat = Arc::new(kernels(&ctx, arch, &name, whole, mode, tuning)?);
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
             flat,
-            terrain: std::sync::OnceLock::new(),
-            spheres: std::sync::OnceLock::new(),
-            implicit: Default::default(),
+            kept: Default::default(),
+            specialise,
             name,
             arch,
             mode,
@@ -216,35 +224,40 @@ impl Device {
     }
 
     /// The kernel for `batch`: the flat floor's, terrain's or sphere
-    /// contact's (compiled now if it was not yet).
-    fn kernels(&self, batch: &Batch) -> Result<&Kernels, String> {
-        let variant = if batch.sphere_contact() {
-            Variant::Spheres
-        } else if batch.on_terrain() {
-            Variant::Terrain
-        } else {
-            Variant::Flat
-        };
-        let implicit = batch.implicit();
-        let cell = match (variant, implicit) {
-            (Variant::Flat, false) => return Ok(&self.flat),
-            (Variant::Terrain, false) => &self.terrain,
-            (Variant::Spheres, false) => &self.spheres,
-            (v, true) => &self.implicit[v as usize],
-        };
-        cell.get_or_init(|| {
-            kernels(
-                &self.ctx,
-                self.arch,
-                &self.name,
-                variant,
-                implicit,
-                self.mode,
-                self.tuning,
-            )
-        })
-        .as_ref()
-        .map_err(Clone::clone)
+    /// contact's, with implicit Euler if the batch steps with it, and
+    /// specialised for the batch ([`Special`]) if it holds at least
+    /// [`SPECIALISE_FROM`] creatures, unless `ANIMATS_GPU_SPECIALISE=0`;
+    /// compiled now if no batch needed it yet (or read from the disk's
+    /// cache).
+    fn kernels(&self, batch: &Batch) -> Result<Arc<Kernels>, String> {
+        let key = KernelKey::of(batch, self.specialise);
+        if key.variant == Variant::Flat && !key.implicit && key.special.is_none() {
+            return Ok(self.flat.clone());
+        }
+        let mut kept = self
+            .kept
+            .lock()
+            .map_err(|_| "the GPU's kernels: a thread panicked while compiling one".to_string())?;
+        if let Some((_, k)) = kept.iter().find(|(k, _)| *k == key) {
+            return k.clone();
+        }
+        let compiled = kernels(
+            &self.ctx,
+            self.arch,
+            &self.name,
+            key,
+            self.mode,
+            self.tuning,
+        )
+        .map(Arc::new);
+        kept.push((key, compiled.clone()));
+        compiled
+    }
+
+    /// The options the kernel for `batch` is compiled with beyond the
+    /// mode's own ([`kernel_options`], as this device specialises).
+    pub fn kernel_options(&self, batch: &Batch) -> Vec<String> {
+        kernel_options(batch, self.specialise)
     }
 
     /// The mode its kernels were compiled in.
@@ -273,6 +286,31 @@ impl Device {
     /// GPU's threads ([`Schedule::Static`] unless set).
     pub fn set_schedule(&mut self, schedule: Schedule) {
         self.schedule = schedule;
+    }
+
+    /// Compiles (or reads from the disk's cache) the kernel for `batch`,
+    /// loads it and launches its evaluation on none of the batch's
+    /// creatures, so that a run timed after it holds the evaluation alone.
+    /// Changes nothing of the batch.
+    pub fn prepare(&self, batch: &Batch) -> Result<(), String> {
+        let s = &self.stream;
+        let (_on_device, raw) = upload(s, batch)?;
+        let kernels = self.kernels(batch)?;
+        let (none, local, queue) = (0i64, batch.layout().flag(), 0i32);
+        let next = s
+            .alloc_zeros::<u64>(1)
+            .map_err(err("the queue's counter"))?;
+        let mut launch = s.launch_builder(&kernels.evaluate);
+        launch
+            .arg(&raw)
+            .arg(&none)
+            .arg(&local)
+            .arg(&next)
+            .arg(&queue);
+        // SAFETY: as in `evaluate`; with no creatures the one thread
+        // returns before reading anything.
+        unsafe { launch.launch(config(1, 32)?) }.map_err(err("launching the evaluation"))?;
+        s.synchronize().map_err(err("waiting for the GPU"))
     }
 
     /// Steps every creature of `batch` `steps` times on the GPU (one
@@ -397,7 +435,7 @@ impl Device {
 /// Which of the kernels: each holds only the code its batches need, so
 /// that the commonest hold the fewest registers (each also with implicit
 /// Euler, `AN_WITH_IMPLICIT`, for batches that step with it).
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Variant {
     /// The flat floor (or none): `AN_FLAT_ONLY`.
     Flat = 0,
@@ -407,15 +445,122 @@ enum Variant {
     Spheres = 2,
 }
 
-/// The kernel `variant` compiled for `arch` in `mode`, from the disk's
+/// Creatures a batch holds from which it runs a kernel specialised for it
+/// ([`Special`]): NVRTC takes some 20–40 s to compile one (once a
+/// machine: it is kept on disk), more than a smaller batch's whole run
+/// on the GPU could gain (4,096 roobots took 0.08 s on an H200,
+/// 2026-11-30), so smaller batches run the whole kernel of their floor,
+/// compiled when the device is opened.
+pub const SPECIALISE_FROM: usize = 4096;
+
+/// A kernel specialised for a batch: its integrator as a constant and
+/// without the parts none of its creatures has (`kernel/step.h`,
+/// `AN_ONLY_INTEGRATOR` and `AN_ABSENT`). The compiler drops their code, so
+/// the kernel holds fewer registers and more warps fit on a
+/// multiprocessor (`bench/nvrtc.py --special`: a walker's evaluation 255
+/// registers with spills → 160 on sm_90); the same bits, as only code that
+/// would have run zero times for the batch is left out. Batches of one
+/// scene share one: a run compiles one or two.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Special {
+    /// The C's number of the batch's integrator.
+    pub integrator: i32,
+    /// `AN_ABSENT`: the parts no creature of the batch has.
+    pub absent: u32,
+}
+
+impl Special {
+    /// `batch`'s.
+    pub fn of(batch: &Batch) -> Special {
+        Special {
+            integrator: batch.integrator_code(),
+            absent: batch.absent(),
+        }
+    }
+}
+
+/// What a kernel is compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct KernelKey {
+    variant: Variant,
+    implicit: bool,
+    special: Option<Special>,
+}
+
+impl KernelKey {
+    /// The kernel `batch` needs: specialised for it if `specialise`.
+    fn of(batch: &Batch, specialise: bool) -> KernelKey {
+        let variant = if batch.sphere_contact() {
+            Variant::Spheres
+        } else if batch.on_terrain() {
+            Variant::Terrain
+        } else {
+            Variant::Flat
+        };
+        KernelKey {
+            variant,
+            implicit: batch.implicit(),
+            special: (specialise && batch.creatures() >= SPECIALISE_FROM)
+                .then(|| Special::of(batch)),
+        }
+    }
+
+    /// Its options beyond the mode's and the tuning's.
+    fn options(self) -> Vec<String> {
+        let mut options = Vec::new();
+        if self.variant != Variant::Terrain {
+            options.push("-DAN_FLAT_ONLY".into());
+        }
+        if self.variant == Variant::Spheres {
+            options.push("-DAN_SPHERES".into());
+        }
+        if self.implicit {
+            options.push("-DAN_WITH_IMPLICIT".into());
+        }
+        if let Some(s) = self.special {
+            options.push(format!("-DAN_ONLY_INTEGRATOR={}", s.integrator));
+            options.push(format!("-DAN_ABSENT={}", s.absent));
+        }
+        options
+    }
+}
+
+/// The options the kernel for `batch` is compiled with beyond the mode's
+/// own and the tuning's: which floor, implicit Euler, and where
+/// `specialise` (and the batch holds at least [`SPECIALISE_FROM`]
+/// creatures), the batch's specialisation (`-DAN_ONLY_INTEGRATOR=…
+/// -DAN_ABSENT=…`, [`Special`]). Needs no GPU: `bench/nvrtc.py` compiles
+/// a kernel with them.
+pub fn kernel_options(batch: &Batch, specialise: bool) -> Vec<String> {
+    KernelKey::of(batch, specialise).options()
+}
+
+/// `ANIMATS_GPU_SPECIALISE`: unset, empty or `1` gives each batch a kernel
+/// specialised for it ([`Special`]); `0` the whole kernel of its floor;
+/// anything else is refused by name.
+pub fn specialise_from_env() -> Result<bool, String> {
+    parse_specialise(std::env::var("ANIMATS_GPU_SPECIALISE").ok().as_deref())
+}
+
+/// [`specialise_from_env`] from the variable's value (`None`: unset).
+pub fn parse_specialise(v: Option<&str>) -> Result<bool, String> {
+    match v.map(str::trim) {
+        None | Some("") | Some("1") => Ok(true),
+        Some("0") => Ok(false),
+        Some(other) => Err(format!(
+            "ANIMATS_GPU_SPECIALISE: 1 (a kernel specialised for each batch) or 0 (the whole kernel), got {other:?}"
+        )),
+    }
+}
+
+/// The kernel `key` compiled for `arch` in `mode`, from the disk's
 /// cache where an earlier run kept it (src/cache.rs), else by NVRTC now,
 /// and kept.
 fn kernels(
     ctx: &Arc<CudaContext>,
     arch: (i32, i32),
     name: &str,
-    variant: Variant,
-    implicit: bool,
+    key: KernelKey,
     mode: Mode,
     tuning: Tuning,
 ) -> Result<Kernels, String> {
@@ -424,15 +569,7 @@ fn kernels(
     if let Some(n) = tuning.regs {
         options.push(format!("--maxrregcount={n}"));
     }
-    if variant != Variant::Terrain {
-        options.push("-DAN_FLAT_ONLY".into());
-    }
-    if variant == Variant::Spheres {
-        options.push("-DAN_SPHERES".into());
-    }
-    if implicit {
-        options.push("-DAN_WITH_IMPLICIT".into());
-    }
+    options.extend(key.options());
     let kept = crate::cache::folder()
         .map(|dir| crate::cache::file(&dir, &[&src, &options.join(" "), &nvrtc_version()], arch));
     let load = |cubin: Vec<u8>| ctx.load_module(cudarc::nvrtc::Ptx::from_binary(cubin));
@@ -685,7 +822,22 @@ mod tests {
         assert!(!s.contains("#include"));
     }
 
-    use super::{config, threads_a_block, Tuning, BLOCK};
+    use super::{config, parse_specialise, threads_a_block, Tuning, BLOCK};
+
+    #[test]
+    fn specialising_is_on_unless_turned_off_and_other_values_are_refused_by_name() {
+        for on in [None, Some(""), Some("1"), Some(" 1 ")] {
+            assert_eq!(parse_specialise(on), Ok(true), "{on:?}");
+        }
+        assert_eq!(parse_specialise(Some("0")), Ok(false));
+        for bad in ["yes", "2", "off"] {
+            let e = parse_specialise(Some(bad)).unwrap_err();
+            assert!(
+                e.contains("ANIMATS_GPU_SPECIALISE") && e.contains(bad),
+                "{e}"
+            );
+        }
+    }
 
     #[test]
     fn the_tuning_knobs_take_what_a_gpu_can_run_and_name_what_they_refuse() {

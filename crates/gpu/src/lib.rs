@@ -43,7 +43,7 @@ mod pack;
 pub mod ported;
 mod scenes;
 
-pub use cuda::{Device, Schedule, Tuning};
+pub use cuda::{Device, Schedule, Special, Tuning};
 pub use scenes::cpu_has_fma;
 
 /// How the C does its arithmetic.

@@ -6,7 +6,7 @@ use animats_engine::{
     DVec3, FloorCollision, IntegratorKind, NBodyGravity, PlaneConstraint, RodDrag, SoftContact,
     Solver, SphereContact, Terrain, World,
 };
-use std::os::raw::{c_double, c_int, c_longlong};
+use std::os::raw::{c_double, c_int, c_longlong, c_uint};
 use std::sync::Arc;
 
 /// The C's `an_batch`: pointers into a [`Batch`]'s vectors (or into their
@@ -154,6 +154,7 @@ pub(crate) struct Raw {
     implicit: *mut c_double,
     solver_tolerance: c_double,
     solver_iterations: c_longlong,
+    absent: c_uint,
 }
 
 extern "C" {
@@ -217,6 +218,10 @@ const IMPLICIT: [usize; 3] = [39, 6, 55];
 
 /// Doubles of scratch per particle the C step uses.
 const SCRATCH: usize = 15;
+
+/// Controller kinds the C evaluates (`ctrl_kind`, `kernel/eval.h`'s
+/// `an_act`: oscillator, network, CTRNN, FSM, hopper, jellyfish, Raibert's).
+const CONTROL_KINDS: i32 = 7;
 
 /// Many worlds (creatures) as one batch of the C step's arrays.
 #[derive(Clone, Debug)]
@@ -638,6 +643,41 @@ impl Batch {
         self.integrator == IntegratorKind::Implicit
     }
 
+    /// The batch's integrator as the C numbers them (`AN_RK4` and its
+    /// kin, `kernel/step.h`).
+    pub(crate) fn integrator_code(&self) -> c_int {
+        match self.integrator {
+            IntegratorKind::Euler => 0,
+            IntegratorKind::Midpoint => 1,
+            IntegratorKind::Rk4 => 2,
+            IntegratorKind::Implicit => 4,
+            _ => 3,
+        }
+    }
+
+    /// The parts of the step no creature of the batch has, as the bits of
+    /// `AN_ABSENT` (`kernel/step.h`, `AN_P_*`): a kernel compiled without
+    /// them runs the same arithmetic on this batch, each of their loops
+    /// having had nothing to do.
+    pub(crate) fn absent(&self) -> u32 {
+        let parts = [
+            self.joint_a.is_empty(),
+            self.motor_end.is_empty(),
+            self.push_particle.is_empty(),
+            self.fluid_drag.is_empty(),
+            self.nbody_param.is_empty(),
+            self.pair_a.is_empty(),
+            self.rod_a.is_empty(),
+            self.plane_param.is_empty(),
+        ];
+        let controls = (0..CONTROL_KINDS).map(|k| !self.ev.ctrl_kind.contains(&k));
+        parts
+            .into_iter()
+            .chain(controls)
+            .enumerate()
+            .fold(0, |bits, (i, none)| bits | (u32::from(none) << i))
+    }
+
     /// Whether a creature of the batch has sphere contact (the event).
     pub fn sphere_contact(&self) -> bool {
         self.contact_param.chunks(4).any(|p| p[0] != 0.0)
@@ -946,13 +986,7 @@ impl Batch {
             gy: self.g.y,
             gz: self.g.z,
             gravity: c_int::from(self.gravity),
-            integrator: match self.integrator {
-                IntegratorKind::Euler => 0,
-                IntegratorKind::Midpoint => 1,
-                IntegratorKind::Rk4 => 2,
-                IntegratorKind::Implicit => 4,
-                _ => 3,
-            },
+            integrator: self.integrator_code(),
             dt: self.dt,
             floor: c_int::from(self.floor.is_some()),
             floor_contact: c_int::from(self.floor.as_ref().is_some_and(|f| f.contact.is_some())),
@@ -1060,6 +1094,7 @@ impl Batch {
             implicit: m(Array::Implicit),
             solver_tolerance: self.solver.tolerance,
             solver_iterations: c_longlong::from(self.solver.max_iterations),
+            absent: self.absent(),
         }
     }
 }

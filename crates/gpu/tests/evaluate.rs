@@ -1495,3 +1495,55 @@ fn every_shipped_scene_evaluates_in_the_c_as_in_the_engine() {
     }
     assert!(tried.len() >= 20, "{tried:?}");
 }
+
+#[test]
+fn a_batch_leaves_out_only_the_parts_none_of_its_creatures_has() {
+    // `Special::of`: what a kernel specialised for a batch may drop (the
+    // bits of kernel/step.h's AN_P_*). Every parity test above runs the C
+    // skipping those parts (b->absent), so a part wrongly called absent
+    // breaks them; this pins what is called absent, so that a part called
+    // present for nothing (which costs registers, not bits) shows too.
+    use animats_gpu::Special;
+    const JOINTS: u32 = 1;
+    const FLUIDS: u32 = 1 << 3;
+    const SOFT: u32 = 1 << 5;
+    const PLANES: u32 = 1 << 7;
+    let control = |k: u32| 1u32 << (8 + k);
+    let every = (1u32 << 15) - 1;
+    let special = |scenes: &[Scene]| {
+        let refs: Vec<&Scene> = scenes.iter().collect();
+        Special::of(&Batch::pack_scenes(&refs).unwrap())
+    };
+    // The walker: springs (its muscles) under oscillators, nothing else,
+    // symplectic Euler.
+    let walkers = genomes(WALKER, 2, 1);
+    let w = special(&walkers);
+    assert_eq!((w.integrator, w.absent), (3, every & !control(0)), "{w:?}");
+    // The roobot: angle and torque joints, still air, the plane it hops
+    // in and its FSM (controller kind 4), RK4.
+    let roobot = vec![SceneProblem::parse(HOP_EVOLVER, "hop_evolver.toml")
+        .unwrap()
+        .fresh()
+        .unwrap()];
+    let r = special(&roobot);
+    assert_eq!(r.integrator, 2);
+    for present in [JOINTS, 2, FLUIDS, PLANES, control(4)] {
+        assert_eq!(r.absent & present, 0, "{r:?}: {present:#x}");
+    }
+    assert_eq!(r.absent & (control(0) | SOFT), control(0) | SOFT, "{r:?}");
+    // Jellyfish among swimming bodies: the batch leaves out what both
+    // lack, no more.
+    let text = include_str!("../../../scenes/bodies_swim.toml");
+    let problem = MorphologyProblem::parse(text, "bodies_swim.toml").unwrap();
+    let bodies = random_bodies(&problem, 3, 2);
+    let jelly = include_str!("../../../scenes/jellyfish_swim.toml")
+        .replace("dt = 0.01 ", "dt = 0.001 ")
+        .replace("integrator = \"rk4\"", "integrator = \"symplectic\"");
+    let jellyfish = vec![animats_scene::parse(&jelly, "jellyfish_swim.toml").unwrap()];
+    let (b, j) = (special(&bodies), special(&jellyfish));
+    let mut both = bodies;
+    both.extend(jellyfish);
+    let m = special(&both);
+    assert_eq!(m.absent, b.absent & j.absent, "{b:?} {j:?} {m:?}");
+    assert!(b.absent != j.absent && m.absent != b.absent, "{b:?} {j:?}");
+}
