@@ -117,7 +117,7 @@ def main():
             ("implicit Euler, flat floor", ["-DAN_FLAT_ONLY", "-DAN_WITH_IMPLICIT"]),
             # A kernel specialised for a batch (src/cuda.rs, `Special`): the
             # walker's, as gpu_evaluate prints it.
-            ("specialised for walkers", ["-DAN_FLAT_ONLY", "-DAN_ONLY_INTEGRATOR=3", "-DAN_ABSENT=32511"]),
+            ("specialised for walkers", ["-DAN_FLAT_ONLY", "-DAN_ONLY_INTEGRATOR=3", "-DAN_ABSENT=65279"]),
         ]
         for i, (kernel, extra) in enumerate(kinds):
             # (--quick: PTX only but for the first.)

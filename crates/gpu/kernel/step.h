@@ -68,7 +68,8 @@ enum {
     AN_P_SOFT = 1 << 5,    /* soft contact */
     AN_P_RODS = 1 << 6,    /* drag across springs */
     AN_P_PLANES = 1 << 7,  /* plane constraints */
-    AN_P_CONTROL = 1 << 8  /* controller kind k (eval.h, an_act): AN_P_CONTROL << k, k = 0 .. 6 */
+    AN_P_CONTROL = 1 << 8, /* controller kind k (eval.h, an_act): AN_P_CONTROL << k, k = 0 .. 6 */
+    AN_P_REEF = 1 << 15    /* a reef's waves, a fluid's or rods' current (an_current) */
 };
 
 /*
@@ -387,8 +388,9 @@ AN_COLD void an_reef_current(const double *cur, const double *p, double t, doubl
 
 /* The current's velocity at p at time t, into u: a uniform current's
  * (still water's 0), or a reef's. */
-AN_FN void an_current(const double *cur, const double *p, double t, double *u) {
-    if (cur[3] != cur[3]) {
+AN_FN void an_current(const an_batch *b, const double *cur, const double *p, double t,
+                      double *u) {
+    if (!AN_HAS(b, AN_P_REEF) || cur[3] != cur[3]) {
         u[0] = cur[0];
         u[1] = cur[1];
         u[2] = cur[2];
@@ -415,7 +417,7 @@ AN_FN void an_fluids(const an_batch *b, an_state st, long long p0, long long n, 
         const double *cur = b->fluid_current + AN_CURRENT * q;
         for (long long i = 0; i < n; i++) {
             double r = st.r[i], u[3];
-            an_current(cur, x + 3 * i, t, u);
+            an_current(b, cur, x + 3 * i, t, u);
             double vr[3] = {v[3 * i] - u[0], v[3 * i + 1] - u[1], v[3 * i + 2] - u[2]};
             double speed = sqrt(an_dot(vr, vr));
             double s = drag * r * r * speed;
@@ -500,7 +502,7 @@ AN_FN void an_rod_drag(const an_batch *b, long long q0, long long nq, const doub
             for (int k = 0; k < 3; k++) {
                 at[k] = x[3 * a + k] + d[k] * xi;
             }
-            an_current(cur, at, t, uc);
+            an_current(b, cur, at, t, uc);
             for (int k = 0; k < 3; k++) {
                 w[k] = (v[3 * a + k] + dv[k] * xi) - uc[k];
             }
@@ -1050,7 +1052,7 @@ AN_COLD void an_implicit(const an_batch *b, an_state st, long long c, long long 
         const double *cur = b->fluid_current + AN_CURRENT * qf;
         for (long long i = 0; i < n; i++) {
             double uc[3], vr[3];
-            an_current(cur, x0 + 3 * i, t, uc);
+            an_current(b, cur, x0 + 3 * i, t, uc);
             for (int k = 0; k < 3; k++) {
                 vr[k] = v0[3 * i + k] - uc[k];
             }

@@ -457,10 +457,11 @@ pub const SPECIALISE_FROM: usize = 4096;
 /// without the parts none of its creatures has (`kernel/step.h`,
 /// `AN_ONLY_INTEGRATOR` and `AN_ABSENT`). The compiler drops their code, so
 /// the kernel holds fewer registers and more warps fit on a
-/// multiprocessor (`bench/nvrtc.py --special`: a walker's evaluation 255
-/// registers with spills → 160 on sm_90); the same bits, as only code that
-/// would have run zero times for the batch is left out. Batches of one
-/// scene share one: a run compiles one or two.
+/// multiprocessor (`bench/nvrtc.py sm_90 -- OPTIONS`: a batch of walkers'
+/// evaluation 222 registers → 136; docs/GPU.md); the same bits, as only
+/// code that would have run zero times for the batch is left out (the C
+/// skips the same code at run time, `Batch::absent`, in every parity
+/// test). Batches of one scene share one: a run compiles one or two.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Special {
     /// The C's number of the batch's integrator.

@@ -656,7 +656,8 @@ impl Batch {
     }
 
     /// The parts of the step no creature of the batch has, as the bits of
-    /// `AN_ABSENT` (`kernel/step.h`, `AN_P_*`): a kernel compiled without
+    /// `AN_ABSENT` (`kernel/step.h`, `AN_P_*`, in their order: eight kinds
+    /// of force and event, seven of controller, a reef's waves): a kernel compiled without
     /// them runs the same arithmetic on this batch, each of their loops
     /// having had nothing to do.
     pub(crate) fn absent(&self) -> u32 {
@@ -671,9 +672,14 @@ impl Batch {
             self.plane_param.is_empty(),
         ];
         let controls = (0..CONTROL_KINDS).map(|k| !self.ev.ctrl_kind.contains(&k));
+        // A reef's current is marked by a number in its slot 3 (a uniform
+        // current's is NaN: `current`).
+        let reef = |c: &[f64]| c.chunks_exact(11).any(|c| !c[3].is_nan());
+        let no_reef = !reef(&self.fluid_current) && !reef(&self.rod_current);
         parts
             .into_iter()
             .chain(controls)
+            .chain([no_reef])
             .enumerate()
             .fold(0, |bits, (i, none)| bits | (u32::from(none) << i))
     }

@@ -1509,7 +1509,8 @@ fn a_batch_leaves_out_only_the_parts_none_of_its_creatures_has() {
     const SOFT: u32 = 1 << 5;
     const PLANES: u32 = 1 << 7;
     let control = |k: u32| 1u32 << (8 + k);
-    let every = (1u32 << 15) - 1;
+    const REEF: u32 = 1 << 15;
+    let every = (1u32 << 16) - 1;
     let special = |scenes: &[Scene]| {
         let refs: Vec<&Scene> = scenes.iter().collect();
         Special::of(&Batch::pack_scenes(&refs).unwrap())
@@ -1546,4 +1547,14 @@ fn a_batch_leaves_out_only_the_parts_none_of_its_creatures_has() {
     let m = special(&both);
     assert_eq!(m.absent, b.absent & j.absent, "{b:?} {j:?} {m:?}");
     assert!(b.absent != j.absent && m.absent != b.absent, "{b:?} {j:?}");
+    assert_eq!(b.absent & REEF, REEF, "still water: {b:?}");
+    // Under a reef's waves the current's code stays.
+    let waves = text.replace(
+        "drag_coefficient = 0.47\n",
+        "drag_coefficient = 0.47\ncurrent = { kind = \"reef\", surface = 0.4, amplitude = 0.1, wavelength = 1.5, direction = [1.0, 0.0, 0.3], drift = [0.05, 0.0, 0.0] }\n",
+    );
+    assert!(waves.contains("reef"));
+    let problem = MorphologyProblem::parse(&waves, "bodies_swim.toml").unwrap();
+    let w = special(&random_bodies(&problem, 3, 2));
+    assert_eq!(w.absent, b.absent & !REEF, "{w:?} {b:?}");
 }
