@@ -201,12 +201,14 @@ impl Device {
         let sort = crate::order::sort_from_env()?;
         let layout = crate::layout_choice::layout_from_env()?;
         let specialise = specialise_from_env()?;
-        let whole = KernelKey {
-            variant: Variant::Flat,
-            implicit: false,
-            special: None,
-        };
-        let flat = Arc::new(kernels(&ctx, arch, &name, whole, mode, tuning)?);
+        let flat = Arc::new(kernels(
+            &ctx,
+            arch,
+            &name,
+            KernelKey::WHOLE_FLAT,
+            mode,
+            tuning,
+        )?);
         Ok(Device {
             stream: ctx.default_stream(),
             ctx,
@@ -231,7 +233,7 @@ impl Device {
     /// cache).
     fn kernels(&self, batch: &Batch) -> Result<Arc<Kernels>, String> {
         let key = KernelKey::of(batch, self.specialise);
-        if key.variant == Variant::Flat && !key.implicit && key.special.is_none() {
+        if key == KernelKey::WHOLE_FLAT {
             return Ok(self.flat.clone());
         }
         let mut kept = self
@@ -252,6 +254,17 @@ impl Device {
         .map(Arc::new);
         kept.push((key, compiled.clone()));
         compiled
+    }
+
+    /// Whether the kernel for `batch` is compiled (or its compilation
+    /// failed) already.
+    fn has_kernels(&self, batch: &Batch) -> bool {
+        let key = KernelKey::of(batch, self.specialise);
+        key == KernelKey::WHOLE_FLAT
+            || self
+                .kept
+                .lock()
+                .is_ok_and(|kept| kept.iter().any(|(k, _)| *k == key))
     }
 
     /// The options the kernel for `batch` is compiled with beyond the
@@ -418,8 +431,18 @@ impl Device {
                 let layout = choice.next();
                 batch.set_layout(layout);
                 // The kernel compiled first (a batch's first needs it), so
-                // that the clock times the evaluation alone.
+                // that the clock times the evaluation alone; a compilation
+                // (NVRTC: seconds) said, so that a pause is not taken for a hang.
+                let known = device.has_kernels(&batch);
+                let t = std::time::Instant::now();
                 device.kernels(&batch)?;
+                let took = t.elapsed().as_secs_f64();
+                if !known && took >= 1.0 {
+                    say(format!(
+                        "GPU: the kernel for this run's batches ({}) compiled in {took:.1} s; kept on disk for later runs",
+                        device.kernel_options(&batch).join(" ")
+                    ));
+                }
                 let t = std::time::Instant::now();
                 let evaluations = device.evaluate(&mut batch)?;
                 let simulated: f64 = evaluations.iter().map(|e| e.time).sum();
@@ -489,6 +512,13 @@ struct KernelKey {
 }
 
 impl KernelKey {
+    /// The flat floor's whole kernel, compiled when a device is opened.
+    const WHOLE_FLAT: KernelKey = KernelKey {
+        variant: Variant::Flat,
+        implicit: false,
+        special: None,
+    };
+
     /// The kernel `batch` needs: specialised for it if `specialise`.
     fn of(batch: &Batch, specialise: bool) -> KernelKey {
         let variant = if batch.sphere_contact() {
