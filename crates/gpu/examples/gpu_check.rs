@@ -208,6 +208,13 @@ fn main() {
         eprintln!("gpu_check: {e}");
         std::process::exit(2);
     }
+    match device.kernel_report(&packed) {
+        Ok(report) => println!("GPU kernel: {report}"),
+        Err(e) => {
+            eprintln!("gpu_check: {e}");
+            std::process::exit(2);
+        }
+    }
     // Each creature's state in the thread's local memory (the default),
     // then in the batch's arrays.
     let mut bad_gpu = 0;

@@ -321,6 +321,10 @@ fn main() {
     // The batch's kernel compiled, loaded and launched once before any
     // clock starts (the first launch pays for the loading).
     device.prepare(&packed).unwrap_or_else(|e| fail(e));
+    println!(
+        "GPU kernel: {}",
+        device.kernel_report(&packed).unwrap_or_else(|e| fail(e))
+    );
     // Each creature's state in the thread's local memory (the default),
     // then in the batch's arrays; one thread per evaluation (the default),
     // then threads taking evaluations from a queue.

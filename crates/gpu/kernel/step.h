@@ -51,6 +51,9 @@ enum { AN_EULER = 0, AN_MIDPOINT = 1, AN_RK4 = 2, AN_SYMPLECTIC = 3, AN_IMPLICIT
  * controller kind no creature has): the C on the CPU skips by b->absent
  * in every parity test, so a part wrongly called absent shows there. */
 #ifdef AN_ONLY_INTEGRATOR
+#if AN_ONLY_INTEGRATOR == 4 && !defined(AN_WITH_IMPLICIT)
+#error "AN_ONLY_INTEGRATOR=4 (implicit Euler) needs AN_WITH_IMPLICIT"
+#endif
 #define AN_INTEGRATOR(b) AN_ONLY_INTEGRATOR
 #else
 #define AN_INTEGRATOR(b) ((b)->integrator)

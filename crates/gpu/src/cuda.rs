@@ -256,6 +256,34 @@ impl Device {
         compiled
     }
 
+    /// What the driver says of the kernel for `batch` (compiled now if it
+    /// was not): each entry's registers a thread, local memory a thread,
+    /// and the warps a multiprocessor holds in the blocks `batch` is
+    /// launched in — the figures docs/GPU.md's table of specialised
+    /// kernels computes from ptxas's report.
+    pub fn kernel_report(&self, batch: &Batch) -> Result<String, String> {
+        let kernels = self.kernels(batch)?;
+        let n = i64::try_from(batch.creatures()).unwrap_or(i64::MAX);
+        let block = threads_a_block(n, kernels.sms, self.tuning.block);
+        let entry = |name: &str, f: &CudaFunction| -> Result<String, String> {
+            let e = |e: cudarc::driver::DriverError| format!("the {name}'s attributes: {e}");
+            let blocks = f
+                .occupancy_max_active_blocks_per_multiprocessor(block, 0, None)
+                .map_err(e)?;
+            Ok(format!(
+                "{name} {} registers, {} bytes local, {} warps a multiprocessor",
+                f.num_regs().map_err(e)?,
+                f.local_size_bytes().map_err(e)?,
+                i64::from(blocks) * i64::from(block) / 32
+            ))
+        };
+        Ok(format!(
+            "{}; {} (blocks of {block})",
+            entry("evaluation", &kernels.evaluate)?,
+            entry("step", &kernels.step)?
+        ))
+    }
+
     /// Whether the kernel for `batch` is compiled (or its compilation
     /// failed) already.
     fn has_kernels(&self, batch: &Batch) -> bool {
@@ -469,9 +497,9 @@ enum Variant {
 }
 
 /// Creatures a batch holds from which it runs a kernel specialised for it
-/// ([`Special`]): NVRTC takes some 20–40 s to compile one (once a
-/// machine: it is kept on disk), more than a smaller batch's whole run
-/// on the GPU could gain (4,096 roobots took 0.08 s on an H200,
+/// ([`Special`]): NVRTC takes about 10 s to compile one on an H200's host
+/// and 40 s on a 2-core Xeon (once a machine: it is kept on disk), more
+/// than a smaller batch's whole run on the GPU could gain (4,096 roobots took 0.08 s on an H200,
 /// 2026-11-30), so smaller batches run the whole kernel of their floor,
 /// compiled when the device is opened.
 pub const SPECIALISE_FROM: usize = 4096;
