@@ -29,6 +29,12 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 
 /// Writes `state` to `path` atomically.
 pub fn save(path: &Path, state: &State) -> Result<(), String> {
+    animats_files::write_atomically(path, encode(state)?.as_bytes())
+}
+
+/// `state` as a checkpoint file's text ([`save`] writes it; [`load`]
+/// reads it back).
+pub fn encode(state: &State) -> Result<String, String> {
     let body =
         serde_json::to_string(state).map_err(|e| format!("cannot encode the checkpoint: {e}"))?;
     let header = Header {
@@ -37,7 +43,7 @@ pub fn save(path: &Path, state: &State) -> Result<(), String> {
         checksum: format!("{:016x}", fnv1a(body.as_bytes())),
     };
     let header = serde_json::to_string(&header).map_err(|e| e.to_string())?;
-    animats_files::write_atomically(path, format!("{header}\n{body}\n").as_bytes())
+    Ok(format!("{header}\n{body}\n"))
 }
 
 /// Reads a checkpoint, refusing anything that is not an intact one.
