@@ -541,6 +541,12 @@ fn evolve(
         let live = Mutex::new(Live::new(state));
         let watcher = std::thread::current();
         let problem = problem.as_ref();
+        // Set by the work before it wakes this thread: the thread itself
+        // is finished only a moment later, and a watcher that woke to find
+        // it not yet finished slept its whole 250 ms again while every lane
+        // waited (0.25-0.29 s at a checkpoint or at the end, seen in
+        // `--schedule` traces, 2026-12-01).
+        let done = AtomicBool::new(false);
         let result = std::thread::scope(|scope| {
             let work = scope.spawn(|| {
                 let more = || !stop.load(Ordering::SeqCst) && begun.elapsed() < every;
@@ -550,11 +556,12 @@ fn evolve(
                     }
                 };
                 let r = pool.install(|| state.advance_while(problem, tracer, &more, &seen));
+                done.store(true, Ordering::SeqCst);
                 watcher.unpark();
                 r
             });
             // (Finished also when an evaluation panicked: then `join` says so.)
-            while !work.is_finished() {
+            while !done.load(Ordering::SeqCst) && !work.is_finished() {
                 std::thread::park_timeout(Duration::from_millis(250));
                 if let Ok(mut l) = live.lock() {
                     progress.show_numbers(l.generation(), l.evaluations(), l.best_fitness(), false);
