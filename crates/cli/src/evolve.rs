@@ -238,9 +238,10 @@ fn periodic_files(dir: &Path, state: &State) -> Result<Vec<(PathBuf, Vec<u8>)>, 
 
 /// A run's periodic save being written by a thread of its own, so that
 /// the lanes need not wait for the disk (each file is synced before it
-/// is renamed into place: 13 to 260 ms a save on this project's machines,
-/// 2026-12-01). One save at a time: the next, and the end's, wait for it
-/// first ([`Writing::wait`]); dropped, it is waited for too.
+/// is renamed into place: a few milliseconds on this project's machines,
+/// far longer on a busy or networked file system). One save at a time:
+/// the next, and the end's, wait for it first ([`Writing::wait`]);
+/// dropped, it is waited for too.
 #[derive(Default)]
 struct Writing(Option<std::thread::JoinHandle<Result<(), String>>>);
 
