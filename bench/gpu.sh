@@ -28,8 +28,11 @@
 # memory (Layout::Local, the default) and in the batch's arrays
 # (Layout::Batch), and gpu_evaluate also with the threads taking
 # evaluations from a queue (Schedule::Queue); every one's bits checked.
-# The first run compiles the kernel (about 10 s) and keeps it in
-# $ANIMATS_CACHE (here a folder of its own); the rest read it.
+# Batches of 4,096 creatures and more run a kernel specialised for them
+# (animats_gpu::Special: fewer registers; each run prints its options and,
+# from the driver, its registers and resident warps). Every kernel is
+# compiled once (about 10 s each) into $ANIMATS_CACHE (here a folder of
+# its own), side by side before anything is timed (`warm`, below).
 #
 # Builds nothing: it takes the examples built here, carried in an ignored
 # folder:

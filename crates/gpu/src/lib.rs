@@ -22,7 +22,9 @@
 //!   compiles the same C for the GPU (a CUBIN for its architecture,
 //!   `--fmad=false`); [`Device::run`] steps a batch there, one thread per
 //!   creature. Where no driver, device or NVRTC is found, `open` says
-//!   which. The compiled kernel is kept on disk for the next run
+//!   which. A batch of at least 4,096 creatures runs a kernel specialised
+//!   for it ([`Special`]: its integrator, and only the parts its creatures
+//!   have). Compiled kernels are kept on disk for the next run
 //!   ([`cache`]). Run on an NVIDIA H200 with the CPU's bits (docs/GPU.md).
 //!
 //! What the C covers today: particles, uniform gravity, damped springs,
