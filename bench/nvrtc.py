@@ -98,14 +98,18 @@ def main():
         args = args[:args.index("--")]
     quick = "--quick" in args
     args = [a for a in args if a != "--quick"]
+    def report(to, name, extra):
+        """Compiles the kernel with `extra` for `to`; prints what ptxas says."""
+        ok, log = compile_for(lib, to, src, extra)
+        print(f"NVRTC {major.value}.{minor.value}, {to}, {name}: {'compiled' if ok else 'REFUSED'}")
+        for line in log.splitlines():
+            if not ok or "entry function" in line or "registers" in line or "spill" in line or "warning" in line:
+                print("  " + line.strip())
+        return ok
+
     for arch in args or ["sm_90"]:
         if given is not None:
-            ok, log = compile_for(lib, arch, src, given)
-            print(f"NVRTC {major.value}.{minor.value}, {arch}, {' '.join(given)}: {'compiled' if ok else 'REFUSED'}")
-            for line in log.splitlines():
-                if not ok or "entry function" in line or "registers" in line or "spill" in line or "warning" in line:
-                    print("  " + line.strip())
-            failed |= not ok
+            failed |= not report(arch, " ".join(given), given)
             continue
         # As crates/gpu/src/cuda.rs's whole kernels: the flat floor's,
         # terrain's and sphere contact's (on the flat floor); then the flat
@@ -122,12 +126,7 @@ def main():
         for i, (kernel, extra) in enumerate(kinds):
             # (--quick: PTX only but for the first.)
             to = arch.replace("sm_", "compute_") if quick and i > 0 else arch
-            ok, log = compile_for(lib, to, src, extra)
-            print(f"NVRTC {major.value}.{minor.value}, {to}, {kernel}: {'compiled' if ok else 'REFUSED'}")
-            for line in log.splitlines():
-                if not ok or "entry function" in line or "registers" in line or "spill" in line or "warning" in line:
-                    print("  " + line.strip())
-            failed |= not ok
+            failed |= not report(to, kernel, extra)
     sys.exit(1 if failed else 0)
 
 
