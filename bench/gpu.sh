@@ -124,16 +124,25 @@ warm() {
   echo "== [${SECONDS} s] the kernels compiled side by side into $ANIMATS_CACHE"
   ANIMATS_PREPARE_ONLY=1 "$E" walker 32 0.01 >/dev/null 2>&1
   local run
-  for run in "${CHECKS[@]}"; do
-    # shellcheck disable=SC2086
-    ANIMATS_PREPARE_ONLY=1 "$B" $run >/dev/null 2>&1 &
-  done
-  for run in "${EVALS[@]}"; do
-    # (Fast mode is left out on terrain and among rocks, below.)
-    case $run in rough*|rocks*) skip_fast=1 ;; *) skip_fast="" ;; esac
-    # shellcheck disable=SC2086
-    ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=$skip_fast "$E" $run >/dev/null 2>&1 &
-  done
+  if [ "$part" != evolve ]; then
+    for run in "${CHECKS[@]}"; do
+      # shellcheck disable=SC2086
+      ANIMATS_PREPARE_ONLY=1 "$B" $run >/dev/null 2>&1 &
+    done
+    for run in "${EVALS[@]}"; do
+      # (Fast mode is left out on terrain and among rocks, below.)
+      case $run in rough*|rocks*) skip_fast=1 ;; *) skip_fast="" ;; esac
+      # shellcheck disable=SC2086
+      ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=$skip_fast "$E" $run >/dev/null 2>&1 &
+    done
+  else
+    # The evolve part's: the walker's batches of 16,384 (specialised),
+    # terrain's and sphere contact's whole kernels (the shipped scenes).
+    for run in "walker 16384 10" "rough 32 0.01" "rocks 32 0.01"; do
+      # shellcheck disable=SC2086
+      ANIMATS_PREPARE_ONLY=1 ANIMATS_SKIP_FAST=1 "$E" $run >/dev/null 2>&1 &
+    done
+  fi
   wait
 }
 # `tune` (a third call, not part of `all`): the kernel's registers and
