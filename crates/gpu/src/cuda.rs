@@ -232,16 +232,22 @@ impl Device {
     /// compiled now if no batch needed it yet (or read from the disk's
     /// cache).
     fn kernels(&self, batch: &Batch) -> Result<Arc<Kernels>, String> {
-        let key = KernelKey::of(batch, self.specialise);
+        self.kernels_for(KernelKey::of(batch, self.specialise))
+            .map(|(k, _)| k)
+    }
+
+    /// The kernel `key` names, and whether it was made now (compiled, or
+    /// read from the disk's cache) rather than found made.
+    fn kernels_for(&self, key: KernelKey) -> Result<(Arc<Kernels>, bool), String> {
         if key == KernelKey::WHOLE_FLAT {
-            return Ok(self.flat.clone());
+            return Ok((self.flat.clone(), false));
         }
         let mut kept = self
             .kept
             .lock()
             .map_err(|_| "the GPU's kernels: a thread panicked while compiling one".to_string())?;
         if let Some((_, k)) = kept.iter().find(|(k, _)| *k == key) {
-            return k.clone();
+            return k.clone().map(|k| (k, false));
         }
         let compiled = kernels(
             &self.ctx,
@@ -253,7 +259,7 @@ impl Device {
         )
         .map(Arc::new);
         kept.push((key, compiled.clone()));
-        compiled
+        compiled.map(|k| (k, true))
     }
 
     /// What the driver says of the kernel for `batch` (compiled now if it
@@ -282,17 +288,6 @@ impl Device {
             entry("evaluation", &kernels.evaluate)?,
             entry("step", &kernels.step)?
         ))
-    }
-
-    /// Whether the kernel for `batch` is compiled (or its compilation
-    /// failed) already.
-    fn has_kernels(&self, batch: &Batch) -> bool {
-        let key = KernelKey::of(batch, self.specialise);
-        key == KernelKey::WHOLE_FLAT
-            || self
-                .kept
-                .lock()
-                .is_ok_and(|kept| kept.iter().any(|(k, _)| *k == key))
     }
 
     /// The options the kernel for `batch` is compiled with beyond the
@@ -461,14 +456,14 @@ impl Device {
                 // The kernel compiled first (a batch's first needs it), so
                 // that the clock times the evaluation alone; a compilation
                 // (NVRTC: seconds) said, so that a pause is not taken for a hang.
-                let known = device.has_kernels(&batch);
+                let key = KernelKey::of(&batch, device.specialise);
                 let t = std::time::Instant::now();
-                device.kernels(&batch)?;
+                let (_, made) = device.kernels_for(key)?;
                 let took = t.elapsed().as_secs_f64();
-                if !known && took >= 1.0 {
+                if made && took >= 1.0 {
                     say(format!(
                         "GPU: the kernel for this run's batches ({}) compiled in {took:.1} s; kept on disk for later runs",
-                        device.kernel_options(&batch).join(" ")
+                        key.options().join(" ")
                     ));
                 }
                 let t = std::time::Instant::now();

@@ -223,6 +223,10 @@ const SCRATCH: usize = 15;
 /// `an_act`: oscillator, network, CTRNN, FSM, hopper, jellyfish, Raibert's).
 const CONTROL_KINDS: i32 = 7;
 
+/// Numbers a fluid's or rods' current takes (`current`; `AN_CURRENT` in
+/// `kernel/step.h`).
+const CURRENT: usize = 11;
+
 /// Many worlds (creatures) as one batch of the C step's arrays.
 #[derive(Clone, Debug)]
 pub struct Batch {
@@ -671,10 +675,13 @@ impl Batch {
             self.rod_a.is_empty(),
             self.plane_param.is_empty(),
         ];
-        let controls = (0..CONTROL_KINDS).map(|k| !self.ev.ctrl_kind.contains(&k));
+        let kinds = (self.ev.ctrl_kind.iter())
+            .filter(|&&k| (0..CONTROL_KINDS).contains(&k))
+            .fold(0u32, |seen, &k| seen | 1 << k);
+        let controls = (0..CONTROL_KINDS).map(|k| kinds & 1 << k == 0);
         // A reef's current is marked by a number in its slot 3 (a uniform
         // current's is NaN: `current`).
-        let reef = |c: &[f64]| c.chunks_exact(11).any(|c| !c[3].is_nan());
+        let reef = |c: &[f64]| c.chunks_exact(CURRENT).any(|c| !c[3].is_nan());
         let no_reef = !reef(&self.fluid_current) && !reef(&self.rod_current);
         parts
             .into_iter()
@@ -1203,7 +1210,7 @@ fn supported(w: &World) -> Result<(), String> {
 /// then its surface, `amplitude × ω`, `k`, `ω` and its direction
 /// normalised (forces/current.rs, `ReefWater::velocity`, which forms each
 /// of them so).
-fn current(c: &animats_engine::Current) -> [f64; 11] {
+fn current(c: &animats_engine::Current) -> [f64; CURRENT] {
     use animats_engine::Current;
     use std::f64::consts::TAU;
     let uniform = |u: DVec3| [u.x, u.y, u.z, f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
