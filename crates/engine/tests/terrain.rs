@@ -432,3 +432,84 @@ fn the_spheres_on_the_ground_are_counted_by_their_clearance() {
         }
     }
 }
+
+/// `touches_ground` gives `clearance(p) <= tolerance`'s answer on every
+/// terrain, though off the flat floor it skips the search for spheres
+/// certainly too far: spheres from inside the ground to 2 m above a
+/// heightfield (gentle and steep), steps and a slope, each asked at its
+/// own clearance and one and two ulps either side, and at tolerances from
+/// 0 to 1 m; radii from 0 (a point) to 0.2 m.
+#[test]
+fn touching_the_ground_is_the_clearance_within_the_tolerance() {
+    let mut state = 0x2545_f491_4f6c_dd1d_u64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let field = |relief: f64, uniform: &mut dyn FnMut() -> f64| {
+        let heights = (0..12 * 9).map(|_| relief * (uniform() - 0.5)).collect();
+        Terrain::Heightfield(Heightfield::new(
+            DVec2::new(-0.6, -0.4),
+            0.1,
+            12,
+            9,
+            heights,
+        ))
+    };
+    let steps = Terrain::Steps(Steps {
+        direction: DVec3::X,
+        start: 0.0,
+        height: 0.05,
+        depth: 0.2,
+        count: 4,
+    });
+    let terrains = [
+        field(0.03, &mut uniform),
+        field(0.5, &mut uniform),
+        steps,
+        slope(25.0),
+    ];
+    let (mut asked, mut touching) = (0, 0);
+    for terrain in terrains {
+        let mut w = world_on(terrain.clone(), IntegratorKind::Symplectic);
+        let ids: Vec<ParticleId> = (0..400)
+            .map(|k| {
+                let r = [0.0, 0.01, 0.05, 0.2][k % 4];
+                let (x, z) = (1.6 * uniform() - 0.8, 1.2 * uniform() - 0.6);
+                let y = terrain.height(x, z) + 2.0 * uniform() * uniform() - 0.05;
+                w.add_particle(ParticleDef::new(0.1).with_radius(r).at(DVec3::new(x, y, z)))
+                    .unwrap()
+            })
+            .collect();
+        for &p in &ids {
+            let c = w.clearance(p);
+            let mut tolerances = vec![-0.01, 0.0, 1e-3, 0.01, 0.1, 1.0];
+            if c.is_finite() && c > 0.0 {
+                let (down, up) = (
+                    f64::from_bits(c.to_bits() - 1),
+                    f64::from_bits(c.to_bits() + 1),
+                );
+                tolerances.extend([c, down, up, f64::from_bits(down.to_bits() - 1)]);
+            }
+            for tolerance in tolerances {
+                let touches = w.touches_ground(p, tolerance);
+                assert_eq!(
+                    touches,
+                    c <= tolerance,
+                    "particle {p:?} at {:?} r {}: {c} against {tolerance}, {terrain:?}",
+                    w.position(p),
+                    w.particles().radius[p.index()]
+                );
+                asked += 1;
+                touching += usize::from(touches);
+            }
+        }
+    }
+    // Both answers were given often.
+    assert!(
+        touching > asked / 5 && touching < asked * 4 / 5,
+        "{touching} of {asked}"
+    );
+}

@@ -571,7 +571,7 @@ impl<'a> Recorder<'a> {
     /// Records the world after a step.
     pub fn step(&mut self, world: &World) {
         self.steps += 1;
-        let on_floor = |p: ParticleId| world.clearance(p) <= self.tolerance;
+        let on_floor = |p: ParticleId| world.touches_ground(p, self.tolerance);
         for (m, sum) in self.measures.iter().zip(&mut self.sums) {
             match m {
                 Measure::ContactFraction(p) if on_floor(*p) => *sum += 1.0,

@@ -373,7 +373,7 @@ impl EvolveSpec {
         let touch = self
             .fail_on_touch
             .iter()
-            .find(|(p, _)| world.clearance(*p) <= self.touch_tolerance);
+            .find(|(p, _)| world.touches_ground(*p, self.touch_tolerance));
         if let Some((_, n)) = touch {
             return Some(Ended::Touch(n.clone()));
         }

@@ -15,7 +15,7 @@ pub const TOUCH_TOLERANCE: f64 = 1e-3;
 /// True while `p`'s surface is on or inside the floor (within
 /// [`TOUCH_TOLERANCE`]; on terrain, of the terrain's surface).
 pub fn touches_floor(world: &World, p: ParticleId) -> bool {
-    world.clearance(p) <= TOUCH_TOLERANCE
+    world.touches_ground(p, TOUCH_TOLERANCE)
 }
 
 /// What is read.

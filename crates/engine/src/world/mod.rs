@@ -453,6 +453,48 @@ impl World {
         self.clearance_searched(p)
     }
 
+    /// Whether particle `p` is within `tolerance` of the ground: exactly
+    /// `self.clearance(p) <= tolerance`, but on terrain a particle certainly
+    /// farther than that is told so without the search for the nearest
+    /// point (the terrain's probe given a reach a billionth above `radius +
+    /// tolerance`, and never less than the rounding of `p`'s coordinates).
+    /// What the end rules, touch sensors and `feet` ask each step.
+    #[inline]
+    pub fn touches_ground(&self, p: ParticleId, tolerance: f64) -> bool {
+        if let Some(f) = &self.forces.floor {
+            if f.terrain.is_flat() {
+                return self.position(p).y - self.particles().radius[p.index()] <= tolerance;
+            }
+        }
+        self.touches_searched(p, tolerance)
+    }
+
+    /// [`World::touches_ground`] off the flat floor's contact force.
+    #[inline(never)]
+    fn touches_searched(&self, p: ParticleId, tolerance: f64) -> bool {
+        let (x, r) = (self.position(p), self.particles().radius[p.index()]);
+        match self.ground() {
+            Some(t) if !t.is_flat() => {
+                let reach = r + tolerance;
+                let margin = 1e-9 * (reach.abs() + 1.0 + x.abs().max_element());
+                match t.probe(x, reach + margin) {
+                    Some((d, _)) => d - r <= tolerance,
+                    None => false,
+                }
+            }
+            _ => x.y - r <= tolerance,
+        }
+    }
+
+    /// The terrain [`World::clearance`] measures from: the contact force's,
+    /// else the collision event's.
+    fn ground(&self) -> Option<&crate::Terrain> {
+        match &self.forces.floor {
+            Some(f) => Some(&*f.terrain),
+            None => self.terrain(),
+        }
+    }
+
     /// How many particles that move (a positive inverse mass) have a
     /// [`World::clearance`] of at most `tolerance`: the `feet` measure, each
     /// step. One loop over the arrays on a flat floor.
@@ -468,9 +510,9 @@ impl World {
                     .count();
             }
         }
-        // (Not flat, or no contact force: `clearance` would search for each.)
+        // (Not flat, or no contact force.)
         self.particle_ids()
-            .filter(|&p| props.inv_mass[p.index()] > 0.0 && self.clearance_searched(p) <= tolerance)
+            .filter(|&p| props.inv_mass[p.index()] > 0.0 && self.touches_searched(p, tolerance))
             .count()
     }
 
@@ -478,11 +520,7 @@ impl World {
     #[inline(never)]
     fn clearance_searched(&self, p: ParticleId) -> f64 {
         let (x, r) = (self.position(p), self.particles().radius[p.index()]);
-        let terrain = match &self.forces.floor {
-            Some(f) => Some(&*f.terrain),
-            None => self.terrain(),
-        };
-        match terrain {
+        match self.ground() {
             Some(t) if !t.is_flat() => t.probe(x, f64::INFINITY).map_or(x.y, |(d, _)| d) - r,
             _ => x.y - r,
         }
