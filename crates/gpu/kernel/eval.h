@@ -147,6 +147,26 @@ AN_FN double an_clearance(const an_batch *b, an_state st, long long p) {
     return x[1] - st.r[p];
 }
 
+/* World::touches_ground: whether an_clearance(b, st, p) <= tolerance, a
+ * particle certainly farther told so without the terrain's search (the
+ * probe's reach a billionth above r + tolerance). */
+AN_FN int an_touches(const an_batch *b, an_state st, long long p, double tolerance) {
+    const double *x = st.x + 3 * p;
+    double r = st.r[p];
+    if (b->floor && AN_ON_TERRAIN(b)) {
+        double d, n[3], reach = r + tolerance;
+        /* glam's abs().max_element(): max(x, max(y, z)), max(a, b) = a > b ? a : b */
+        double ax = an_fabs(x[0]), ay = an_fabs(x[1]), az = an_fabs(x[2]);
+        double yz = ay > az ? ay : az, most = ax > yz ? ax : yz;
+        double margin = 1e-9 * (an_fabs(reach) + 1.0 + most);
+        if (an_probe(b->terrain, b->terrain_param, b->terrain_height, x, reach + margin, &d, n)) {
+            return d - r <= tolerance;
+        }
+        return 0;
+    }
+    return x[1] - r <= tolerance;
+}
+
 /* Sensor kinds (creatures/src/sensors/probe.rs, `Probe`; then the
  * roobot's own: sensors/height.rs, tilt.rs, touchdown.rs; its speed
  * sensor is AN_S_SPEED mapped from [0, 1]). */
@@ -189,7 +209,7 @@ AN_FN double an_sensor(const an_batch *b, an_state st, long long q) {
         reading = an_dot(v + 3 * ids[0], param);
         break;
     case AN_S_TOUCH: /* TOUCH_TOLERANCE */
-        reading = an_clearance(b, st, ids[0]) <= 1e-3 ? 1.0 : 0.0;
+        reading = an_touches(b, st, ids[0], 1e-3) ? 1.0 : 0.0;
         break;
     case AN_S_LENGTH: /* glam's distance: (a - b).length() */
         for (int k = 0; k < 3; k++) {
@@ -777,9 +797,9 @@ AN_FN const int *an_measure_ids(const an_batch *b, long long q, long long *nk) {
 }
 
 /* Whether particle p of the creature whose state is st touches the
- * floor within `tolerance` (World::clearance). */
+ * floor within `tolerance` (World::touches_ground). */
 AN_FN int an_on_floor(const an_batch *b, an_state st, long long p, double tolerance) {
-    return an_clearance(b, st, p) <= tolerance;
+    return an_touches(b, st, p, tolerance);
 }
 
 /* Recorder::new: the centres that displacements and speeds start from. */

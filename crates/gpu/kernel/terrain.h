@@ -303,12 +303,103 @@ AN_COLD void an_hf_try(const double *p, const double *a, const double *b, const 
     }
 }
 
+/* f64::max and f64::min: a NaN gives way to the other. */
+AN_FN double an_max_num(double a, double b) { return a != a ? b : (b != b ? a : (a > b ? a : b)); }
+AN_FN double an_min_num(double a, double b) { return a != a ? b : (b != b ? a : (a < b ? a : b)); }
+
+/* Heightfield::nearest_within's radius: how far across from p a cell may
+ * lie and still hold a triangle as near as the squared distance d2. */
+AN_FN double an_hf_radius(double d2, double tolerance) {
+    /* finite: the exponent's bits not all set */
+    return (an_bits(d2) & 0x7ff0000000000000ULL) != 0x7ff0000000000000ULL
+               ? sqrt(d2) * (1.0 + 1e-9) + tolerance
+               : an_inf();
+}
+
+/* How far across c lies from the footprint [from, to]. */
+AN_FN double an_hf_gap(double c, double from, double to) {
+    return an_max_num(an_max_num(from - c, c - to), 0.0);
+}
+
+/* Heightfield::nearest_within, pruned: cells farther across from p than
+ * the nearest point so far (at first, on the centre cell's triangles)
+ * are passed over; the same triangle is found as with every cell visited
+ * (the engine's test pruning_changes_no_bit). */
+AN_FN double an_hf_nearest(const double *tp, const double *h, const double *p, long long i0,
+                             long long j0, long long span, double *nearest, double *face) {
+    double cell = tp[2];
+    double tolerance = 1e-6 * (cell + an_fabs(p[0]) + an_fabs(p[2]));
+    double bound = an_inf();
+    {
+        double va[3], vb[3], vc[3], vd[3], q[3], d[3];
+        an_vertex(tp, h, i0, j0, va);
+        an_vertex(tp, h, i0 + 1, j0, vb);
+        an_vertex(tp, h, i0 + 1, j0 + 1, vc);
+        an_vertex(tp, h, i0, j0 + 1, vd);
+        an_nearest_on_triangle(p, va, vc, vb, q);
+        for (int e = 0; e < 3; e++) {
+            d[e] = p[e] - q[e];
+        }
+        bound = an_min_num(bound, an_dot3(d, d));
+        an_nearest_on_triangle(p, va, vd, vc, q);
+        for (int e = 0; e < 3; e++) {
+            d[e] = p[e] - q[e];
+        }
+        bound = an_min_num(bound, an_dot3(d, d));
+    }
+    double r = an_hf_radius(bound, tolerance);
+    double best = an_inf();
+    for (int e = 0; e < 3; e++) {
+        nearest[e] = p[e];
+    }
+    face[0] = 0.0;
+    face[1] = 1.0;
+    face[2] = 0.0;
+    for (long long j = j0 - span; j <= j0 + span; j++) {
+        double z0 = tp[1] + (double)j * cell;
+        double dz = an_hf_gap(p[2], z0, tp[1] + (double)(j + 1) * cell);
+        if (dz > r) {
+            if (z0 > p[2]) {
+                break; /* every later row lies farther still */
+            }
+            continue;
+        }
+        for (long long i = i0 - span; i <= i0 + span; i++) {
+            double x0 = tp[0] + (double)i * cell;
+            double dx = an_hf_gap(p[0], x0, tp[0] + (double)(i + 1) * cell);
+            if (dx * dx + dz * dz > r * r) {
+                if (x0 > p[0]) {
+                    break;
+                }
+                continue;
+            }
+            /* Cell (i, j)'s triangles: [a, c, b] and [a, d, c]. */
+            double va[3], vb[3], vc[3], vd[3];
+            an_vertex(tp, h, i, j, va);
+            an_vertex(tp, h, i + 1, j, vb);
+            an_vertex(tp, h, i + 1, j + 1, vc);
+            an_vertex(tp, h, i, j + 1, vd);
+            double was = best;
+            an_hf_try(p, va, vc, vb, &best, nearest, face);
+            if (best != was) {
+                r = an_min_num(r, an_hf_radius(best, tolerance));
+                was = best;
+            }
+            an_hf_try(p, va, vd, vc, &best, nearest, face);
+            if (best != was) {
+                r = an_min_num(r, an_hf_radius(best, tolerance));
+            }
+        }
+    }
+    return best;
+}
+
 /* Heightfield::probe. (Past 9.2e18 cells the engine's i64 wraps; this
  * saturates.) */
 AN_COLD int an_hf_probe(const double *tp, const double *h, const double *p, double reach,
                       double *dist, double *normal) {
     double vertical = p[1] - an_hf_height(tp, h, p[0], p[2]);
-    if (vertical * tp[3] > reach) {
+    if ((vertical >= 0.0 ? vertical * tp[3] : vertical) > reach) {
         return 0;
     }
     long long s = an_to_i64(ceil(an_fabs(vertical) / tp[2]));
@@ -316,19 +407,8 @@ AN_COLD int an_hf_probe(const double *tp, const double *h, const double *p, doub
     long long i0, j0;
     double fu, fv;
     an_cell_of(tp, p[0], p[2], &i0, &j0, &fu, &fv);
-    double best = an_inf(), nearest[3] = {p[0], p[1], p[2]}, face[3] = {0.0, 1.0, 0.0};
-    for (long long j = j0 - span; j <= j0 + span; j++) {
-        for (long long i = i0 - span; i <= i0 + span; i++) {
-            /* Cell (i, j)'s triangles: [a, c, b] and [a, d, c]. */
-            double va[3], vb[3], vc[3], vd[3];
-            an_vertex(tp, h, i, j, va);
-            an_vertex(tp, h, i + 1, j, vb);
-            an_vertex(tp, h, i + 1, j + 1, vc);
-            an_vertex(tp, h, i, j + 1, vd);
-            an_hf_try(p, va, vc, vb, &best, nearest, face);
-            an_hf_try(p, va, vd, vc, &best, nearest, face);
-        }
-    }
+    double nearest[3], face[3];
+    double best = an_hf_nearest(tp, h, p, i0, j0, span, nearest, face);
     int below = vertical < 0.0;
     double distance = sqrt(best);
     if (distance > 1e-12) {
