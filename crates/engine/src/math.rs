@@ -8,14 +8,16 @@
 //! arithmetic on every platform, and one list of functions for a GPU
 //! kernel to port.
 //!
-//! (A table-driven `atan2` of our own, twice musl's throughput in
-//! isolation — 12.5 against 24.8 ns a call on an AMD EPYC — and as
-//! accurate, gave the roobot's evaluation nothing: 2.32–2.43 ms against
-//! 2.35 ms, the fastest of 30, 2026-11-27; the angle joints' `atan2`
-//! overlaps the rest of the step. musl's own operations four joints at a
-//! time, its branches turned into selections (every lane the same bits on
-//! 10⁷ pairs), gave nothing either: 2.155 and 2.167 ms against 2.113 and
-//! 2.033 ms, `animats bench hopper --runs 9`, 2026-11-30. So it is musl's.)
+//! (Why musl's `atan2`: one of our own, branch-free, from a table of
+//! Taylor polynomials evaluated with fused multiply-adds, is more accurate
+//! — largest error 0.990 against 1.385 ulp on 200,000 pairs — and made the
+//! roobot's evaluation only about 4 % faster, 1.498 against 1.560 ms
+//! (`animats bench hopper --runs 15`, AMD EPYC, 2026-12-02): too little to
+//! re-pin every figure that depends on the joints' bits. It is kept
+//! applicable, with its figures and commands, in `bench/atan2/`. An
+//! earlier table-driven one, and musl's operations four joints at a time
+//! with its branches turned into selections, gave nothing measurable,
+//! 2026-11-27 and 2026-11-30.)
 
 /// `sin x`.
 #[inline]
