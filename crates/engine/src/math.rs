@@ -11,10 +11,11 @@
 //! (Why musl's `atan2`: one of our own, branch-free, from a table of
 //! Taylor polynomials evaluated with fused multiply-adds, is more accurate
 //! — largest error 0.990 against 1.385 ulp on 200,000 pairs — and made the
-//! roobot's evaluation only about 4 % faster, 1.498 against 1.560 ms
+//! roobot's evaluation only 4–7 % faster, 1.601 against 1.715 ms
 //! (`animats bench hopper --runs 15`, AMD EPYC, 2026-12-02): too little to
 //! re-pin every figure that depends on the joints' bits. It is kept
-//! applicable, with its figures and commands, in `bench/atan2/`. An
+//! applicable, ported to the GPU kernel's C, with its test, figures and
+//! commands, in `bench/atan2/`. An
 //! earlier table-driven one, and musl's operations four joints at a time
 //! with its branches turned into selections, gave nothing measurable,
 //! 2026-11-27 and 2026-11-30.)
