@@ -15,10 +15,9 @@
 //! (`animats bench hopper --runs 15`, AMD EPYC, 2026-12-02): too little to
 //! re-pin every figure that depends on the joints' bits. It is kept
 //! applicable, ported to the GPU kernel's C, with its test, figures and
-//! commands, in `bench/atan2/`. An
-//! earlier table-driven one, and musl's operations four joints at a time
-//! with its branches turned into selections, gave nothing measurable,
-//! 2026-11-27 and 2026-11-30.)
+//! commands, in `bench/atan2/`. An earlier table-driven one, and musl's
+//! operations four joints at a time with its branches turned into
+//! selections, gave nothing measurable, 2026-11-27 and 2026-11-30.)
 
 /// `sin x`.
 #[inline]
