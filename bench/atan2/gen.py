@@ -5,8 +5,7 @@ each as the nearest double and the nearest double to what is left
 (ATAN_BASE). Needs mpmath. `python3 gen.py c` prints them for C
 (kernel/libm.h), as bit patterns; `python3 gen.py ref N` N pairs with
 their atan2 to 256 bits (the engine's test data); `python3 gen.py bound`
-prints instead the
-largest relative error of the truncation after degree 11, 12, 13."""
+the largest relative error of the truncation after degree 11, 12, 13."""
 import math
 import struct
 import sys
@@ -22,6 +21,8 @@ def hexf(x):
 
 
 if len(sys.argv) > 1 and sys.argv[1] == "bound":
+    # The first two omitted terms at |u| = h, relative to the row's smallest
+    # result (row 0: atan u ~ u, so relative to u itself).
     h = mp.mpf(1) / (2 * K)
     for n in (11, 12, 13):
         worst = mp.mpf(0)
@@ -29,12 +30,7 @@ if len(sys.argv) > 1 and sys.argv[1] == "bound":
             c = mp.mpf(k) / K
             co = mp.taylor(mp.atan, c, n + 3)
             tail = sum(abs(co[j]) * h**j for j in range(n + 1, n + 3))
-            # Relative to the smallest result of the row (k = 0: atan u ~ u).
-            low = h if k == 0 else mp.atan(c - h)
-            if k == 0:
-                tail = sum(abs(co[j]) * h ** (j - 1) for j in range(n + 1, n + 3))
-                low = 1
-            worst = max(worst, tail / low)
+            worst = max(worst, tail / (h if k == 0 else mp.atan(c - h)))
         print("degree", n, "largest relative truncation error 2^%.1f" % float(mp.log(worst, 2)))
     sys.exit(0)
 
