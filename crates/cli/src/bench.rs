@@ -5,7 +5,10 @@ use animats_bench::{Options, Row, WORKLOADS};
 
 /// Arguments of `animats bench`.
 #[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct Args {
+    #[command(subcommand)]
+    instrument: Option<Instrument>,
     /// Workloads to run (default: all of chain-64, cloth-32, cloth-128,
     /// nbody5, allpairs-1000, hopper, brains, seaworld, stability,
     /// scene-load; `implicit`, `contacts`, `bodies` and `diversity` only
@@ -23,6 +26,23 @@ pub struct Args {
     /// per machine.
     #[arg(long)]
     json: bool,
+}
+
+/// Instruments that measure a run of the user's own rather than a
+/// standard workload.
+#[derive(clap::Subcommand)]
+enum Instrument {
+    /// Where an evolution's time goes, and its speed-up predicted on 1 to 64
+    /// workers (`animats evolve ... --schedule`).
+    ///
+    /// `animats bench scaling [SCENE] [OPTIONS]` is `animats evolve [SCENE]
+    /// [OPTIONS] --schedule` (the same options, the same run, log and
+    /// files; docs/PERFORMANCE.md, "Evolution on many cores"): it records every ask,
+    /// evaluation and tell into DIR/schedule.csv and, from their measured
+    /// times and the run's own dependencies, predicts the wall time and
+    /// speed-up on 1, 2, 4, 8, 16, 32 and 64 workers, beside the wall time
+    /// it took on --threads.
+    Scaling(crate::evolve::Args),
 }
 
 /// The machine, for `--json`: CPU model (Linux's /proc/cpuinfo), cores, OS,
@@ -210,6 +230,10 @@ fn print_row(r: &Row) {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
+    if let Some(Instrument::Scaling(mut evolve)) = args.instrument {
+        evolve.schedule = true;
+        return crate::evolve::run(evolve);
+    }
     let names: Vec<String> = if args.workloads.is_empty() {
         WORKLOADS.iter().map(|s| s.to_string()).collect()
     } else {

@@ -75,7 +75,7 @@ pub struct Args {
     /// predict for 1 to 64 workers, with and without the barrier at the
     /// end of each batch of generations. The results are unchanged.
     #[arg(long)]
-    schedule: bool,
+    pub(crate) schedule: bool,
     /// Skip the checks at the end of the run (the best scored again at a
     /// quarter of the step with its own integrator and with another: eight
     /// evaluations' time at the scene's step).

@@ -1,7 +1,7 @@
 //! `animats bench --json`: one object per measurement, with every run.
 
 mod common;
-use common::{animats, text};
+use common::{animats, scratch, text};
 
 /// `--json`'s output: one object per line.
 fn json_rows(out: &str) -> Vec<serde_json::Value> {
@@ -83,4 +83,83 @@ fn scene_load_builds_every_particle_and_spring() {
     assert!(last
         .iter()
         .any(|c| c["name"] == "time per byte against the 4x smaller file"));
+}
+
+/// `bench scaling` (issue 41's instrument) is `evolve --schedule`: the same
+/// run (log.csv the same bytes), schedule.csv with every evaluation, and
+/// the model's table for 1 to 64 workers, whose one worker is the recorded
+/// work; a missing scene is refused by name (exit 2), and the workloads'
+/// own arguments still parse beside it.
+#[test]
+fn bench_scaling_is_evolve_with_its_schedule() {
+    let dir = scratch("bench-scaling");
+    let (a, b) = (dir.join("bench"), dir.join("evolve"));
+    let common = [
+        "--generations",
+        "4",
+        "--lanes",
+        "2",
+        "--seed",
+        "5",
+        "--threads",
+        "2",
+        "--no-check",
+    ];
+    let mut args = vec!["bench", "scaling"];
+    args.extend(common);
+    args.extend(["--out", a.to_str().unwrap()]);
+    let o = animats(&args);
+    let (stdout, err) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let mut args = vec!["evolve"];
+    args.extend(common);
+    args.extend(["--schedule", "--out", b.to_str().unwrap()]);
+    let o = animats(&args);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o).1);
+    let log = |d: &std::path::Path| std::fs::read_to_string(d.join("log.csv")).unwrap();
+    assert_eq!(log(&a), log(&b));
+    let csv = std::fs::read_to_string(a.join("schedule.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    // 2 lanes × 4 generations of the hill climber: one evaluation each.
+    assert_eq!(rows.iter().filter(|r| r.contains(",evaluate,")).count(), 8);
+    let work: f64 = rows
+        .iter()
+        .map(|r| r.split(',').nth(7).unwrap().parse::<f64>().unwrap())
+        .sum();
+    let predicted = |w: &str| -> f64 {
+        let line = stdout
+            .lines()
+            .skip_while(|l| !l.contains("workers   predicted wall"))
+            .find(|l| l.split_whitespace().next() == Some(w))
+            .unwrap_or_else(|| panic!("no row for {w} workers: {stdout}"));
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert!((predicted("1") - work).abs() < 2e-3, "{stdout}");
+    // More workers never take longer (list scheduling of this run's work).
+    for (w, more) in [
+        ("2", "4"),
+        ("4", "8"),
+        ("8", "16"),
+        ("16", "32"),
+        ("32", "64"),
+    ] {
+        assert!(
+            predicted(more) <= predicted(w) + 1e-9,
+            "{w} -> {more}: {stdout}"
+        );
+    }
+    let missing = dir.join("no-such-scene.toml");
+    let o = animats(&[
+        "bench",
+        "scaling",
+        missing.to_str().unwrap(),
+        "--out",
+        dir.join("m").to_str().unwrap(),
+    ]);
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("no-such-scene.toml"), "{err}");
+    let o = animats(&["bench", "nonesuch", "--runs", "5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o).1.contains("unknown workload `nonesuch`"));
 }
