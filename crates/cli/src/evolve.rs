@@ -732,6 +732,53 @@ fn report_schedule(
     Ok(())
 }
 
+/// Where a run's threads outnumber the evaluations its lanes' generations
+/// hold at a time, a note saying so: the others had nothing to evaluate
+/// (a lane's generation waits for its own evaluations; the lanes never
+/// wait for each other). More lanes or larger populations give them work;
+/// the run cannot widen itself, since its results would then depend on the
+/// number of threads. `None` where every thread could be busy.
+fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
+    let lanes: Vec<u64> = state
+        .lanes
+        .iter()
+        .filter(|l| l.generation > 0)
+        .map(|l| l.evaluations.div_ceil(l.generation))
+        .collect();
+    let each = *lanes.iter().max()?;
+    // An overlapping lane evaluates two generations at once.
+    let overlap = state.lanes.iter().any(|l| l.optimiser.overlaps());
+    let at_once = lanes.iter().sum::<u64>() * if overlap { 2 } else { 1 };
+    if threads as u64 <= at_once {
+        return None;
+    }
+    let (n, lanes) = (lanes.len(), if lanes.len() == 1 { "lane" } else { "lanes" });
+    let each = if n == 1 {
+        format!("{each} a generation")
+    } else {
+        format!("up to {each} a generation each")
+    };
+    let two = if overlap {
+        ", two generations at once"
+    } else {
+        ""
+    };
+    // A quality-diversity search has one lane.
+    let qd = state
+        .lanes
+        .iter()
+        .any(|l| l.optimiser.kind().qd().is_some());
+    let wider = if qd {
+        "a larger population (--population)"
+    } else {
+        "more lanes (--lanes) or a larger population (--population)"
+    };
+    Some(format!(
+        "note: {threads} threads, but at most {at_once} evaluations at once ({n} {lanes}, {each}{two}): {wider} would give the other {} threads work",
+        threads as u64 - at_once,
+    ))
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> Result<(), Failure> {
     let (dir, mut state) = start(&args)?;
@@ -785,6 +832,11 @@ pub fn run(args: Args) -> Result<(), Failure> {
             b.distance,
             b.ended
         );
+    }
+    if args.device == crate::device::DeviceName::Cpu {
+        if let Some(note) = idle_threads_note(&state, threads) {
+            eprintln!("{note}");
+        }
     }
     // A checked.toml of an earlier part of this run no longer stands.
     let _ = std::fs::remove_file(dir.join("checked.toml"));

@@ -592,3 +592,42 @@ fn bodies_start_their_longest_evaluations_first_with_the_same_log() {
         }
     }
 }
+
+/// More threads than a generation's evaluations (issue 41): the run says
+/// how many could work and what would give the others work, on stderr,
+/// and is the same run (the log the same bytes); where every thread could
+/// be busy it says nothing.
+#[test]
+fn threads_beyond_a_generation_s_evaluations_are_named() {
+    let dir = scratch("idle-threads");
+    let run = |threads: &str| {
+        let out = dir.join(threads);
+        let o = animats(&[
+            "evolve",
+            "--generations",
+            "3",
+            "--lanes",
+            "2",
+            "--seed",
+            "2",
+            "--no-check",
+            "--threads",
+            threads,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let (_, err) = text(&o);
+        assert!(o.status.success(), "{err}");
+        (std::fs::read_to_string(out.join("log.csv")).unwrap(), err)
+    };
+    let (wide, note) = run("5");
+    let (narrow, quiet) = run("2");
+    assert_eq!(wide, narrow);
+    // The thesis's hill climber: one evaluation a generation in each lane.
+    assert!(
+        note.contains("note: 5 threads, but at most 2 evaluations at once (2 lanes, up to 1 a generation each)"),
+        "{note}"
+    );
+    assert!(note.contains("give the other 3 threads work"), "{note}");
+    assert!(!quiet.contains("note:"), "{quiet}");
+}
