@@ -753,10 +753,17 @@ fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
         return None;
     }
     let (n, lanes) = (lanes.len(), if lanes.len() == 1 { "lane" } else { "lanes" });
+    // Restarts (IPOP) grow the population: the figures are then a lane's
+    // mean over its generations.
+    let (most, up_to) = if state.config.restarts > 0 {
+        ("about", "about")
+    } else {
+        ("at most", "up to")
+    };
     let each = if n == 1 {
         format!("{each} a generation")
     } else {
-        format!("up to {each} a generation each")
+        format!("{up_to} {each} a generation each")
     };
     let two = if overlap {
         ", two generations at once"
@@ -774,7 +781,7 @@ fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
         "more lanes (--lanes) or a larger population (--population)"
     };
     Some(format!(
-        "note: {threads} threads, but at most {at_once} evaluations at once ({n} {lanes}, {each}{two}): {wider} would give the other {} threads work",
+        "note: {threads} threads, but {most} {at_once} evaluations at once ({n} {lanes}, {each}{two}): {wider} would give the other {} threads work",
         threads as u64 - at_once,
     ))
 }

@@ -88,8 +88,8 @@ fn scene_load_builds_every_particle_and_spring() {
 /// `bench scaling` (issue 41's instrument) is `evolve --schedule`: the same
 /// run (log.csv the same bytes), schedule.csv with every evaluation, and
 /// the model's table for 1 to 64 workers, whose one worker is the recorded
-/// work; a missing scene is refused by name (exit 2), and the workloads'
-/// own arguments still parse beside it.
+/// work; a missing scene is refused by name (exit 2), and an unknown
+/// workload still is beside it.
 #[test]
 fn bench_scaling_is_evolve_with_its_schedule() {
     let dir = scratch("bench-scaling");
@@ -135,18 +135,12 @@ fn bench_scaling_is_evolve_with_its_schedule() {
         line.split_whitespace().nth(1).unwrap().parse().unwrap()
     };
     assert!((predicted("1") - work).abs() < 2e-3, "{stdout}");
-    // More workers never take longer (list scheduling of this run's work).
-    for (w, more) in [
-        ("2", "4"),
-        ("4", "8"),
-        ("8", "16"),
-        ("16", "32"),
-        ("32", "64"),
-    ] {
-        assert!(
-            predicted(more) <= predicted(w) + 1e-9,
-            "{w} -> {more}: {stdout}"
-        );
+    // Two lanes of one evaluation a generation, which never wait for each
+    // other: two workers hold each its own lane's chain, no third has
+    // anything to do, and neither can beat half the work.
+    assert!(predicted("2") >= work / 2.0 - 2e-3, "{stdout}");
+    for w in ["4", "8", "16", "32", "64"] {
+        assert_eq!(predicted(w), predicted("2"), "{w} workers: {stdout}");
     }
     let missing = dir.join("no-such-scene.toml");
     let o = animats(&[
