@@ -739,31 +739,29 @@ fn report_schedule(
 /// the run cannot widen itself, since its results would then depend on the
 /// number of threads. `None` where every thread could be busy.
 fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
-    let lanes: Vec<u64> = state
+    // Each lane's evaluations a generation (its mean over its generations).
+    let per_lane: Vec<u64> = state
         .lanes
         .iter()
         .filter(|l| l.generation > 0)
         .map(|l| l.evaluations.div_ceil(l.generation))
         .collect();
-    let each = *lanes.iter().max()?;
+    let widest = *per_lane.iter().max()?;
     // An overlapping lane evaluates two generations at once.
     let overlap = state.lanes.iter().any(|l| l.optimiser.overlaps());
-    let at_once = lanes.iter().sum::<u64>() * if overlap { 2 } else { 1 };
+    let at_once = per_lane.iter().sum::<u64>() * if overlap { 2 } else { 1 };
     if threads as u64 <= at_once {
         return None;
     }
-    let (n, lanes) = (lanes.len(), if lanes.len() == 1 { "lane" } else { "lanes" });
-    // Restarts (IPOP) grow the population: the figures are then a lane's
-    // mean over its generations.
+    // Restarts (IPOP) grow the population: the figures are then means.
     let (most, up_to) = if state.config.restarts > 0 {
         ("about", "about")
     } else {
         ("at most", "up to")
     };
-    let each = if n == 1 {
-        format!("{each} a generation")
-    } else {
-        format!("{up_to} {each} a generation each")
+    let lanes = match per_lane.len() {
+        1 => format!("1 lane, {widest} a generation"),
+        n => format!("{n} lanes, {up_to} {widest} a generation each"),
     };
     let two = if overlap {
         ", two generations at once"
@@ -781,7 +779,7 @@ fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
         "more lanes (--lanes) or a larger population (--population)"
     };
     Some(format!(
-        "note: {threads} threads, but {most} {at_once} evaluations at once ({n} {lanes}, {each}{two}): {wider} would give the other {} threads work",
+        "note: {threads} threads, but {most} {at_once} evaluations at once ({lanes}{two}): {wider} would give the other {} threads work",
         threads as u64 - at_once,
     ))
 }
