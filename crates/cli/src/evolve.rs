@@ -5,6 +5,7 @@
 //! not a terminal), checkpoints, and Ctrl-C to stop cleanly.
 
 use crate::Failure;
+use animats_evolve::optimiser::map_elites::QdKind;
 use animats_evolve::{checkpoint, Choices, Config, OptimiserKind, ProblemSpec, State};
 use animats_render::{step_plot_png, Plot, Series};
 use animats_scene::morphology::MorphologyProblem;
@@ -768,19 +769,22 @@ fn idle_threads_note(state: &State, threads: usize) -> Option<String> {
     } else {
         ""
     };
-    // A quality-diversity search has one lane.
-    let qd = state
-        .lanes
-        .iter()
-        .any(|l| l.optimiser.kind().qd().is_some());
-    let wider = if qd {
-        "a larger population (--population)"
-    } else {
-        "more lanes (--lanes) or a larger population (--population)"
+    // A quality-diversity search has one lane; MAP-Elites's may overlap
+    // its generations (CMA-ME's emitters adapt from each one told).
+    let qd = state.lanes.iter().find_map(|l| l.optimiser.kind().qd());
+    let wider = match qd {
+        Some(QdKind::MapElites) if !overlap => {
+            "a larger population (--population) or overlapping generations ([archive] overlap = true)"
+        }
+        Some(_) => "a larger population (--population)",
+        None => "more lanes (--lanes) or a larger population (--population)",
+    };
+    let others = match threads as u64 - at_once {
+        1 => "the other thread".to_string(),
+        n => format!("the other {n} threads"),
     };
     Some(format!(
-        "note: {threads} threads, but {most} {at_once} evaluations at once ({lanes}{two}): {wider} would give the other {} threads work",
-        threads as u64 - at_once,
+        "note: {threads} threads, but {most} {at_once} evaluations at once ({lanes}{two}): {wider} would give {others} work",
     ))
 }
 

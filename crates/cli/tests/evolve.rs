@@ -630,4 +630,51 @@ fn threads_beyond_a_generation_s_evaluations_are_named() {
     );
     assert!(note.contains("give the other 3 threads work"), "{note}");
     assert!(!quiet.contains("note:"), "{quiet}");
+
+    // MAP-Elites (one lane) may also overlap its generations; once it
+    // does, it has two at once and the note says so.
+    let scene = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/hop_map.toml"
+    ))
+    .unwrap();
+    let overlapped = dir.join("hop_map_overlap.toml");
+    // ([archive] is the scene's last table.)
+    std::fs::write(&overlapped, format!("{scene}\noverlap = true\n")).unwrap();
+    let map = |scene: &str, name: &str| {
+        let out = dir.join(name);
+        let o = animats(&[
+            "evolve",
+            scene,
+            "--optimiser",
+            "map-elites",
+            "--population",
+            "2",
+            "--generations",
+            "2",
+            "--seed",
+            "2",
+            "--no-check",
+            "--threads",
+            "5",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let (_, err) = text(&o);
+        assert!(o.status.success(), "{err}");
+        err
+    };
+    let plain = map(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/hop_map.toml"),
+        "map",
+    );
+    assert!(
+        plain.contains("note: 5 threads, but at most 2 evaluations at once (1 lane, 2 a generation): a larger population (--population) or overlapping generations ([archive] overlap = true) would give the other 3 threads work"),
+        "{plain}"
+    );
+    let two = map(overlapped.to_str().unwrap(), "map-overlap");
+    assert!(
+        two.contains("note: 5 threads, but at most 4 evaluations at once (1 lane, 2 a generation, two generations at once): a larger population (--population) would give the other thread work"),
+        "{two}"
+    );
 }
