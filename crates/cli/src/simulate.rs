@@ -2,7 +2,7 @@
 
 use crate::output::Trajectory;
 use crate::{positive_f64, Failure};
-use animats_engine::{IntegratorKind, SimError};
+use animats_engine::{IntegratorKind, Shown, SimError};
 use animats_scene::Scene;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -127,15 +127,33 @@ fn prepare(args: &Args) -> Result<(Scene, f64, u64), Failure> {
         let warning = animats_scene::build::step_warning(&scene.world, &scene.names, dt);
         crate::warn(&args.scene, warning.as_slice());
     }
+    // Where each came from, for the messages below.
+    let file = args.scene.display();
+    let of_duration = if args.duration.is_some() {
+        "--duration"
+    } else {
+        "[world] duration"
+    };
+    let of_dt = if args.dt.is_some() {
+        "--dt"
+    } else {
+        "[world] dt"
+    };
+    let (d, h) = (Shown(duration), Shown(dt));
     let steps = (duration / dt).round();
     if steps < 1.0 {
         return Err(Failure::Input(format!(
-            "the duration ({duration} s) is shorter than half a step ({dt} s): nothing to simulate"
+            "{file}: the duration ({d} s, {of_duration}) is shorter than half a step ({h} s, {of_dt}): nothing to simulate"
         )));
     }
     if steps > 1e12 {
+        let count = if steps.is_finite() {
+            format!("{steps:.1e} steps")
+        } else {
+            "over 1e308 steps".to_string()
+        };
         return Err(Failure::Input(format!(
-            "{steps:.1e} steps is too many (at most 1e12): raise --dt or lower --duration"
+            "{file}: {count} ({d} s of {of_duration} at {h} s of {of_dt}) is too many (at most 1e12): raise the step or shorten the run"
         )));
     }
     Ok((scene, dt, steps as u64))

@@ -285,6 +285,13 @@ fn missing_files_bad_options_and_unwritable_outputs_exit_2() {
         err.contains("1.0e302 steps") && err.contains("too many"),
         "{err}"
     );
+    // Naming the file, and where the step and the duration came from.
+    assert!(
+        err.contains("scenes/oscillator.toml: ")
+            && err.contains("of --duration")
+            && err.contains("of [world] dt"),
+        "{err}"
+    );
     assert!(err.len() < 200, "{err}");
 }
 
