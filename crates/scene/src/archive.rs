@@ -438,10 +438,7 @@ impl MeasureEntry {
                     &format!("{field}.particles"),
                     "name at least one particle (or leave it out: [evolve]'s)",
                 )),
-                Some(l) => l
-                    .iter()
-                    .map(|n| names.one(at, &format!("{field}.particles"), n))
-                    .collect(),
+                Some(l) => names.list(at, &format!("{field}.particles"), l),
             }
         };
         let direction = |a: &Option<[f64; 3]>| -> Result<DVec3, SceneError> {

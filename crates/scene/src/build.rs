@@ -125,12 +125,24 @@ impl Names {
     ) -> Result<Targets, SceneError> {
         match names {
             None => Ok(Targets::All),
-            Some(list) => Ok(Targets::Only(
-                list.iter()
-                    .map(|n| self.one(at, "particles", n))
-                    .collect::<Result<_, _>>()?,
-            )),
+            Some(list) => Ok(Targets::Only(self.list(at, "particles", list)?)),
         }
+    }
+
+    /// The particles `names`, each once: a particle named twice would be
+    /// acted on (or counted) twice, and an n-body group would pull it
+    /// towards itself at no distance.
+    pub(crate) fn list(
+        &self,
+        at: &At,
+        field: &str,
+        names: &[String],
+    ) -> Result<Vec<ParticleId>, SceneError> {
+        let mut seen = std::collections::HashSet::new();
+        if let Some(twice) = names.iter().find(|n| !seen.insert(n.as_str())) {
+            return Err(at.err(field, format!("`{twice}` is listed twice")));
+        }
+        names.iter().map(|n| self.one(at, field, n)).collect()
     }
 }
 

@@ -188,10 +188,7 @@ impl EvolveSpec {
                     "name at least one particle (or leave it out: all)",
                 ))
             }
-            Some(list) => list
-                .iter()
-                .map(|n| names.one(at, "particles", n))
-                .collect::<Result<_, _>>()?,
+            Some(list) => names.list(at, "particles", list)?,
         };
         let axis = at.vec3("axis", e.axis)?;
         if axis.length() == 0.0 {

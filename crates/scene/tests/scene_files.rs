@@ -69,3 +69,54 @@ fn defaults_are_those_of_the_contract() {
         animats_engine::DVec3::new(0.0, -9.8, 0.0)
     );
 }
+
+/// A particle named twice in a list would be acted on (or counted) twice,
+/// and an n-body group would pull it towards itself at no distance (its
+/// energy −∞): every list of particles refuses it, naming the entry, the
+/// field and the particle.
+#[test]
+fn a_particle_named_twice_in_a_list_is_refused() {
+    let two = "[[particle]]\nname = \"a\"\nmass = 1.0\nposition = [0, 0.5, 0]\nradius = 0.1\n\
+               [[particle]]\nname = \"b\"\nmass = 1.0\nposition = [1, 0.5, 0]\nradius = 0.1\n\
+               [[spring]]\na = \"a\"\nb = \"b\"\nstiffness = 10.0\n";
+    let list = "[\"a\", \"b\", \"a\"]";
+    for (table, field) in [
+        (format!("[[nbody]]\nparticles = {list}\n"), "nbody[0].particles"),
+        (
+            format!("[fluid]\ndensity = 1000.0\nparticles = {list}\n"),
+            "fluid.particles",
+        ),
+        (format!("[floor]\nparticles = {list}\n"), "floor.particles"),
+        (format!("[contacts]\nparticles = {list}\n"), "contacts.particles"),
+        (
+            format!("[[constant_force]]\nforce = [0, 1, 0]\nparticles = {list}\n"),
+            "constant_force[0].particles",
+        ),
+        (
+            format!("[evolve]\nduration = 1.0\nparticles = {list}\n"),
+            "evolve.particles",
+        ),
+        (
+            format!(
+                "[evolve]\nduration = 1.0\n[archive]\nmeasures = [{{ kind = \"mean_height\", particles = {list} }}]\nbins = [4]\nranges = [[0.0, 1.0]]\n"
+            ),
+            "archive.measures[0].particles",
+        ),
+    ] {
+        let text = format!("{two}{table}");
+        let message = match animats_scene::parse(&text, "twice.toml") {
+            Ok(_) => panic!("accepted {table}"),
+            Err(e) => e.to_string(),
+        };
+        assert!(
+            message.starts_with("twice.toml:")
+                && message.contains(&format!(": {field}: `a` is listed twice")),
+            "{table}: {message}"
+        );
+        // Each once is a scene.
+        let once = text.replace(list, "[\"a\", \"b\"]");
+        if let Err(e) = animats_scene::parse(&once, "once.toml") {
+            panic!("{once}: {e}");
+        }
+    }
+}
