@@ -107,10 +107,17 @@ impl Terrain {
             Terrain::Flat => Ok(()),
             Terrain::Slope(s) => {
                 horizontal("direction", s.uphill)?;
-                if !(0.0..std::f64::consts::FRAC_PI_2 - 1e-6).contains(&s.angle) {
+                // (A microradian short of vertical: the height's slope,
+                // tan θ, stays finite and its normal computable.)
+                let steepest = std::f64::consts::FRAC_PI_2 - 1e-6;
+                if !(0.0..steepest).contains(&s.angle) {
                     return Err(ModelError::new(
                         "angle",
-                        format!("must be in [0°, 90°), got {}°", s.angle.to_degrees()),
+                        format!(
+                            "must be at least 0° and under {:.5}° (90° less a microradian), got {}°",
+                            steepest.to_degrees(),
+                            s.angle.to_degrees()
+                        ),
                     ));
                 }
                 Ok(())

@@ -71,6 +71,11 @@ fn a_generated_heightfield_is_the_same_for_the_same_seed_and_follows_the_scene_s
 fn bad_terrain_is_named() {
     for (terrain, expect) in [
         ("kind = \"slope\"\nangle = 95", "terrain.angle"),
+        // The bound the message gives is the one applied.
+        (
+            "kind = \"slope\"\nangle = 89.9999999",
+            "terrain.angle: must be at least 0° and under 89.99994°",
+        ),
         (
             "kind = \"slope\"\nangle = 10\ndirection = [0, 1, 0]",
             "terrain.direction",
