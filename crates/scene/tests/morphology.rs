@@ -467,6 +467,12 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
             "encoding = \"lattice\"\ncells = [101, 100, 1]",
             "morphology.cells",
         ),
+        // (Its corners' penalty contact named `contacts.particles` of the
+        // developed text, at line 1,070,220 of a 12-line file.)
+        (
+            "encoding = \"lattice\"\ncells = [40, 40, 1]",
+            "morphology.cells: [40, 40, 1]: up to 3362 particles",
+        ),
         (
             "encoding = \"lattice\"\ncells = [2, 1, 1]\nstructure = [[1, 7]]",
             "morphology.structure",
@@ -531,6 +537,17 @@ fn bad_morphology_keys_are_refused_naming_the_field() {
     .to_string();
     assert!(
         e.contains("morphology.start") && e.contains("fails its own checks: particles"),
+        "{e}"
+    );
+    // A start that is itself a [morphology] scene (here, the scene itself:
+    // it recursed until the stack overflowed) is refused.
+    let itself = with("start = \"self.toml\"");
+    std::fs::write(dir.join("self.toml"), &itself).unwrap();
+    let e = MorphologyProblem::parse(&itself, dir.join("self.toml").to_str().unwrap())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("morphology.start") && e.contains("has a [morphology] table of its own"),
         "{e}"
     );
     // A start whose oscillator has `duty`: refused by a sine body, which

@@ -361,7 +361,22 @@ impl Morphology {
                 }
                 None
             }
-            EncodingName::Lattice => Some(lattice::Shape::from_entry(at, e)?),
+            EncodingName::Lattice => {
+                let shape = lattice::Shape::from_entry(at, e)?;
+                // Its particles are the cells' corners: as many as a full
+                // lattice has, at most.
+                let corners: usize = shape.cells.iter().map(|c| c + 1).product();
+                if e.self_contact && corners > most {
+                    return Err(at.err(
+                        "cells",
+                        format!(
+                            "{:?}: up to {corners} particles (the cells' corners) with self_contact: penalty contact tests every pair, at most {most} spheres; fewer cells or set self_contact = false",
+                            shape.cells
+                        ),
+                    ));
+                }
+                Some(shape)
+            }
         };
         let skewed = e.waveform == WaveformName::Skewed;
         if skewed && (neural || lattice.is_some()) {

@@ -407,6 +407,13 @@ fn start_body(file: &str, path: &str) -> Result<Body, String> {
         text: &text,
     })
     .map_err(|e| e.to_string())?;
+    // (Its own start would be read in turn: a scene that starts from
+    // itself recursed until the stack overflowed.)
+    if def.morphology.is_some() {
+        return Err(format!(
+            "{name} has a [morphology] table of its own: a start body is a plain scene of [[particle]] and [[spring]] entries"
+        ));
+    }
     let scene = crate::parse(&text, &name).map_err(|e| e.to_string())?;
     let index = |p: &str| {
         def.particle
