@@ -486,11 +486,17 @@ impl Optimiser for CmaEs {
 
 /// Eigenvalues and eigenvectors (as the columns of a row-major matrix) of a
 /// symmetric `n × n` matrix, by cyclic Jacobi rotations.
+///
+/// The eigenvectors are accumulated as rows (`vt`, the transpose of the
+/// result), so that each rotation updates two contiguous rows instead of
+/// two columns `n` apart: the same operations on the same numbers, so the
+/// same bits, in about half the time for CMA-ME's 100-D emitters (the
+/// rotations' strided loads of `a`'s columns and `v`'s were what bound it).
 pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
     let mut a = m.to_vec();
-    let mut v = vec![0.0; n * n];
+    let mut vt = vec![0.0; n * n];
     for i in 0..n {
-        v[i * n + i] = 1.0;
+        vt[i * n + i] = 1.0;
     }
     for _sweep in 0..100 {
         let off: f64 = (0..n)
@@ -518,20 +524,90 @@ pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
                     a[k * n + p] = c * akp - s * akq;
                     a[k * n + q] = s * akp + c * akq;
                 }
-                for k in 0..n {
-                    let apk = a[p * n + k];
-                    let aqk = a[q * n + k];
-                    a[p * n + k] = c * apk - s * aqk;
-                    a[q * n + k] = s * apk + c * aqk;
+                let (head, tail) = a.split_at_mut(q * n);
+                let (ap, aq) = (&mut head[p * n..(p + 1) * n], &mut tail[..n]);
+                for (apk, aqk) in ap.iter_mut().zip(aq.iter_mut()) {
+                    let (x, y) = (*apk, *aqk);
+                    *apk = c * x - s * y;
+                    *aqk = s * x + c * y;
                 }
-                for k in 0..n {
-                    let vkp = v[k * n + p];
-                    let vkq = v[k * n + q];
-                    v[k * n + p] = c * vkp - s * vkq;
-                    v[k * n + q] = s * vkp + c * vkq;
+                let (head, tail) = vt.split_at_mut(q * n);
+                let (vp, vq) = (&mut head[p * n..(p + 1) * n], &mut tail[..n]);
+                for (vkp, vkq) in vp.iter_mut().zip(vq.iter_mut()) {
+                    let (x, y) = (*vkp, *vkq);
+                    *vkp = c * x - s * y;
+                    *vkq = s * x + c * y;
                 }
             }
         }
     }
+    let mut v = vec![0.0; n * n];
+    for (i, row) in vt.chunks_exact(n.max(1)).enumerate() {
+        for (k, &x) in row.iter().enumerate() {
+            v[k * n + i] = x;
+        }
+    }
     ((0..n).map(|i| a[i * n + i]).collect(), v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::jacobi_eigen;
+
+    /// Each pair is an eigenpair (‖A v − λ v‖ within 1e-12 of ‖A‖), the
+    /// vectors orthonormal to 1e-13, and the values sum to the trace, for
+    /// random symmetric matrices and covariances B Bᵀ of 1 to 100 rows.
+    #[test]
+    fn jacobi_gives_orthonormal_eigenpairs() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for n in [1usize, 2, 3, 7, 16, 33, 100] {
+            for covariance in [false, true] {
+                let mut m = vec![0.0; n * n];
+                for i in 0..n {
+                    for j in i..n {
+                        let x = rnd();
+                        m[i * n + j] = x;
+                        m[j * n + i] = x;
+                    }
+                }
+                if covariance {
+                    let b = m.clone();
+                    for i in 0..n {
+                        for j in 0..n {
+                            m[i * n + j] = (0..n).map(|k| b[i * n + k] * b[j * n + k]).sum();
+                        }
+                    }
+                }
+                let norm = m.iter().map(|x| x * x).sum::<f64>().sqrt();
+                let (values, v) = jacobi_eigen(&m, n);
+                for (i, &l) in values.iter().enumerate() {
+                    let residual = (0..n)
+                        .map(|r| {
+                            let av: f64 = (0..n).map(|k| m[r * n + k] * v[k * n + i]).sum();
+                            (av - l * v[r * n + i]).powi(2)
+                        })
+                        .sum::<f64>()
+                        .sqrt();
+                    assert!(residual <= 1e-12 * norm, "n {n}, pair {i}: {residual}");
+                    if covariance {
+                        assert!(l >= -1e-12 * norm, "n {n}: a covariance's value {l}");
+                    }
+                    for j in 0..n {
+                        let dot: f64 = (0..n).map(|k| v[k * n + i] * v[k * n + j]).sum();
+                        let want = if i == j { 1.0 } else { 0.0 };
+                        assert!((dot - want).abs() <= 1e-13, "n {n}: vᵢ·vⱼ {dot}");
+                    }
+                }
+                let trace: f64 = (0..n).map(|i| m[i * n + i]).sum();
+                let sum: f64 = values.iter().sum();
+                assert!((trace - sum).abs() <= 1e-12 * norm.max(1.0), "n {n}");
+            }
+        }
+    }
 }
