@@ -555,19 +555,15 @@ pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
 #[cfg(test)]
 mod tests {
     use super::jacobi_eigen;
+    use crate::optimiser::Random;
 
     /// Each pair is an eigenpair (‖A v − λ v‖ within 1e-12 of ‖A‖), the
     /// vectors orthonormal to 1e-13, and the values sum to the trace, for
     /// random symmetric matrices and covariances B Bᵀ of 1 to 100 rows.
     #[test]
     fn jacobi_gives_orthonormal_eigenpairs() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut rng = Random::for_entry(7, 0);
+        let mut rnd = || rng.uniform() - 0.5;
         for n in [1usize, 2, 3, 7, 16, 33, 100] {
             for covariance in [false, true] {
                 let mut m = vec![0.0; n * n];
