@@ -41,7 +41,10 @@ impl Recipe {
     ) -> PyResult<Recipe> {
         if let Some(hz) = act_hz {
             if !(hz > 0.0 && hz.is_finite()) {
-                return Err(value_error(format!("act_hz must be > 0, got {hz}")));
+                return Err(value_error(format!(
+                    "act_hz must be > 0, got {}",
+                    animats_engine::Shown(hz)
+                )));
             }
         }
         Ok(Recipe {
@@ -60,7 +63,8 @@ impl Recipe {
     fn make_scene(&self, noise: f64) -> PyResult<SceneEnv> {
         if !(noise >= 0.0 && noise.is_finite()) {
             return Err(value_error(format!(
-                "noise must be a finite number ≥ 0, got {noise}"
+                "noise must be a finite number ≥ 0, got {}",
+                animats_engine::Shown(noise)
             )));
         }
         let env = SceneEnv::parse(&self.scene.text, &self.scene.file, noise)
@@ -123,9 +127,7 @@ fn body(env: &SceneEnv) -> Vec<(animats_engine::DVec3, f64)> {
 
 impl Env {
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, SceneEnv>> {
-        self.env
-            .lock()
-            .map_err(|_| runtime_error("the environment was poisoned by an earlier failure"))
+        crate::lock(&self.env, "environment")
     }
 }
 
@@ -308,9 +310,7 @@ type Stepped<'py> = (
 
 impl VecEnv {
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, RustVecEnv<Dyn>>> {
-        self.env
-            .lock()
-            .map_err(|_| runtime_error("the environment was poisoned by an earlier failure"))
+        crate::lock(&self.env, "environment")
     }
 }
 
@@ -382,10 +382,7 @@ impl VecEnv {
         actions: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Stepped<'py>> {
         let mut v = self.lock()?;
-        let mut out = self
-            .transitions
-            .lock()
-            .map_err(|_| runtime_error("poisoned"))?;
+        let mut out = crate::lock(&self.transitions, "environment")?;
         let shape = actions.shape();
         if shape[0] != v.len() || shape[1] != v.action_size() {
             return Err(value_error(format!(

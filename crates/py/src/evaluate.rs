@@ -4,6 +4,7 @@
 
 use crate::scene::{no_evolve, Scene};
 use crate::{on, pool, runtime_error, scene_error, value_error};
+use animats_engine::Shown;
 use animats_evolve::screen::Screen;
 use animats_evolve::{Outcome, Problem, ProblemSpec};
 use animats_scene::evaluate::{score_all, Batches, Make};
@@ -101,7 +102,10 @@ fn within_bounds(problem: &dyn Problem, rows: &mut [Vec<f64>], clip: bool) -> Py
                 *x = x.clamp(lo, hi);
             } else {
                 return Err(value_error(format!(
-                    "genome {k}, gene {i} = {x} is outside its bounds [{lo}, {hi}] (scene.bounds()); pass clip=True to clip genes into their bounds"
+                    "genome {k}, gene {i} = {} is outside its bounds [{}, {}] (scene.bounds()); pass clip=True to clip genes into their bounds",
+                    Shown(*x),
+                    Shown(lo),
+                    Shown(hi)
                 )));
             }
         }

@@ -44,6 +44,82 @@ pub(crate) fn scene_error(e: impl std::fmt::Display) -> PyErr {
     SceneError::new_err(e.to_string())
 }
 
+/// Locks `m` without holding the GIL while it waits: the thread that holds
+/// it may be working with the GIL released (a long `World.step`) and need
+/// the GIL back before it can let go, which a waiter that kept the GIL
+/// would never give (the two would wait for each other for ever). Ctrl-C
+/// stops the wait (`KeyboardInterrupt`).
+pub(crate) fn lock<'a, T: Send>(
+    m: &'a std::sync::Mutex<T>,
+    what: &str,
+) -> PyResult<std::sync::MutexGuard<'a, T>> {
+    use std::sync::TryLockError;
+    loop {
+        match m.try_lock() {
+            Ok(guard) => return Ok(guard),
+            Err(TryLockError::Poisoned(_)) => {
+                return Err(runtime_error(format!(
+                    "the {what} was poisoned by an earlier failure"
+                )))
+            }
+            Err(TryLockError::WouldBlock) => Python::attach(|py| {
+                py.detach(|| std::thread::sleep(std::time::Duration::from_micros(200)));
+                py.check_signals()
+            })?,
+        }
+    }
+}
+
+/// How long a long call works with the GIL released before it takes the
+/// GIL back to let Python handle a signal (Ctrl-C raises
+/// `KeyboardInterrupt` in at most about this long).
+pub(crate) const SLICE: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Runs `work` on a thread of its own while this one, the GIL released,
+/// waits for it and takes the GIL back every [`SLICE`] to let Python
+/// handle signals: on Ctrl-C it sets `stop`, which `work` is to heed by
+/// ending early, waits for it to end and raises `KeyboardInterrupt`.
+pub(crate) fn interruptible<T: Send>(
+    py: Python<'_>,
+    stop: &std::sync::atomic::AtomicBool,
+    work: impl FnOnce() -> T + Send,
+) -> PyResult<T> {
+    use std::sync::atomic::Ordering;
+    use std::sync::mpsc::{channel, RecvTimeoutError};
+    std::thread::scope(|s| {
+        let (tx, rx) = channel();
+        let handle = s.spawn(move || {
+            let out = work();
+            // (The receiver may be gone only if this thread panicked.)
+            let _ = tx.send(());
+            out
+        });
+        let mut rx = Some(rx);
+        loop {
+            let Some(r) = rx.take() else { break };
+            let (r, ended) = py.detach(move || {
+                let ended = r.recv_timeout(SLICE);
+                (r, ended)
+            });
+            rx = Some(r);
+            match ended {
+                Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
+                Err(RecvTimeoutError::Timeout) => {
+                    if let Err(e) = py.check_signals() {
+                        stop.store(true, Ordering::Relaxed);
+                        // It ends at its next check; wait without the GIL.
+                        let _ = py.detach(|| handle.join());
+                        return Err(e);
+                    }
+                }
+            }
+        }
+        handle
+            .join()
+            .map_err(|_| runtime_error("the run panicked; see the message above"))
+    })
+}
+
 /// A rayon pool of `threads` threads, or `None` for the global pool (every
 /// core).
 pub(crate) fn pool(threads: Option<usize>) -> PyResult<Option<rayon::ThreadPool>> {

@@ -385,7 +385,10 @@ impl Evolution {
     }
 
     /// Advances every lane by up to `generations` generations (default:
-    /// to the end) here, in parallel, the GIL released.
+    /// to the end) here, in parallel, the GIL released. Ctrl-C stops it
+    /// (`KeyboardInterrupt`) once each thread's generation in flight
+    /// ends: the run stands at whole generations, and `run()` goes on to
+    /// the same results as a run never stopped.
     #[pyo3(signature = (generations = None, threads = None))]
     fn run(
         &mut self,
@@ -402,8 +405,12 @@ impl Evolution {
         let n = generations.unwrap_or(self.state.config.generations);
         let Evolution { state, problem, .. } = self;
         let problem = problem.as_ref();
-        py.detach(|| on(&pool, || state.advance_with(problem, n)))
-            .map_err(runtime_error)
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let more = || !stop.load(std::sync::atomic::Ordering::Relaxed);
+        crate::interruptible(py, &stop, || {
+            on(&pool, || state.advance_by_while(problem, n, None, &more))
+        })?
+        .map_err(runtime_error)
     }
 
     /// True when every lane has done its generations.

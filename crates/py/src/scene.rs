@@ -1,6 +1,7 @@
 //! `animats.load`, `Scene`, `World`, `Snapshot`.
 
 use crate::{runtime_error, scene_error, value_error};
+use animats_engine::Shown;
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -333,9 +334,7 @@ impl World {
     }
 
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, animats_scene::Scene>> {
-        self.scene
-            .lock()
-            .map_err(|_| runtime_error("the world was poisoned by an earlier failure"))
+        crate::lock(&self.scene, "world")
     }
 }
 
@@ -349,19 +348,38 @@ fn vec3s<'py>(
     Ok(a.into_pyarray(py))
 }
 
+/// The most steps one `World.step` call takes (`animats simulate`'s bound).
+const MAX_STEPS: u64 = 1_000_000_000_000;
+
 #[pymethods]
 impl World {
-    /// Advances `n` steps of the scene's `dt` (controllers act before each).
-    /// Raises `RuntimeError` if the simulation blows up, naming the step.
+    /// Advances `n` steps of the scene's `dt` (controllers act before each),
+    /// at most 10¹² a call. Raises `RuntimeError` if the simulation blows
+    /// up, naming the particle and the time. Ctrl-C stops a long call
+    /// between two steps (`KeyboardInterrupt`): the world stands after the
+    /// last step taken, the same bits as one stepped that far.
     #[pyo3(signature = (n = 1))]
     fn step(&self, py: Python<'_>, n: u64) -> PyResult<()> {
+        if n > MAX_STEPS {
+            return Err(value_error(format!(
+                "n = {n} steps is too many (at most 1e12 a call)"
+            )));
+        }
         let mut s = self.lock()?;
         let scene = &mut *s;
-        py.detach(|| {
-            let dt = scene.dt;
-            scene.steps(n, dt).map_err(|e| e.to_string())
-        })
-        .map_err(runtime_error)
+        let dt = scene.dt;
+        let mut left = n;
+        while left > 0 {
+            let begun = std::time::Instant::now();
+            let more = || begun.elapsed() < crate::SLICE;
+            left -= py
+                .detach(|| scene.steps_while(left, dt, more))
+                .map_err(runtime_error)?;
+            if left > 0 {
+                py.check_signals()?;
+            }
+        }
+        Ok(())
     }
 
     /// Simulated time, s.
@@ -489,24 +507,27 @@ impl World {
     }
 
     /// Which particles touch the floor now: an `(N,)` bool array, true
-    /// where a particle's lowest point is within `tolerance` m of y = 0
-    /// (all false in a scene without a `[floor]`).
+    /// where a particle's surface is within `tolerance` m of the ground
+    /// (y = 0, or the `[terrain]`'s surface), as `touch` sensors and the
+    /// `feet` measure ask; all false in a scene without a `[floor]`.
     #[pyo3(signature = (tolerance = 1e-6))]
     fn contacts<'py>(
         &self,
         py: Python<'py>,
         tolerance: f64,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+        if !(tolerance >= 0.0 && tolerance.is_finite()) {
+            return Err(value_error(format!(
+                "tolerance must be a finite number of metres ≥ 0, got {}",
+                Shown(tolerance)
+            )));
+        }
         let s = self.lock()?;
-        let floor = s.world.forces().floor().is_some();
-        let r = &s.world.particles().radius;
-        let on: Vec<bool> = s
-            .world
-            .state()
-            .pos
-            .iter()
-            .zip(r)
-            .map(|(p, r)| floor && p.y - r <= tolerance)
+        let w = &s.world;
+        let floor = w.terrain().is_some();
+        let on: Vec<bool> = w
+            .particle_ids()
+            .map(|p| floor && w.touches_ground(p, tolerance))
             .collect();
         Ok(PyArray1::from_vec(py, on))
     }

@@ -1,9 +1,11 @@
 """The Python API against the command line: the same scenes, the same
 evaluations (to the bit), the same evolution logs."""
 
+import _thread
 import json
 import os
 import re
+import threading
 import warnings
 
 import numpy as np
@@ -185,6 +187,24 @@ def test_the_roobots_evolution_is_the_thesis_run(cli, tmp_path):
     run.run(threads=1)
     assert run.log_csv() == (tmp_path / "log.csv").read_text()
     assert run.best_toml() == (tmp_path / "best.toml").read_text()
+
+
+def test_ctrl_c_stops_a_run_at_whole_generations_and_it_goes_on_to_the_same_bits():
+    straight = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
+    straight.run(threads=2)
+    run = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
+    # Ctrl-C, as Python sees it, 0.3 s into a run of about 2 s on one thread.
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run.run(threads=1)
+    finally:
+        timer.cancel()
+    assert 0 < run.generation < 300 and not run.done
+    run.run(threads=2)
+    assert run.log_csv() == straight.log_csv()
+    assert run.best_toml() == straight.best_toml()
 
 
 def test_ask_and_tell_elsewhere_equal_run_here(crawler):

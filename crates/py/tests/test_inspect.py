@@ -2,7 +2,12 @@
 masses, springs and contacts, setting the state, genes held to their
 bounds, and the version."""
 
+import _thread
 import re
+import subprocess
+import sys
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -53,6 +58,73 @@ def test_masses_springs_and_contacts_of_the_walker(root):
     on = w.contacts()
     feet = [i for i, n in enumerate(w.names) if n.startswith("foot")]
     assert on.dtype == np.bool_ and on[feet].all() and not on[hips].any()
+
+
+def test_contacts_are_measured_from_the_terrain_and_the_tolerance_checked(tmp_path):
+    # A 1 cm ball resting on a 20° slope, 0.5 m along it (its surface 18 cm
+    # above y = 0), and one 1 cm clear of the slope.
+    def ball(name, x, gap):
+        y = x * np.tan(np.radians(20)) + (0.01 + gap) / np.cos(np.radians(20))
+        return f"[[particle]]\nname = \"{name}\"\nmass = 0.1\nposition = [{x}, {y}, 0.0]\nradius = 0.01\n"
+
+    s = tmp_path / "slope.toml"
+    s.write_text(
+        "[world]\ndt = 0.001\n[terrain]\nkind = \"slope\"\nangle = 20.0\n"
+        + ball("resting", 0.5, 0.0)
+        + ball("above", 1.0, 0.01)
+    )
+    w = animats.load(s).world()
+    assert w.contacts().tolist() == [True, False]
+    assert w.contacts(tolerance=0.011).tolist() == [True, True]
+    for bad in (float("nan"), -1e-3, float("inf")):
+        with pytest.raises(ValueError, match="tolerance"):
+            w.contacts(tolerance=bad)
+
+
+def test_ctrl_c_stops_a_long_step_between_steps(root):
+    scene = animats.load(root / "scenes" / "walker.toml")
+    w = scene.world()
+    # Ctrl-C, as Python sees it, 0.3 s into a call of about a day.
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    began = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            w.step(10**11)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - began < 3.0
+    steps = round(w.time / w.dt)
+    assert 0 < steps < 10**11
+    # It stands after its last whole step: the same bits as a world stepped
+    # that far in one go.
+    straight = scene.world()
+    straight.step(steps)
+    assert straight.time == w.time
+    assert np.array_equal(straight.positions(), w.positions())
+    assert np.array_equal(straight.velocities(), w.velocities())
+    with pytest.raises(ValueError, match="too many"):
+        w.step(10**12 + 1)
+
+
+def test_a_world_read_while_another_thread_steps_it_waits_for_the_step(root):
+    # Before, the reader waited for the world holding the GIL, which the
+    # stepping thread needed back to let go of it: both hung for ever. In
+    # a process of its own, so that a hang fails here instead of stopping
+    # the tests.
+    code = f"""
+import threading, time, animats
+w = animats.load({str(root / "scenes" / "walker.toml")!r}).world()
+t = threading.Thread(target=lambda: w.step(400_000))
+t.start()
+time.sleep(0.05)
+w.positions()
+t.join()
+print(round(w.time / w.dt))
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["400000"]
 
 
 def test_positions_and_velocities_can_be_set(tmp_path):

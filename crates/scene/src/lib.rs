@@ -186,6 +186,30 @@ impl Scene {
         })
     }
 
+    /// [`Scene::steps`], asking `more()` after every 64 steps and stopping
+    /// there when it says no: how many steps it took (`n` unless stopped).
+    /// The same steps, bit for bit, however it is cut: a caller that
+    /// must answer meanwhile (Python's Ctrl-C) takes a long run in slices.
+    pub fn steps_while(
+        &mut self,
+        n: u64,
+        dt: f64,
+        more: impl Fn() -> bool + Sync,
+    ) -> Result<u64, SimError> {
+        animats_engine::on_pool_if(self.world.steps_on_pool(), || {
+            let mut done = 0;
+            while done < n {
+                let k = (n - done).min(64);
+                (0..k).try_for_each(|_| self.step(dt).map(drop))?;
+                done += k;
+                if done < n && !more() {
+                    break;
+                }
+            }
+            Ok(done)
+        })
+    }
+
     /// Like [`Scene::step`], but a program is the brain: every actuator is
     /// driven towards `levels` (scene order, each at most its `rate`
     /// allows) and no controller runs. The other actors act as usual.

@@ -90,3 +90,24 @@ fn many_steps_stop_at_a_blow_up_and_say_so() {
         "{message}"
     );
 }
+
+#[test]
+fn steps_cut_where_asked_give_the_bits_of_steps_in_one_go() {
+    // `steps_while` asks after every 64 steps: stopped at the second ask,
+    // then run on to 300 in slices of the caller's, it takes the steps of
+    // one `steps(300)` to the bit (Python's `World.step` answering Ctrl-C).
+    let text = net(8, 10.0, 1e-4);
+    let mut cut = animats_scene::parse(&text, "net.toml").unwrap();
+    let mut whole = animats_scene::parse(&text, "net.toml").unwrap();
+    let asked = std::sync::atomic::AtomicUsize::new(0);
+    let more = || asked.fetch_add(1, std::sync::atomic::Ordering::Relaxed) < 1;
+    assert_eq!(cut.steps_while(300, 1e-4, more).unwrap(), 128);
+    assert_eq!(asked.into_inner(), 2);
+    assert_eq!(cut.steps_while(100, 1e-4, || false).unwrap(), 64);
+    assert_eq!(cut.steps_while(108, 1e-4, || true).unwrap(), 108);
+    // The last slice is not asked about: nothing is left after it.
+    assert_eq!(cut.steps_while(0, 1e-4, || false).unwrap(), 0);
+    whole.steps(300, 1e-4).unwrap();
+    assert_eq!(cut.world.time(), whole.world.time());
+    assert!(bits(&cut) == bits(&whole), "the states differ");
+}
