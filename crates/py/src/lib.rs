@@ -75,49 +75,50 @@ pub(crate) fn lock<'a, T: Send>(
 /// `KeyboardInterrupt` in at most about this long).
 pub(crate) const SLICE: std::time::Duration = std::time::Duration::from_millis(100);
 
-/// Runs `work` on a thread of its own while this one, the GIL released,
-/// waits for it and takes the GIL back every [`SLICE`] to let Python
-/// handle signals: on Ctrl-C it sets `stop`, which `work` is to heed by
-/// ending early, waits for it to end and raises `KeyboardInterrupt`.
+/// Runs `work` on `pool` (the global pool for `None`) while this thread,
+/// the GIL released, waits for it and takes the GIL back every [`SLICE`]
+/// to let Python handle signals: on Ctrl-C it sets `stop`, which `work`
+/// is to heed by ending early, waits for it to end and raises
+/// `KeyboardInterrupt`.
 pub(crate) fn interruptible<T: Send>(
     py: Python<'_>,
+    pool: &Option<rayon::ThreadPool>,
     stop: &std::sync::atomic::AtomicBool,
     work: impl FnOnce() -> T + Send,
 ) -> PyResult<T> {
+    py.detach(|| match pool {
+        Some(p) => p.in_place_scope(|s| wait_for(s, stop, work)),
+        None => rayon::in_place_scope(|s| wait_for(s, stop, work)),
+    })
+}
+
+/// [`interruptible`] in the scope `s`.
+fn wait_for<'scope, T: Send + 'scope>(
+    s: &rayon::Scope<'scope>,
+    stop: &std::sync::atomic::AtomicBool,
+    work: impl FnOnce() -> T + Send + 'scope,
+) -> PyResult<T> {
     use std::sync::atomic::Ordering;
     use std::sync::mpsc::{channel, RecvTimeoutError};
-    std::thread::scope(|s| {
-        let (tx, rx) = channel();
-        let handle = s.spawn(move || {
-            let out = work();
-            // (The receiver may be gone only if this thread panicked.)
-            let _ = tx.send(());
-            out
-        });
-        let mut rx = Some(rx);
-        loop {
-            let Some(r) = rx.take() else { break };
-            let (r, ended) = py.detach(move || {
-                let ended = r.recv_timeout(SLICE);
-                (r, ended)
-            });
-            rx = Some(r);
-            match ended {
-                Ok(()) | Err(RecvTimeoutError::Disconnected) => break,
-                Err(RecvTimeoutError::Timeout) => {
-                    if let Err(e) = py.check_signals() {
-                        stop.store(true, Ordering::Relaxed);
-                        // It ends at its next check; wait without the GIL.
-                        let _ = py.detach(|| handle.join());
-                        return Err(e);
-                    }
+    let (tx, rx) = channel();
+    s.spawn(move |_| {
+        // (The receiver is gone only after a Ctrl-C.)
+        let _ = tx.send(work());
+    });
+    loop {
+        match rx.recv_timeout(SLICE) {
+            Ok(out) => return Ok(out),
+            Err(RecvTimeoutError::Timeout) => {
+                if let Err(e) = Python::attach(|py| py.check_signals()) {
+                    stop.store(true, Ordering::Relaxed);
+                    // The scope waits for `work` to end.
+                    return Err(e);
                 }
             }
+            // `work` panicked: the scope passes the panic on.
+            Err(RecvTimeoutError::Disconnected) => return Err(runtime_error("the work panicked")),
         }
-        handle
-            .join()
-            .map_err(|_| runtime_error("the run panicked; see the message above"))
-    })
+    }
 }
 
 /// A rayon pool of `threads` threads, or `None` for the global pool (every

@@ -3,7 +3,7 @@
 //! seed gives the same candidates, log and best.toml as the command line.
 
 use crate::evaluate::{build, outcome_dict, outcomes, problem_spec};
-use crate::{on, pool, runtime_error, value_error};
+use crate::{pool, runtime_error, value_error};
 use animats_evolve::optimiser::{Bounds, Optimiser as _};
 use animats_evolve::run::Generation;
 use animats_evolve::screen::Screen;
@@ -407,8 +407,8 @@ impl Evolution {
         let problem = problem.as_ref();
         let stop = std::sync::atomic::AtomicBool::new(false);
         let more = || !stop.load(std::sync::atomic::Ordering::Relaxed);
-        crate::interruptible(py, &stop, || {
-            on(&pool, || state.advance_by_while(problem, n, None, &more))
+        crate::interruptible(py, &pool, &stop, || {
+            state.advance_by_while(problem, n, None, &more)
         })?
         .map_err(runtime_error)
     }

@@ -6,6 +6,7 @@ import json
 import os
 import re
 import threading
+import time
 import warnings
 
 import numpy as np
@@ -205,6 +206,25 @@ def test_ctrl_c_stops_a_run_at_whole_generations_and_it_goes_on_to_the_same_bits
     run.run(threads=2)
     assert run.log_csv() == straight.log_csv()
     assert run.best_toml() == straight.best_toml()
+
+
+def test_ctrl_c_stops_an_evaluation_of_many_genomes(root):
+    scene = animats.load(root / "scenes" / "walker.toml")
+    few = np.tile(scene.start(), (3, 1))
+    want = animats.evaluate(scene, few, threads=1)
+    # About 20 s of evaluations on one thread; Ctrl-C 0.3 s in.
+    many = np.tile(scene.start(), (3000, 1))
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    began = time.monotonic()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            animats.evaluate(scene, many, threads=1)
+    finally:
+        timer.cancel()
+    assert time.monotonic() - began < 3.0
+    # Nothing of it lingers: the next call is as any other.
+    assert np.array_equal(animats.evaluate(scene, few, threads=1), want)
 
 
 def test_ask_and_tell_elsewhere_equal_run_here(crawler):
