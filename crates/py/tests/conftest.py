@@ -1,10 +1,14 @@
 """Shared fixtures: the repository's paths and the `animats` binary the
 Python results are compared with."""
 
+import _thread
+import contextlib
 import os
 import pathlib
 import shutil
+import signal
 import subprocess
+import threading
 
 import pytest
 
@@ -57,3 +61,25 @@ def pogo_env(tmp_path_factory):
     p = tmp_path_factory.mktemp("scenes") / "pogo_env.toml"
     p.write_text(text)
     return p
+
+
+@pytest.fixture
+def ctrl_c():
+    """`with ctrl_c(seconds):` Ctrl-C, as Python sees it (SIGINT's handler
+    raising KeyboardInterrupt in the main thread), `seconds` into the block.
+    Python's own handler is put in place for it: a process started in the
+    background, as CI may be, inherits SIGINT ignored, and then
+    `interrupt_main` does nothing."""
+
+    @contextlib.contextmanager
+    def after(seconds):
+        old = signal.signal(signal.SIGINT, signal.default_int_handler)
+        timer = threading.Timer(seconds, _thread.interrupt_main)
+        timer.start()
+        try:
+            yield
+        finally:
+            timer.cancel()
+            signal.signal(signal.SIGINT, old)
+
+    return after

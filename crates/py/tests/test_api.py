@@ -1,11 +1,9 @@
 """The Python API against the command line: the same scenes, the same
 evaluations (to the bit), the same evolution logs."""
 
-import _thread
 import json
 import os
 import re
-import threading
 import time
 import warnings
 
@@ -190,38 +188,28 @@ def test_the_roobots_evolution_is_the_thesis_run(cli, tmp_path):
     assert run.best_toml() == (tmp_path / "best.toml").read_text()
 
 
-def test_ctrl_c_stops_a_run_at_whole_generations_and_it_goes_on_to_the_same_bits():
+def test_ctrl_c_stops_a_run_at_whole_generations_and_it_goes_on_to_the_same_bits(ctrl_c):
     straight = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
     straight.run(threads=2)
     run = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
-    # Ctrl-C, as Python sees it, 0.3 s into a run of about 2 s on one thread.
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            run.run(threads=1)
-    finally:
-        timer.cancel()
+    # Ctrl-C 0.3 s into a run of about 2 s on one thread.
+    with ctrl_c(0.3), pytest.raises(KeyboardInterrupt):
+        run.run(threads=1)
     assert 0 < run.generation < 300 and not run.done
     run.run(threads=2)
     assert run.log_csv() == straight.log_csv()
     assert run.best_toml() == straight.best_toml()
 
 
-def test_ctrl_c_stops_an_evaluation_of_many_genomes(root):
+def test_ctrl_c_stops_an_evaluation_of_many_genomes(root, ctrl_c):
     scene = animats.load(root / "scenes" / "walker.toml")
     few = np.tile(scene.start(), (3, 1))
     want = animats.evaluate(scene, few, threads=1)
     # About 20 s of evaluations on one thread; Ctrl-C 0.3 s in.
     many = np.tile(scene.start(), (3000, 1))
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
     began = time.monotonic()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            animats.evaluate(scene, many, threads=1)
-    finally:
-        timer.cancel()
+    with ctrl_c(0.3), pytest.raises(KeyboardInterrupt):
+        animats.evaluate(scene, many, threads=1)
     assert time.monotonic() - began < 3.0
     # Nothing of it lingers: the next call is as any other.
     assert np.array_equal(animats.evaluate(scene, few, threads=1), want)
