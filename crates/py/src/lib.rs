@@ -54,6 +54,10 @@ pub(crate) fn lock<'a, T: Send>(
     what: &str,
 ) -> PyResult<std::sync::MutexGuard<'a, T>> {
     use std::sync::TryLockError;
+    use std::time::Duration;
+    // Asked again after 50 µs, then twice as long each time up to 10 ms: a
+    // short wait ends soon, a long one takes the GIL only 100 times a second.
+    let mut pause = Duration::from_micros(50);
     loop {
         match m.try_lock() {
             Ok(guard) => return Ok(guard),
@@ -63,10 +67,11 @@ pub(crate) fn lock<'a, T: Send>(
                 )))
             }
             Err(TryLockError::WouldBlock) => Python::attach(|py| {
-                py.detach(|| std::thread::sleep(std::time::Duration::from_micros(200)));
+                py.detach(|| std::thread::sleep(pause));
                 py.check_signals()
             })?,
         }
+        pause = (pause * 2).min(Duration::from_millis(10));
     }
 }
 
