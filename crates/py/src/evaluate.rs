@@ -259,9 +259,12 @@ pub fn evaluate_scenes<'py>(
             texts
                 .par_iter()
                 .zip(&files)
-                .map(|(text, file)| match () {
-                    _ if stop.load(Ordering::Relaxed) => Err("interrupted".to_string()),
-                    _ => evaluate_text(text, file),
+                .map(|(text, file)| {
+                    if stop.load(Ordering::Relaxed) {
+                        Err("interrupted".to_string())
+                    } else {
+                        evaluate_text(text, file)
+                    }
                 })
                 .collect()
         })?;

@@ -181,9 +181,7 @@ impl Scene {
     /// ([`animats_engine::on_pool_if`]) instead of at every step. Stops at the
     /// first blow-up.
     pub fn steps(&mut self, n: u64, dt: f64) -> Result<(), SimError> {
-        animats_engine::on_pool_if(self.world.steps_on_pool(), || {
-            (0..n).try_for_each(|_| self.step(dt).map(drop))
-        })
+        self.steps_while(n, dt, || true).map(drop)
     }
 
     /// [`Scene::steps`], asking `more()` after every 64 steps and stopping
