@@ -14,7 +14,9 @@
 //!   rests at the height of the tetrahedron, the base held by friction; a
 //!   square pyramid of 30 comes to rest and stays; so does a column of 12,
 //!   taller than the handling's passes.
-//! - Spheres flung far away neither break the grid nor hide a collision.
+//! - Spheres flung far away neither break the grid nor hide a collision;
+//!   spheres millions of cells apart are never a pair (not even a sphere
+//!   with itself), and a pair that touches out there is found once.
 //!
 //! The pile of a thousand spheres is in `crates/bench/tests/pile.rs`.
 // std's transcendental functions: an independent reference here
@@ -343,6 +345,56 @@ fn spheres_far_beyond_the_grid_neither_panic_nor_hide_a_collision() {
         );
     }
     assert_eq!(impacts, vec![(0, 1)]);
+}
+
+#[test]
+fn spheres_apart_a_million_cells_and_more_are_never_a_pair() {
+    // Cells twice the largest radius, 6 cm here: spheres 100 km from the
+    // origin are 1.7 million cells out, and a sparse grid's neighbouring
+    // cells there must stay distinct cells, or a sphere is tested against
+    // itself (an overlap of 2r at distance 0: every step backtracked).
+    // Apart: no pair, no overlap. Two overlapping by 1 mm out there: one
+    // pair, 1 mm deep. Spread over more cells than a 64-bit key holds
+    // (10¹² cells apart in x, 10⁹ in y and z): the same.
+    let r = 0.03;
+    for (spread, far) in [
+        (DVec3::new(7e3, 0.0, 0.0), 1e5),
+        (DVec3::new(7e3, 0.0, 0.0), -1e5),
+        (DVec3::new(6e10, 6e7, 6e7), 0.0),
+        (DVec3::new(1e300, 0.0, 0.0), 0.0),
+    ] {
+        for touching in [false, true] {
+            let mut w = World::new();
+            w.set_integrator(IntegratorKind::Symplectic);
+            let mut at = Vec::new();
+            for i in 0..12 {
+                at.push(DVec3::new(far, 0.0, 0.0) + spread * (i as f64 - 5.5));
+            }
+            if touching {
+                at.push(at[3] + DVec3::new(0.0, 2.0 * r - 1e-3, 0.0));
+            }
+            for &x in &at {
+                w.add_particle(ball(1.0, r, x, DVec3::ZERO)).unwrap();
+            }
+            w.add_sphere_contact(SphereContactDef::default()).unwrap();
+            let mut probe = SphereContact::new(SphereContactDef::default()).unwrap();
+            let deepest = probe.deepest_overlap(&w.state().pos, w.particles());
+            let want = if touching { 1e-3 } else { 0.0 };
+            // The pair lies along y: its gap is rounded where its y is.
+            let tol = 4.0 * f64::EPSILON * (at[3].y.abs() + 2.0 * r);
+            assert!(
+                (deepest - want).abs() <= tol,
+                "spread {spread}, far {far}, touching {touching}: deepest overlap {deepest}"
+            );
+            let steps = w.step(1e-3).unwrap();
+            assert_eq!(
+                w.event::<SphereContact>().unwrap().touching(),
+                usize::from(touching),
+                "spread {spread}, far {far}, touching {touching}"
+            );
+            assert_eq!(steps.backtracks, 0, "spread {spread}, far {far}");
+        }
+    }
 }
 
 #[test]

@@ -13,9 +13,8 @@
  * against itself and then its 13 forward neighbours. Here the spheres are
  * sorted by (cell, index); on a dense grid each is tested against those
  * after it in its own and its forward neighbours' cells and each cell's
- * pairs put in the grid's order, on a sparse one (whose keys are clamped)
- * each neighbour's run is searched for: the same pairs in the same order,
- * with no grid. */
+ * pairs put in the grid's order, on a sparse one each neighbour's run is
+ * searched for: the same pairs in the same order, with no grid. */
 
 #ifndef ANIMATS_SPHERES_H
 #define ANIMATS_SPHERES_H
@@ -64,17 +63,21 @@ AN_FN int an_excluded(const an_spheres *s, long long a, long long b) {
     return lo < s->n_excluded && s->excluded[lo] == key;
 }
 
-/* grid.rs `floor_i64` of a coordinate clamped to ±1e12. */
-AN_FN long long an_sphere_cell(double x, double size) {
-    double c = an_min(an_max(x / size, -1e12), 1e12);
+/* grid.rs `floor_i64` of a coordinate clamped to ±limit (`Grid::cell`). */
+AN_FN long long an_sphere_cell(double x, double size, double limit) {
+    double c = an_min(an_max(x / size, -limit), limit);
     long long t = (long long)c;
     return (double)t > c ? t - 1 : t;
 }
 
-/* grid.rs `cell_key`'s clamp of one coordinate (a sparse grid's). */
-AN_FN long long an_key_part(long long c) {
-    long long k = c + (1LL << 20);
-    return k < 0 ? 0 : (k > (1LL << 21) - 1 ? (1LL << 21) - 1 : k);
+/* The bits of v (grid.rs `Grid::bits`: a sparse key's coordinate). */
+AN_FN int an_key_bits(unsigned long long v) {
+    int b = 0;
+    while (v) {
+        b++;
+        v >>= 1;
+    }
+    return b;
 }
 
 /* Whether (cell ka, sphere wa) comes before (cell kb, sphere wb). */
@@ -155,33 +158,41 @@ AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
     double size = 2.0 * largest;
     long long *who = s->slots, *key = s->slots + n, *pair = s->pair;
     long long count = 0, lo[3], hi[3];
-    for (long long i = 0; i < n; i++) {
-        const double *p = x + 3 * i;
-        int finite = p[0] - p[0] == 0.0 && p[1] - p[1] == 0.0 && p[2] - p[2] == 0.0;
-        if (!(s->r[i] > 0.0) || !finite) {
-            continue;
+    int dense = 0;
+    /* grid.rs `bin`: cells clamped to ±1e12 (FAR), or to ±(2^20 - 2)
+     * (NEAR) where a sparse grid's key would need more than 64 bits. */
+    for (double limit = 1e12;; limit = (double)((1LL << 20) - 2)) {
+        count = 0;
+        for (long long i = 0; i < n; i++) {
+            const double *p = x + 3 * i;
+            int finite = p[0] - p[0] == 0.0 && p[1] - p[1] == 0.0 && p[2] - p[2] == 0.0;
+            if (!(s->r[i] > 0.0) || !finite) {
+                continue;
+            }
+            for (int k = 0; k < 3; k++) {
+                long long c = an_sphere_cell(p[k], size, limit);
+                key[3 * count + k] = c;
+                if (count == 0 || c < lo[k]) {
+                    lo[k] = c;
+                }
+                if (count == 0 || c > hi[k]) {
+                    hi[k] = c;
+                }
+            }
+            who[count++] = i;
         }
+        if (count == 0) {
+            return 0.0;
+        }
+        double total = (double)(hi[0] - lo[0] + 1) * (double)(hi[1] - lo[1] + 1) *
+                       (double)(hi[2] - lo[2] + 1);
+        dense = total <= (double)(4 * count + 4096);
+        int bits = 0;
         for (int k = 0; k < 3; k++) {
-            long long c = an_sphere_cell(p[k], size);
-            key[3 * count + k] = c;
-            if (count == 0 || c < lo[k]) {
-                lo[k] = c;
-            }
-            if (count == 0 || c > hi[k]) {
-                hi[k] = c;
-            }
+            bits += an_key_bits((unsigned long long)(hi[k] - lo[k] + 2));
         }
-        who[count++] = i;
-    }
-    if (count == 0) {
-        return 0.0;
-    }
-    double total = (double)(hi[0] - lo[0] + 1) * (double)(hi[1] - lo[1] + 1) *
-                   (double)(hi[2] - lo[2] + 1);
-    int dense = total <= (double)(4 * count + 4096);
-    if (!dense) {
-        for (long long q = 0; q < 3 * count; q++) {
-            key[q] = an_key_part(key[q]);
+        if (dense || bits <= 64 || limit < 1e12) {
+            break;
         }
     }
     /* Sorted by (cell, index): insertion sort (they come in index order). */
@@ -254,9 +265,7 @@ AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
     }
     long long start = 0;
     while (start < count) {
-        long long i0 = who[start];
-        long long c[3] = {an_sphere_cell(x[3 * i0], size), an_sphere_cell(x[3 * i0 + 1], size),
-                          an_sphere_cell(x[3 * i0 + 2], size)};
+        const long long *c = key + 3 * start;
         long long end = start + 1;
         while (end < count && key[3 * end] == key[3 * start] &&
                key[3 * end + 1] == key[3 * start + 1] && key[3 * end + 2] == key[3 * start + 2]) {
@@ -267,12 +276,12 @@ AN_FN double an_spheres_find(an_spheres *s, long long n, const double *x) {
             if (o >= 0) {
                 /* grid.rs FORWARD[1..]: the offsets after (0, 0, 0) in
                  * the order of (dx, dy, dz), 27 cells numbered from
-                 * (-1, -1, -1); a sparse grid's keys clamped. */
+                 * (-1, -1, -1). */
                 int cell = 14 + o;
                 int off[3] = {cell / 9 - 1, (cell / 3) % 3 - 1, cell % 3 - 1};
                 long long want[3];
                 for (int k = 0; k < 3; k++) {
-                    want[k] = an_key_part(c[k] + off[k]);
+                    want[k] = c[k] + off[k];
                 }
                 if (!an_run_of(key, count, want, &rs, &re)) {
                     continue;

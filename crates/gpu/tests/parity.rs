@@ -847,7 +847,8 @@ fn spheres_colliding_as_events_are_the_engine_s_to_the_bit() {
 /// a line (no sliding: no friction's impulse); two at one place (no
 /// normal: left alone); two small fast ones flying side by side at one
 /// velocity, 1 cm apart (the swept test with no relative motion); points
-/// (no radius) among spheres; a world of points only (no sphere at all).
+/// (no radius) among spheres; a world of points only (no sphere at all);
+/// spheres on a sparse grid, and spread over more cells than its keys hold.
 #[test]
 fn sphere_contact_s_corner_cases_are_the_engine_s_to_the_bit() {
     for kind in [IntegratorKind::Symplectic, IntegratorKind::Rk4] {
@@ -906,6 +907,23 @@ fn sphere_contact_s_corner_cases_are_the_engine_s_to_the_bit() {
             world(&[
                 (1.0, 0.0, xyz(0.0, 0.3, 0.0), z, false),
                 (1.0, 0.0, xyz(0.0, 0.3, 0.0), xyz(0.1, 0.0, 0.0), false),
+            ]),
+            // A sparse grid, millions of cells apart: a pair touching 100 km
+            // out, lone spheres 7 km and 200 km from it.
+            world(&[
+                (1.0, 0.03, xyz(1e5, 0.5, 0.0), z, false),
+                (1.0, 0.03, xyz(1e5, 0.559, 0.0), xyz(0.0, -1.0, 0.0), false),
+                (1.0, 0.03, xyz(1e5 + 7e3, 0.5, 0.0), z, false),
+                (1.0, 0.03, xyz(-1e5, 0.3, 0.0), xyz(1.0, 0.0, 0.0), false),
+            ]),
+            // Spread over more cells than a 64-bit key holds: the far ones
+            // share the grid's last cells.
+            world(&[
+                (1.0, 0.03, xyz(6e10, 0.5, 0.0), z, false),
+                (1.0, 0.03, xyz(-6e10, 1.2e8, 6e7), z, false),
+                (1.0, 0.03, xyz(0.0, 0.5, -6e7), z, false),
+                (1.0, 0.03, xyz(0.0, 0.5, 0.0), z, false),
+                (1.0, 0.03, xyz(0.0, 0.559, 0.0), xyz(0.0, -1.0, 0.0), false),
             ]),
         ];
         assert_same(

@@ -38,13 +38,6 @@ impl Hasher for CellHasher {
     }
 }
 
-/// 21 bits per coordinate, offset so that cells from −2²⁰ to 2²⁰ pack.
-fn cell_key(c: [i64; 3]) -> u64 {
-    const OFF: i64 = 1 << 20;
-    let f = |x: i64| ((x + OFF).clamp(0, (1 << 21) - 1)) as u64;
-    (f(c[0]) << 42) | (f(c[1]) << 21) | f(c[2])
-}
-
 /// `x.floor() as i64` for `|x| ≤ 10¹²`, without a call: on the baseline
 /// x86-64 instruction set (no SSE4.1 rounding) `f64::floor` is a call into
 /// libm, a tenth of the contact check's time in a large pile. Truncating
@@ -83,21 +76,36 @@ const FORWARD: [[i64; 3]; 14] = [
 #[derive(Clone, Copy)]
 struct Grid {
     size: f64,
+    /// The cells' coordinates are clamped to ±`limit`: a sphere further
+    /// out shares the last cell with any others there (more pairs tested,
+    /// none missed), and a neighbour's coordinate (±1) never overflows.
+    limit: f64,
     lo: [i64; 3],
     hi: [i64; 3],
     /// A dense array of cells (else a hash map of the occupied ones).
     dense: bool,
     ny: i64,
     nz: i64,
+    /// A sparse grid's key: each coordinate counted from one below `lo`,
+    /// x in the highest bits, then y from bit `shift[1]`, z in the lowest,
+    /// each in as many bits as it needs up to one above `hi`, so that the
+    /// cells the spheres and their neighbours occupy have distinct keys,
+    /// ordered as their coordinates (x, then y, then z).
+    shift: [u32; 2],
 }
 
+/// Cells further out than 10¹² cell sizes are clamped (the first grid).
+const FAR: f64 = 1e12;
+
+/// The clamp when the cells from `lo` to `hi` cannot be keyed in 64 bits:
+/// each coordinate in 21 bits.
+const NEAR: f64 = ((1 << 20) - 2) as f64;
+
 impl Grid {
-    /// The cell of `x`: clamped far beyond the packed range, so that a
-    /// neighbour's coordinate (±1) never overflows, wherever a sphere has
-    /// flown.
+    /// The cell of `x`.
     #[inline(always)]
     fn cell(&self, x: DVec3) -> [i64; 3] {
-        let c = (x / self.size).clamp(DVec3::splat(-1e12), DVec3::splat(1e12));
+        let c = (x / self.size).clamp(DVec3::splat(-self.limit), DVec3::splat(self.limit));
         [floor_i64(c.x), floor_i64(c.y), floor_i64(c.z)]
     }
 
@@ -108,13 +116,20 @@ impl Grid {
             as u64
     }
 
+    /// The key of cell `c`, within one cell of `lo` … `hi`.
     #[inline(always)]
     fn key(&self, c: [i64; 3]) -> u64 {
         if self.dense {
             self.linear(c)
         } else {
-            cell_key(c)
+            let f = |k: usize| (c[k] - self.lo[k] + 1) as u64;
+            (f(0) << self.shift[0]) | (f(1) << self.shift[1]) | f(2)
         }
+    }
+
+    /// The bits a sparse key's coordinate `k` takes.
+    fn bits(&self, k: usize) -> u32 {
+        64 - ((self.hi[k] - self.lo[k] + 2) as u64).leading_zeros()
     }
 }
 
@@ -148,34 +163,48 @@ impl SphereContact {
         let n = pos.len();
         let mut grid = Grid {
             size,
-            lo: [i64::MAX; 3],
-            hi: [i64::MIN; 3],
+            limit: FAR,
+            lo: [0; 3],
+            hi: [0; 3],
             dense: false,
             ny: 0,
             nz: 0,
+            shift: [0; 2],
         };
-        // Where the spheres are: the bounds of their cells.
-        let mut count = 0usize;
-        self.def.targets.for_each(n, |i| {
-            if p.radius[i] > 0.0 && pos[i].is_finite() {
-                let c = grid.cell(pos[i]);
-                for (k, ck) in c.into_iter().enumerate() {
-                    grid.lo[k] = grid.lo[k].min(ck);
-                    grid.hi[k] = grid.hi[k].max(ck);
+        let total = loop {
+            // Where the spheres are: the bounds of their cells.
+            let mut count = 0usize;
+            grid.lo = [i64::MAX; 3];
+            grid.hi = [i64::MIN; 3];
+            self.def.targets.for_each(n, |i| {
+                if p.radius[i] > 0.0 && pos[i].is_finite() {
+                    let c = grid.cell(pos[i]);
+                    for (k, ck) in c.into_iter().enumerate() {
+                        grid.lo[k] = grid.lo[k].min(ck);
+                        grid.hi[k] = grid.hi[k].max(ck);
+                    }
+                    count += 1;
                 }
-                count += 1;
+            });
+            if count == 0 {
+                return None;
             }
-        });
-        if count == 0 {
-            return None;
-        }
-        let dims = [0, 1, 2].map(|k| (grid.hi[k] - grid.lo[k] + 1) as f64);
-        let total = dims[0] * dims[1] * dims[2];
-        // A dense grid (an array of cell starts, filled by counting) when
-        // the spheres fill their box; a hash map of occupied cells when
-        // they are spread far apart.
-        grid.dense = total <= (4 * count + 4096) as f64;
-        [_, grid.ny, grid.nz] = dims.map(|d| d as i64);
+            let dims = [0, 1, 2].map(|k| (grid.hi[k] - grid.lo[k] + 1) as f64);
+            let total = dims[0] * dims[1] * dims[2];
+            // A dense grid (an array of cell starts, filled by counting) when
+            // the spheres fill their box; a hash map of occupied cells when
+            // they are spread far apart.
+            grid.dense = total <= (4 * count + 4096) as f64;
+            [_, grid.ny, grid.nz] = dims.map(|d| d as i64);
+            let bits = [0, 1, 2].map(|k| grid.bits(k));
+            grid.shift = [bits[1] + bits[2], bits[2]];
+            if grid.dense || bits.iter().sum::<u32>() <= 64 || grid.limit == NEAR {
+                break total;
+            }
+            // Spread over more cells than 64 bits can key (spheres flown
+            // apart by 10¹⁰ m and more): the far ones share cells.
+            grid.limit = NEAR;
+        };
         let cells = &mut self.cells;
         self.def.targets.for_each(n, |i| {
             if p.radius[i] > 0.0 && pos[i].is_finite() {
@@ -245,7 +274,7 @@ impl SphereContact {
                 let (s, e) = (starts[k] as usize, starts[k + 1] as usize);
                 (e > s).then_some((s, e))
             } else {
-                runs.get(&cell_key(c))
+                runs.get(&grid.key(c))
                     .map(|&(s, e)| (s as usize, e as usize))
             }
         };
