@@ -37,7 +37,7 @@ pub struct Args {
 /// than a parameter file.
 fn is_scene(path: &str) -> bool {
     !params_file::BUILT_IN.contains(&path)
-        && std::fs::read_to_string(Path::new(path))
+        && animats_files::read_text(Path::new(path), animats_scene::MAX_FILE_BYTES)
             .ok()
             .and_then(|t| t.parse::<toml::Table>().ok())
             .is_some_and(|t| t.contains_key("evolve"))

@@ -388,6 +388,16 @@ fn bad_outputs_and_checkpoints_are_refused_before_any_work() {
     let o = evolve(&["--resume", base.join("nothing-here").to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o).1.contains("cannot read the checkpoint"));
+    // A checkpoint that is a device streaming for ever (it was read until
+    // memory ran out).
+    #[cfg(unix)]
+    if std::path::Path::new("/dev/zero").exists() {
+        std::fs::remove_file(&cp).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", &cp).unwrap();
+        let o = evolve(&["--resume", run.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2));
+        assert!(text(&o).1.contains("not a regular file"), "{}", text(&o).1);
+    }
     // A resumed run keeps its seed.
     let fresh = base.join("fresh");
     assert!(evolve(&[

@@ -293,6 +293,20 @@ fn missing_files_bad_options_and_unwritable_outputs_exit_2() {
         "{err}"
     );
     assert!(err.len() < 200, "{err}");
+    // A stream that never ends, whose stated size is 0, is refused at the
+    // bound as it is read (it was read until memory ran out), by every
+    // command that reads a scene or a parameter file.
+    if std::path::Path::new("/dev/zero").exists() {
+        for command in ["simulate", "evaluate", "evolve", "hop"] {
+            let o = animats(&[command, "/dev/zero"]);
+            let err = text(&o).1;
+            assert_eq!(o.status.code(), Some(2), "{command}: {err}");
+            assert!(
+                err.contains("/dev/zero: ") && err.contains("more than"),
+                "{command}: {err}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -49,6 +49,13 @@ pub fn encode(state: &State) -> Result<String, String> {
 /// Reads a checkpoint, refusing anything that is not an intact one.
 pub fn load(path: &Path) -> Result<State, String> {
     let shown = path.display();
+    // `animats evolve` writes checkpoints as regular files: anything else
+    // (a device, a pipe) could stream for ever.
+    let meta =
+        std::fs::metadata(path).map_err(|e| format!("{shown}: cannot read the checkpoint: {e}"))?;
+    if !meta.is_file() {
+        return Err(format!("{shown}: not a checkpoint (not a regular file)"));
+    }
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("{shown}: cannot read the checkpoint: {e}"))?;
     let (header, body) = text

@@ -285,8 +285,16 @@ pub fn read(path: &Path) -> Result<String, SceneError> {
             format!("the scene file is {size} bytes, more than the limit of {MAX_FILE_BYTES}"),
         ));
     }
-    std::fs::read_to_string(path)
-        .map_err(|e| SceneError::file(&file, format!("cannot read the scene file: {e}")))
+    // Bounded as it reads too: a device or a pipe states no size.
+    animats_files::read_text(path, MAX_FILE_BYTES).map_err(|e| {
+        let why = match e.kind() {
+            std::io::ErrorKind::FileTooLarge => {
+                format!("the scene file is more than the limit of {MAX_FILE_BYTES} bytes")
+            }
+            _ => format!("cannot read the scene file: {e}"),
+        };
+        SceneError::file(&file, why)
+    })
 }
 
 /// Parses and builds a scene from its text; `file` names it in errors. A

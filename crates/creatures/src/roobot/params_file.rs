@@ -46,6 +46,10 @@ impl fmt::Display for ParamsError {
 
 impl std::error::Error for ParamsError {}
 
+/// The most bytes a parameter file may hold (one is a few hundred; a
+/// lanes file of thousands of lanes fits too).
+const MAX_BYTES: u64 = 16 << 20;
+
 /// The built-in parameter sets, by name.
 pub const BUILT_IN: [&str; 2] = ["initial", "evolved"];
 
@@ -144,7 +148,7 @@ pub fn load(name_or_path: &str, lane: Option<usize>) -> Result<HopParams, Params
         "initial" if lane.is_none() => Ok(HopParams::INITIAL),
         "evolved" => parse(EVOLVED_TOML, "evolved (built in)", lane),
         path => {
-            let text = std::fs::read_to_string(Path::new(path)).map_err(|e| {
+            let text = animats_files::read_text(Path::new(path), MAX_BYTES).map_err(|e| {
                 let hint = if Path::new(path).extension().is_none() {
                     format!(" (built-in sets: {})", BUILT_IN.join(", "))
                 } else {
