@@ -611,20 +611,22 @@ impl State {
         generations: u64,
         tracer: Option<&crate::schedule::Tracer>,
     ) -> Result<(), String> {
-        self.advance_by_while(problem, generations, tracer, &|| true)
+        self.advance_by_while(problem, generations, tracer, &|| true, None)
     }
 
     /// [`State::advance_traced`], but past each lane's first generation a
     /// thread takes another only while `more()` says so: a run stopped
     /// early (Python's Ctrl-C) stands at whole generations, its lanes
     /// perhaps at different ones, and goes on from there to the same bits
-    /// as one never stopped (see [`State::advance_while`]).
+    /// as one never stopped (see [`State::advance_while`]). `seen` hears
+    /// of each lane's generation as it ends (progress).
     pub fn advance_by_while(
         &mut self,
         problem: &dyn Problem,
         generations: u64,
         tracer: Option<&crate::schedule::Tracer>,
         more: &(dyn Fn() -> bool + Sync),
+        seen: Option<&(dyn Fn(&LogRow) + Sync)>,
     ) -> Result<(), String> {
         let target = self.config.generations;
         let todo: Vec<u64> = self
@@ -632,7 +634,7 @@ impl State {
             .iter()
             .map(|l| generations.min(target.saturating_sub(l.generation)))
             .collect();
-        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer, more, None)?;
+        let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer, more, seen)?;
         if let Some(t) = tracer {
             t.next_batch();
         }

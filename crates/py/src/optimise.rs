@@ -15,6 +15,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2}
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
+use std::sync::{Mutex, MutexGuard};
 
 fn kind(name: &str) -> PyResult<OptimiserKind> {
     OptimiserKind::parse(name).map_err(value_error)
@@ -199,11 +200,64 @@ impl Optimiser {
 /// A whole evolution run, as `animats evolve [SCENE]` makes it: lanes, the
 /// log, the best. `run()` advances it here; `ask()`/`tell()` hand each
 /// generation out to be evaluated elsewhere (`animats.distributed`).
-#[pyclass(module = "animats")]
+///
+/// A second thread may use it while `run()` works: `generation`,
+/// `evaluations`, `best_fitness` and `done` then say how far the run has
+/// got (each lane's generations as they end); every other call waits for
+/// the run to end, as a `World`'s do for its step.
+#[pyclass(frozen, module = "animats")]
 pub struct Evolution {
+    inner: Mutex<Inner>,
+    /// Each lane's progress, kept beside the run: what the getters read.
+    progress: Mutex<Vec<LaneProgress>>,
+    /// The configured generations of every lane.
+    generations: u64,
+}
+
+/// The run itself, behind [`Evolution`]'s lock.
+struct Inner {
     state: State,
     problem: Box<dyn animats_evolve::Problem>,
     pending: Option<Generation>,
+}
+
+/// One lane's generations and evaluations done, and its best so far.
+#[derive(Clone, Copy)]
+struct LaneProgress {
+    generation: u64,
+    evaluations: u64,
+    best: Option<f64>,
+}
+
+/// Every lane's progress as `state` stands.
+fn progress_of(state: &State) -> Vec<LaneProgress> {
+    state
+        .lanes
+        .iter()
+        .map(|l| LaneProgress {
+            generation: l.generation,
+            evaluations: l.evaluations,
+            best: l.best.as_ref().map(|b| b.fitness),
+        })
+        .collect()
+}
+
+impl Evolution {
+    fn lock(&self) -> PyResult<MutexGuard<'_, Inner>> {
+        crate::lock(&self.inner, "evolution")
+    }
+
+    /// Brings the progress up to `state`.
+    fn sync(&self, state: &State) {
+        if let Ok(mut p) = self.progress.lock() {
+            *p = progress_of(state);
+        }
+    }
+
+    /// The progress (a copy; the lock is held for no longer).
+    fn lanes(&self) -> Vec<LaneProgress> {
+        self.progress.lock().map(|p| p.clone()).unwrap_or_default()
+    }
 }
 
 #[pymethods]
@@ -248,9 +302,13 @@ impl Evolution {
             .map_err(crate::scene_error)?;
         let state = State::new(config).map_err(value_error)?;
         Ok(Evolution {
-            state,
-            problem,
-            pending: None,
+            progress: Mutex::new(progress_of(&state)),
+            generations: state.config.generations,
+            inner: Mutex::new(Inner {
+                state,
+                problem,
+                pending: None,
+            }),
         })
     }
 
@@ -258,22 +316,24 @@ impl Evolution {
     /// a `(N, D)` array (a list of N 1-D arrays when bodies evolve: their
     /// genomes differ in length) and each one's lane. Evaluate every one
     /// and `tell`.
-    fn ask<'py>(&mut self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Vec<usize>)> {
-        if self.pending.is_some() {
+    fn ask<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Vec<usize>)> {
+        let mut guard = self.lock()?;
+        let me = &mut *guard;
+        if me.pending.is_some() {
             return Err(value_error(
                 "tell the outcomes of the last generation first",
             ));
         }
-        let g = self.state.ask().map_err(runtime_error)?;
-        let d = self.problem.dim();
+        let g = me.state.ask().map_err(runtime_error)?;
+        let d = me.problem.dim();
         let rows: Vec<Vec<f64>> = g.genomes().map(|x| x.to_vec()).collect();
         let lanes = g
             .lanes
             .iter()
             .flat_map(|(l, p)| std::iter::repeat_n(*l, p.len()))
             .collect();
-        self.pending = Some(g);
-        if self.problem.variation().is_some() {
+        me.pending = Some(g);
+        if me.problem.variation().is_some() {
             let list: Vec<Bound<'py, PyArray1<f64>>> = rows
                 .into_iter()
                 .map(|r| PyArray1::from_vec(py, r))
@@ -287,7 +347,7 @@ impl Evolution {
     /// `time`, `distance` (arrays) and `ended` (strings), and for a
     /// quality-diversity run `measures` (`(P, k)`), as `Evaluator.outcomes`
     /// gives.
-    fn tell(&mut self, outcomes: &Bound<'_, PyDict>) -> PyResult<()> {
+    fn tell(&self, outcomes: &Bound<'_, PyDict>) -> PyResult<()> {
         let get = |k: &str| -> PyResult<Bound<'_, PyAny>> {
             outcomes
                 .get_item(k)?
@@ -318,13 +378,15 @@ impl Evolution {
                 "fitness, time, distance and ended differ in length",
             ));
         }
-        let g = self
+        let mut guard = self.lock()?;
+        let me = &mut *guard;
+        let g = me
             .pending
             .take()
             .ok_or_else(|| value_error("ask for a generation first"))?;
         if g.len() != n {
             let asked = g.len();
-            self.pending = Some(g);
+            me.pending = Some(g);
             return Err(value_error(format!(
                 "{n} outcomes told for a generation of {asked} genomes"
             )));
@@ -343,27 +405,30 @@ impl Evolution {
                 })
             })
             .collect::<PyResult<_>>()?;
-        self.state.tell(g, &o).map_err(value_error)
+        let told = me.state.tell(g, &o).map_err(value_error);
+        self.sync(&me.state);
+        told
     }
 
     /// Evaluates the outcomes of a generation here (what `tell` takes).
     #[pyo3(signature = (genomes, threads = None))]
     fn evaluate<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         genomes: &Bound<'py, PyAny>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pool = pool(threads)?;
+        let me = self.lock()?;
         // The genomes last asked: each screened as its lane's optimiser
         // says, as `run` evaluates them.
-        let screens: Option<Vec<Screen>> = self.pending.as_ref().and_then(|g| {
+        let screens: Option<Vec<Screen>> = me.pending.as_ref().and_then(|g| {
             let n = genomes.len().ok()?;
             (n == g.len()).then(|| (0..n).map(|i| g.screen(i).clone()).collect())
         });
         let o = outcomes(
             py,
-            self.problem.as_ref(),
+            me.problem.as_ref(),
             genomes,
             &pool,
             None,
@@ -377,7 +442,8 @@ impl Evolution {
     /// `Evaluator.outcomes(genomes, screens=...)` wherever the genomes are
     /// evaluated, to write the log `run()` writes.
     fn screens(&self) -> PyResult<Vec<String>> {
-        let g = self
+        let me = self.lock()?;
+        let g = me
             .pending
             .as_ref()
             .ok_or_else(|| value_error("ask for a generation first"))?;
@@ -391,62 +457,81 @@ impl Evolution {
     /// the same results as a run never stopped.
     #[pyo3(signature = (generations = None, threads = None))]
     fn run(
-        &mut self,
+        &self,
         py: Python<'_>,
         generations: Option<u64>,
         threads: Option<usize>,
     ) -> PyResult<()> {
-        if self.pending.is_some() {
+        let mut guard = self.lock()?;
+        if guard.pending.is_some() {
             return Err(value_error(
                 "tell the outcomes of the last generation first",
             ));
         }
         let pool = pool(threads)?;
-        let n = generations.unwrap_or(self.state.config.generations);
-        let Evolution { state, problem, .. } = self;
+        let n = generations.unwrap_or(guard.state.config.generations);
+        let Inner { state, problem, .. } = &mut *guard;
         let problem = problem.as_ref();
         let stop = std::sync::atomic::AtomicBool::new(false);
         let more = || !stop.load(std::sync::atomic::Ordering::Relaxed);
-        crate::interruptible(py, &pool, &stop, || {
-            state.advance_by_while(problem, n, None, &more)
-        })?
-        .map_err(runtime_error)
+        let progress = &self.progress;
+        let seen = |row: &animats_evolve::run::LogRow| {
+            if let Ok(mut p) = progress.lock() {
+                if let Some(lane) = p.get_mut(row.lane) {
+                    *lane = LaneProgress {
+                        generation: row.generation,
+                        evaluations: row.evaluations,
+                        best: Some(row.best_fitness),
+                    };
+                }
+            }
+        };
+        let ran = crate::interruptible(py, &pool, &stop, || {
+            state.advance_by_while(problem, n, None, &more, Some(&seen))
+        });
+        self.sync(state);
+        ran?.map_err(runtime_error)
     }
 
     /// True when every lane has done its generations.
     #[getter]
     fn done(&self) -> bool {
-        self.state.done()
+        self.generation() >= self.generations
     }
 
-    /// Generations every lane has completed.
+    /// Generations every lane has completed (during a `run()` in another
+    /// thread: so far).
     #[getter]
     fn generation(&self) -> u64 {
-        self.state.generation()
+        self.lanes().iter().map(|l| l.generation).min().unwrap_or(0)
     }
 
     /// Evaluations so far.
     #[getter]
     fn evaluations(&self) -> u64 {
-        self.state.evaluations
+        self.lanes().iter().map(|l| l.evaluations).sum()
     }
 
     /// The genome's length.
     #[getter]
-    fn dim(&self) -> usize {
-        self.problem.dim()
+    fn dim(&self) -> PyResult<usize> {
+        Ok(self.lock()?.problem.dim())
     }
 
     /// The best fitness over all lanes so far, or None.
     #[getter]
     fn best_fitness(&self) -> Option<f64> {
-        self.state.best_fitness()
+        self.lanes()
+            .iter()
+            .filter_map(|l| l.best)
+            .max_by(f64::total_cmp)
     }
 
     /// The run's settings as `animats evolve` stores them, as a dict.
     #[getter]
     fn config<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let c = &self.state.config;
+        let me = self.lock()?;
+        let c = &me.state.config;
         let d = PyDict::new(py);
         d.set_item("lanes", c.lanes)?;
         d.set_item("generations", c.generations)?;
@@ -459,20 +544,21 @@ impl Evolution {
     }
 
     /// The problem as text a worker can rebuild: `(file, scene text)`.
-    fn problem_text(&self) -> (String, String) {
-        let p = &self.state.config.problem;
-        (p.file.clone(), p.text.clone())
+    fn problem_text(&self) -> PyResult<(String, String)> {
+        let me = self.lock()?;
+        let p = &me.state.config.problem;
+        Ok((p.file.clone(), p.text.clone()))
     }
 
     /// `log.csv`, exactly as `animats evolve` writes it.
-    fn log_csv(&self) -> String {
-        self.state.log_csv()
+    fn log_csv(&self) -> PyResult<String> {
+        Ok(self.lock()?.state.log_csv())
     }
 
     /// `best.toml`, exactly as `animats evolve` writes it (None before the
     /// first generation).
     fn best_toml(&self) -> PyResult<Option<String>> {
-        self.state.best_toml().map_err(runtime_error)
+        self.lock()?.state.best_toml().map_err(runtime_error)
     }
 
     /// The checks `animats evolve` runs at the end of a run: the best at
@@ -494,7 +580,8 @@ impl Evolution {
         py: Python<'py>,
         out: Option<PathBuf>,
     ) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let state = &self.state;
+        let me = self.lock()?;
+        let state = &me.state;
         let report = py
             .detach(|| animats_evolve::check::check(state))
             .map_err(runtime_error)?;
@@ -558,14 +645,14 @@ impl Evolution {
             pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", directory.display()))
         })?;
         let io = |e: std::io::Error| pyo3::exceptions::PyOSError::new_err(e.to_string());
-        animats_files::write_atomically(&directory.join("log.csv"), self.log_csv().as_bytes())
+        animats_files::write_atomically(&directory.join("log.csv"), self.log_csv()?.as_bytes())
             .map_err(|e| io(std::io::Error::other(e.to_string())))?;
         if let Some(b) = self.best_toml()? {
             animats_files::write_atomically(&directory.join("best.toml"), b.as_bytes())
                 .map_err(|e| io(std::io::Error::other(e.to_string())))?;
         }
         // A quality-diversity run: its archive, as `animats evolve` writes it.
-        if let Some(csv) = self.state.archive_csv() {
+        if let Some(csv) = self.lock()?.state.archive_csv() {
             animats_files::write_atomically(&directory.join("archive.csv"), csv.as_bytes())
                 .map_err(|e| io(std::io::Error::other(e.to_string())))?;
         }

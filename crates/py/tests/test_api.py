@@ -4,6 +4,7 @@ evaluations (to the bit), the same evolution logs."""
 import json
 import os
 import re
+import threading
 import time
 import warnings
 
@@ -199,6 +200,35 @@ def test_ctrl_c_stops_a_run_at_whole_generations_and_it_goes_on_to_the_same_bits
     run.run(threads=2)
     assert run.log_csv() == straight.log_csv()
     assert run.best_toml() == straight.best_toml()
+
+
+def test_another_thread_sees_a_run_s_progress_and_waits_for_its_log():
+    straight = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
+    straight.run(threads=1)
+    run = animats.Evolution("roobot", lanes=3, generations=300, seed=5)
+    worker = threading.Thread(target=run.run, kwargs={"threads": 1})
+    worker.start()
+    seen, during = [], None
+    while worker.is_alive():
+        seen.append((run.generation, run.evaluations))
+        if len(seen) == 3:
+            # Any call but the progress waits for the run: this log is the
+            # whole run's (it was "Already mutably borrowed").
+            during = run.log_csv()
+            assert not worker.is_alive()
+        time.sleep(0.02)
+    worker.join()
+    assert during is not None, f"the run ended within {len(seen)} looks"
+    # Seen part way (about 2 s on one thread), never going back.
+    assert any(0 < g < 300 for g, _ in seen), seen
+    assert seen == sorted(seen), seen
+    assert during == run.log_csv() == straight.log_csv()
+    assert (run.generation, run.evaluations, run.best_fitness, run.done) == (
+        300,
+        straight.evaluations,
+        straight.best_fitness,
+        True,
+    )
 
 
 def test_ctrl_c_stops_an_evaluation_of_many_genomes(root, ctrl_c):
