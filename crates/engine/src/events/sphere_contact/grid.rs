@@ -201,8 +201,9 @@ impl SphereContact {
             if grid.dense || bits.iter().sum::<u32>() <= 64 || grid.limit == NEAR {
                 break total;
             }
-            // Spread over more cells than 64 bits can key (spheres flown
-            // apart by 10¹⁰ m and more): the far ones share cells.
+            // Spread over more cells than 64 bits can key (with 6 cm
+            // cells, about 150 km apart along every axis): the far ones
+            // share cells.
             grid.limit = NEAR;
         };
         let cells = &mut self.cells;
