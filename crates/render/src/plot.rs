@@ -61,7 +61,14 @@ pub fn step_plot_png(plot: &Plot) -> Result<Vec<u8>, String> {
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let pts = plot.series.iter().flat_map(|s| s.points.iter());
+        // Points that cannot be placed (NaN, infinite, beyond ±10³⁰⁰, where
+        // the axis's padding would overflow) are left out: a fitness of
+        // `inf` from a scene's weights must not make the axes infinite.
+        let placed = |&&(x, y): &&(f64, f64)| x.is_finite() && y.is_finite() && y.abs() <= 1e300;
+        let pts = plot
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter().filter(placed));
         let (mut x0, mut x1, mut y0, mut y1) = (
             f64::INFINITY,
             f64::NEG_INFINITY,
@@ -91,16 +98,23 @@ pub fn step_plot_png(plot: &Plot) -> Result<Vec<u8>, String> {
             .y_desc(plot.y_label.as_str())
             .label_style(("sans-serif", 14))
             .x_label_formatter(&|x| format!("{x:.0}"))
-            .y_label_formatter(&|y| format!("{y:.0}"))
+            .y_label_formatter(&|y| {
+                if y.abs() < 1e9 {
+                    format!("{y:.0}")
+                } else {
+                    format!("{y:.2e}")
+                }
+            })
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(|e| e.to_string())?;
         for (i, s) in plot.series.iter().enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
             let mut steps = Vec::with_capacity(2 * s.points.len());
-            for (k, &(x, y)) in s.points.iter().enumerate() {
+            let points: Vec<(f64, f64)> = s.points.iter().filter(placed).copied().collect();
+            for (k, &(x, y)) in points.iter().enumerate() {
                 if k > 0 {
-                    steps.push((x, s.points[k - 1].1));
+                    steps.push((x, points[k - 1].1));
                 }
                 steps.push((x, y));
             }
@@ -123,4 +137,48 @@ pub fn step_plot_png(plot: &Plot) -> Result<Vec<u8>, String> {
         root.present().map_err(|e| e.to_string())?;
     }
     crate::png_file::encode_rgb(w, h, &buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lane whose fitness overflowed (a scene's weight of 1e308) once
+    /// made plotters search for the axis's key points for ever.
+    #[test]
+    fn points_that_cannot_be_placed_are_left_out_and_the_plot_is_drawn() {
+        for points in [
+            vec![(1.0, f64::INFINITY), (2.0, f64::INFINITY)],
+            vec![
+                (1.0, 5.0),
+                (2.0, f64::NAN),
+                (3.0, f64::NEG_INFINITY),
+                (4.0, 7.0),
+            ],
+            vec![(1.0, -1e308), (2.0, 1e308), (3.0, 1e300), (4.0, -1e300)],
+            vec![(f64::NAN, 1.0), (f64::INFINITY, 2.0)],
+        ] {
+            let plot = Plot {
+                title: "t".into(),
+                x_label: "x".into(),
+                y_label: "y".into(),
+                series: vec![Series {
+                    label: "s".into(),
+                    points: points.clone(),
+                }],
+                size: (320, 200),
+            };
+            // On a thread of its own, so that a regression fails here
+            // instead of hanging the tests.
+            let (tx, rx) = std::sync::mpsc::channel();
+            std::thread::spawn(move || {
+                let _ = tx.send(step_plot_png(&plot));
+            });
+            let png = rx
+                .recv_timeout(std::time::Duration::from_secs(60))
+                .expect("the plot was not drawn within 60 s")
+                .unwrap();
+            assert_eq!(&png[..4], b"\x89PNG", "{points:?}");
+        }
+    }
 }

@@ -107,6 +107,24 @@ pub const MAX_TRIALS: u32 = 1000;
 /// 31 runs' time at the step for a candidate scored at every step).
 pub const MAX_HALVINGS: u32 = 4;
 
+/// The largest magnitude of a fitness weight (`distance_weight`,
+/// `time_weight`, `energy_weight`, `target_weight`, each term's `weight`):
+/// beyond it a weight times a distance or a day's time can overflow the
+/// fitness to infinity, where the optimisers cannot rank.
+pub const MAX_WEIGHT: f64 = 1e12;
+
+/// `x` as a fitness weight: finite and at most [`MAX_WEIGHT`] in magnitude.
+fn weight(at: &At, field: &str, x: f64) -> Result<f64, SceneError> {
+    let x = at.finite(field, x)?;
+    if x.abs() > MAX_WEIGHT {
+        return Err(at.err(
+            field,
+            format!("must be between -{MAX_WEIGHT:e} and {MAX_WEIGHT:e}, got {x:e}"),
+        ));
+    }
+    Ok(x)
+}
+
 /// An `[evolve]` table's end rules, resolved.
 struct EndRules {
     fail_on_touch: Vec<(ParticleId, String)>,
@@ -221,7 +239,7 @@ impl EvolveSpec {
             }
             Some(t) => Some((
                 at.vec3("target", t)?,
-                at.finite("target_weight", e.target_weight.unwrap_or(1.0))?,
+                weight(at, "target_weight", e.target_weight.unwrap_or(1.0))?,
             )),
         };
         let trials = e.trials.unwrap_or(1);
@@ -265,7 +283,7 @@ impl EvolveSpec {
             let (weight, m) = t.0.as_ref().map_err(|msg| {
                 at.err(&field, format!("{msg} (kinds: {})", crate::archive::KINDS))
             })?;
-            let weight = at.finite(&format!("{field}.weight"), *weight)?;
+            let weight = self::weight(at, &format!("{field}.weight"), *weight)?;
             terms.push((weight, m.resolve(at, &field, names, &particles, axis)?));
         }
         Ok(EvolveSpec {
@@ -273,8 +291,8 @@ impl EvolveSpec {
             duration,
             particles,
             axis,
-            distance_weight: at.finite("distance_weight", e.distance_weight)?,
-            time_weight: at.finite("time_weight", e.time_weight)?,
+            distance_weight: weight(at, "distance_weight", e.distance_weight)?,
+            time_weight: weight(at, "time_weight", e.time_weight)?,
             fail_on_touch,
             touch_tolerance,
             fail_on_stretch,
@@ -285,7 +303,7 @@ impl EvolveSpec {
             robust,
             robust_halvings,
             optimiser: e.optimiser.clone(),
-            energy_weight: at.finite("energy_weight", e.energy_weight)?,
+            energy_weight: weight(at, "energy_weight", e.energy_weight)?,
             target,
             trials,
             noise,

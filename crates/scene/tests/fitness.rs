@@ -180,6 +180,27 @@ fn bad_fitness_keys_are_named() {
         "evolve.terms[0]",
     );
     bad("energy_weight = nan", "evolve.energy_weight");
+    // A weight of 1e308 once overflowed every fitness to infinity.
+    bad(
+        "time_weight = 1e308",
+        "evolve.time_weight: must be between -1e12 and 1e12, got 1e308",
+    );
+    bad(
+        "distance_weight = -2e12",
+        "evolve.distance_weight: must be between",
+    );
+    bad(
+        "energy_weight = 1e13",
+        "evolve.energy_weight: must be between",
+    );
+    bad(
+        "target = [0, 0, 0]\ntarget_weight = 1e300",
+        "evolve.target_weight: must be between",
+    );
+    bad(
+        "terms = [{ kind = \"mean_height\", weight = 1e200 }]",
+        "evolve.terms[0].weight: must be between",
+    );
     bad("robust_halvings = 2", "evolve.robust_halvings: halves the step of a robust evaluation (2 given): set `robust = true` too");
     bad(
         "robust = true\nrobust_halvings = 0",
