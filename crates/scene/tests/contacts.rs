@@ -118,3 +118,40 @@ fn the_pile_with_no_sleep_time_falls_without_endless_backtracks() {
     assert!(backtracks < 100, "{backtracks} backtracks in 300 steps");
     assert!(fell > 0.3, "the rocks fell only {fell} m");
 }
+
+/// A `[[rocks]]` box must be one: `to` at or beyond `from` on every axis,
+/// with a width that is a number (from -1e308 to 1e308 is not). An inside
+/// out box was once accepted and dropped rocks outside both corners.
+#[test]
+fn a_rock_box_inside_out_or_without_a_finite_width_is_refused() {
+    let rocks = |box_: &str| {
+        let text = format!("[world]\n\n[[rocks]]\ncount = 3\n{box_}\n");
+        animats_scene::parse(&text, "r.toml").map(|s| s.world.len())
+    };
+    assert_eq!(rocks("from = [0, 0, 0]\nto = [1, 1, 1]").unwrap(), 3);
+    assert_eq!(rocks("from = [0, 1, 0]\nto = [1, 1, 1]").unwrap(), 3);
+    for (box_, axis) in [
+        (
+            "from = [1, 0, 0]\nto = [0, 1, 1]",
+            "along x, within a finite width: from 1, to 0",
+        ),
+        (
+            "from = [0, 0, 2]\nto = [1, 1, 1]",
+            "along z, within a finite width: from 2, to 1",
+        ),
+        (
+            "to = [0, 0, 0]",
+            "along y, within a finite width: from 0.2, to 0",
+        ),
+        ("from = [-1e308, 0, 0]\nto = [1e308, 1, 1]", "along x"),
+    ] {
+        let e = rocks(box_).map(|_| ()).unwrap_err().to_string();
+        println!("{e}");
+        assert!(e.contains("r.toml"), "{e}");
+        assert!(
+            e.contains("rocks[0].to: must be at or beyond `from`"),
+            "{e}"
+        );
+        assert!(e.contains(axis), "{box_}: {e}");
+    }
+}

@@ -52,6 +52,20 @@ pub fn scatter(
             format!("must be > 0, got {}", c.density),
         ));
     }
+    for (axis, a, z) in [
+        ("x", c.from.x, c.to.x),
+        ("y", c.from.y, c.to.y),
+        ("z", c.from.z, c.to.z),
+    ] {
+        // A box turned inside out, or one too wide for its width to be a
+        // number (from -1e308 to 1e308), would drop rocks at NaN.
+        if !(a <= z && (z - a).is_finite()) {
+            return Err(ModelError::new(
+                "to",
+                format!("must be at or beyond `from` along {axis}, within a finite width: from {a}, to {z}"),
+            ));
+        }
+    }
     (0..c.count)
         .map(|_| {
             let mass = random.between(c.mass.0, c.mass.1);
