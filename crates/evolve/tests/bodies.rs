@@ -497,3 +497,46 @@ fn an_overlapped_run_evaluates_its_start_body_once() {
     assert_eq!(ahead.len(), 4);
     assert!(ahead.iter().all(|x| x != &start), "the start body again");
 }
+
+/// A generation told outcomes its archive refuses (here the last
+/// candidate's measures are one too few) is refused whole: the run stays
+/// as it was, and told again rightly it is the run never refused.
+#[test]
+fn outcomes_the_archive_refuses_leave_the_run_as_it_was() {
+    let text = format!(
+        "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"feet\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [0.0, 8.0]]\n"
+    );
+    let spec = ProblemSpec {
+        file: "bodies.toml".into(),
+        text,
+    };
+    let choices = Choices {
+        generations: Some(3),
+        population: Some(4),
+        seed: Some(5),
+        optimiser: Some(animats_evolve::OptimiserKind::MapElites),
+        ..Choices::default()
+    };
+    let config = Config::new(spec, &choices).unwrap();
+    let mut never = State::new(config.clone()).unwrap();
+    pool(1).install(|| never.advance(3)).unwrap();
+    let problem = config.problem.build().unwrap();
+    let mut s = State::new(config).unwrap();
+    while !s.done() {
+        let g = s.ask().unwrap();
+        let outcomes: Vec<Outcome> = g
+            .genomes()
+            .enumerate()
+            .map(|(i, x)| problem.evaluate_screened(x, g.screen(i)).unwrap())
+            .collect();
+        let mut bad = outcomes.clone();
+        bad.last_mut().unwrap().measures.pop();
+        let before = s.clone();
+        let e = s.tell(g.clone(), &bad).unwrap_err();
+        assert!(e.contains("1 measures told, the archive has 2"), "{e}");
+        assert_eq!(s, before, "a refused generation moved the run");
+        s.tell(g, &outcomes).unwrap();
+    }
+    assert_eq!(s.log_csv(), never.log_csv());
+    assert_eq!(s, never);
+}

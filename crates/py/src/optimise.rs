@@ -378,26 +378,15 @@ impl Evolution {
                 "fitness, time, distance and ended differ in length",
             ));
         }
-        let mut guard = self.lock()?;
-        let me = &mut *guard;
-        let g = me
-            .pending
-            .take()
-            .ok_or_else(|| value_error("ask for a generation first"))?;
-        if g.len() != n {
-            let asked = g.len();
-            me.pending = Some(g);
-            return Err(value_error(format!(
-                "{n} outcomes told for a generation of {asked} genomes"
-            )));
-        }
         let o: Vec<Outcome> = (0..n)
             .map(|i| {
                 Ok(Outcome {
                     fitness: fitness[i],
                     time: time[i],
                     distance: distance[i],
-                    ended: ended[i].parse().map_err(value_error)?,
+                    ended: ended[i]
+                        .parse()
+                        .map_err(|e| value_error(format!("ended[{i}]: {e}")))?,
                     measures: measures.get(i).cloned().unwrap_or_default(),
                     energy: None,
                     target_distance: None,
@@ -405,9 +394,23 @@ impl Evolution {
                 })
             })
             .collect::<PyResult<_>>()?;
-        let told = me.state.tell(g, &o).map_err(value_error);
+        let mut guard = self.lock()?;
+        let me = &mut *guard;
+        let g = me
+            .pending
+            .as_ref()
+            .ok_or_else(|| value_error("ask for a generation first"))?;
+        if g.len() != n {
+            return Err(value_error(format!(
+                "{n} outcomes told for a generation of {} genomes",
+                g.len()
+            )));
+        }
+        // Outcomes refused leave the generation asked, to be told again.
+        me.state.tell(g.clone(), &o).map_err(value_error)?;
+        me.pending = None;
         self.sync(&me.state);
-        told
+        Ok(())
     }
 
     /// Evaluates the outcomes of a generation here (what `tell` takes).

@@ -53,7 +53,16 @@ def test_an_ask_tell_map_matches_the_command_line(cli, tmp_path):
     ev = animats.Evaluator(str(HOP_MAP))
     while not run.done:
         genomes, _ = run.ask()
-        run.tell(ev.outcomes(genomes))
+        o = ev.outcomes(genomes)
+        # Outcomes refused (an ending that is none, a measure too few)
+        # leave the generation asked, to be told again rightly.
+        bad = dict(o, ended=["sideways"] + list(o["ended"][1:]))
+        with pytest.raises(ValueError, match=r"ended\[0\]: `sideways` is not an ending"):
+            run.tell(bad)
+        bad = dict(o, measures=np.asarray(o["measures"])[:, :1])
+        with pytest.raises(ValueError, match="1 measures told, the archive has 2"):
+            run.tell(bad)
+        run.tell(o)
     run.save(tmp_path / "py")
     for f in ("log.csv", "archive.csv"):
         assert (tmp_path / "py" / f).read_text() == (tmp_path / "cli" / f).read_text(), f
