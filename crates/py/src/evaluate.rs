@@ -7,13 +7,17 @@ use crate::{on, pool, runtime_error, scene_error, value_error};
 use animats_engine::Shown;
 use animats_evolve::screen::Screen;
 use animats_evolve::{Outcome, Problem, ProblemSpec};
-use animats_scene::evaluate::{score_all, Batches, Make};
+use animats_scene::evaluate::{score_all, stoppable, Batches, Make, INTERRUPTED};
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use rayon::prelude::*;
+use std::cell::{Cell, RefCell};
 use std::path::PathBuf;
+use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
 /// What Python names as a problem: a `Scene`, a scene file's path, or
 /// `"roobot"` (the thesis's hopping gait, 20 s at 8 ms).
@@ -149,30 +153,77 @@ pub(crate) fn outcomes(
     if let Some(batch) = py.detach(|| on(pool, || problem.evaluate_population(&rows, &fine))) {
         return batch.map_err(runtime_error);
     }
-    let stop = AtomicBool::new(false);
+    let evaluate = |i: usize, g: &[f64]| match screens {
+        Some(s) => problem.evaluate_screened(g, &s[i]),
+        None => problem.evaluate(g),
+    };
+    // One genome on the global pool: evaluated on this thread (no other
+    // woken), which takes the GIL back every `SLICE` of it to let Python
+    // handle a signal; Ctrl-C ends it within 256 steps.
+    if rows.len() == 1 && pool.is_none() {
+        let (out, caught) = py.detach(|| {
+            let caught: Rc<RefCell<Option<PyErr>>> = Rc::default();
+            let asks = {
+                let caught = caught.clone();
+                let last = Cell::new(Instant::now());
+                Rc::new(move || {
+                    if caught.borrow().is_some() {
+                        return true;
+                    }
+                    if last.get().elapsed() < crate::SLICE {
+                        return false;
+                    }
+                    last.set(Instant::now());
+                    match Python::attach(|py| py.check_signals()) {
+                        Ok(()) => false,
+                        Err(e) => {
+                            *caught.borrow_mut() = Some(e);
+                            true
+                        }
+                    }
+                })
+            };
+            let out = stoppable(asks, || evaluate(0, &rows[0]));
+            (out, caught.take())
+        });
+        if let Some(e) = caught {
+            return Err(e);
+        }
+        return out.map(|o| vec![o]).map_err(runtime_error);
+    }
+    let stop = Arc::new(AtomicBool::new(false));
     let work = || {
         rows.par_iter()
             .enumerate()
-            .map(|(i, g)| match screens {
-                // Ctrl-C: the evaluations not yet begun are skipped.
-                _ if stop.load(Ordering::Relaxed) => Err("interrupted".to_string()),
-                Some(s) => problem.evaluate_screened(g, &s[i]),
-                None => problem.evaluate(g),
+            .map(|(i, g)| {
+                // Ctrl-C: the evaluations not yet begun are skipped, those
+                // under way end within 256 steps.
+                if stop.load(Ordering::Relaxed) {
+                    return Err(INTERRUPTED.to_string());
+                }
+                stoppable(asks(&stop), || evaluate(i, g))
             })
             // (The first genome's failure, whichever thread failed first.)
             .collect::<Vec<_>>()
             .into_iter()
             .collect::<Result<Vec<_>, _>>()
     };
-    // No more genomes than threads: one evaluation's time, not worth the
-    // watch for Ctrl-C (about 17 µs a call, 6 % of one roobot's fall).
-    let threads = pool
-        .as_ref()
-        .map_or_else(rayon::current_num_threads, |p| p.current_num_threads());
-    if rows.len() <= threads {
+    // A few genomes (no more than threads) on the global pool: one
+    // evaluation's time, not worth the watch for Ctrl-C (it took one
+    // roobot genome 268 -> 285 us a call on an AMD EPYC, 264 -> 375 us on
+    // an Intel Xeon). A pool of the call's own (`threads`) costs more to
+    // make than the watch.
+    if pool.is_none() && rows.len() <= rayon::current_num_threads() {
         return py.detach(|| on(pool, work)).map_err(runtime_error);
     }
     crate::interruptible(py, pool, &stop, work)?.map_err(runtime_error)
+}
+
+/// The question [`stoppable`] asks of an evaluation under a Ctrl-C watch
+/// ([`crate::interruptible`]'s `stop`).
+fn asks(stop: &Arc<AtomicBool>) -> Rc<dyn Fn() -> bool> {
+    let stop = stop.clone();
+    Rc::new(move || stop.load(Ordering::Relaxed))
 }
 
 /// Screens sent as `Evolution.screens()` wrote them (JSON texts).
@@ -253,7 +304,7 @@ pub fn evaluate_scenes<'py>(
             .map_err(runtime_error)?;
         return outcome_dict(py, &o);
     }
-    let stop = AtomicBool::new(false);
+    let stop = Arc::new(AtomicBool::new(false));
     let results: Vec<Result<(Outcome, Vec<String>), String>> =
         crate::interruptible(py, &pool, &stop, || {
             texts
@@ -261,9 +312,9 @@ pub fn evaluate_scenes<'py>(
                 .zip(&files)
                 .map(|(text, file)| {
                     if stop.load(Ordering::Relaxed) {
-                        Err("interrupted".to_string())
+                        Err(INTERRUPTED.to_string())
                     } else {
-                        evaluate_text(text, file)
+                        stoppable(asks(&stop), || evaluate_text(text, file))
                     }
                 })
                 .collect()

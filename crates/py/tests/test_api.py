@@ -245,6 +245,41 @@ def test_ctrl_c_stops_an_evaluation_of_many_genomes(root, ctrl_c):
     assert np.array_equal(animats.evaluate(scene, few, threads=1), want)
 
 
+def test_ctrl_c_stops_one_long_evaluation_within_it(root, tmp_path, ctrl_c, cli):
+    # One walker for 80,000 simulated seconds (about two minutes of steps):
+    # Ctrl-C 0.3 s in ends the evaluations under way, not only those not yet
+    # begun, from `evaluate` (one genome on the global pool, one on a pool
+    # of its own, fewer genomes than its threads) and `evaluate_scenes`.
+    # (A few genomes on the global pool, up to its threads, are not
+    # watched: docs/PYTHON.md.)
+    text = (root / "scenes" / "walker.toml").read_text()
+    assert "[evolve]\ncontroller = \"gait\"\nduration = 10.0\n" in text
+    long = text.replace(
+        "[evolve]\ncontroller = \"gait\"\nduration = 10.0\n",
+        "[evolve]\ncontroller = \"gait\"\nduration = 80000.0\n",
+    ).replace('fail_on_touch = ["hip_f", "hip_b"]\n', "")
+    assert "fail_on_touch" not in long
+    path = tmp_path / "long_walker.toml"
+    path.write_text(long)
+    scene = animats.load(path)
+    one = scene.start()[None, :]
+    for call in (
+        lambda: animats.evaluate(scene, one),  # on the calling thread
+        lambda: animats.evaluate(scene, one, threads=1),  # on a pool of its own
+        lambda: animats.evaluate(scene, np.tile(one, (3, 1)), threads=4),
+        lambda: animats.evaluate_scenes([long]),
+    ):
+        began = time.monotonic()
+        with ctrl_c(0.3), pytest.raises(KeyboardInterrupt):
+            call()
+        assert time.monotonic() - began < 3.0
+    # Nothing lingers: a whole evaluation afterwards is the command line's.
+    walker = root / "scenes" / "walker.toml"
+    short = animats.load(walker)
+    one = animats.evaluate(short, short.start()[None, :], threads=1)
+    assert one[0] == json.loads(cli("evaluate", walker, "--json"))["fitness"]
+
+
 def test_ask_and_tell_elsewhere_equal_run_here(crawler):
     here = animats.Evolution(str(crawler), lanes=2, generations=5, seed=2, optimiser="ga")
     here.run()

@@ -26,7 +26,9 @@ use animats_creatures::brain::GenomeKey;
 use animats_creatures::sensors::probe::TOUCH_TOLERANCE;
 use animats_creatures::NervousSystem;
 use animats_engine::{DVec3, ParticleId, Shown, World};
+use std::cell::RefCell;
 use std::fmt;
+use std::rc::Rc;
 
 /// The longest evaluation, s (a simulated day).
 pub const MAX_DURATION: f64 = 86_400.0;
@@ -492,6 +494,49 @@ pub struct Evaluation {
     pub terms: Vec<f64>,
 }
 
+/// What an evaluation stopped by [`stoppable`]'s flag returns as its error.
+pub const INTERRUPTED: &str = "interrupted";
+
+/// Steps between two looks at [`stoppable`]'s flag.
+const STOP_EVERY: u64 = 256;
+
+thread_local! {
+    /// What the evaluations on this thread ask whether to stop ([`stoppable`]).
+    static STOP: RefCell<Option<Rc<dyn Fn() -> bool>>> = const { RefCell::new(None) };
+}
+
+/// Runs `f` with every evaluation it makes on this thread asking `stop`
+/// every 256 steps whether to stop: once it says yes, the evaluation ends
+/// with the error [`INTERRUPTED`] (Python's Ctrl-C during one long
+/// evaluation). An evaluation never stopped gives the same bits as
+/// without. Evaluations of a scene's trials that run on other threads of
+/// the pool do not ask; nor does anything outside `f` (an evolution, which
+/// must stand at whole generations, never calls this).
+pub fn stoppable<T>(stop: Rc<dyn Fn() -> bool>, f: impl FnOnce() -> T) -> T {
+    /// Puts the thread's earlier question back, even if `f` panics.
+    struct Restore(Option<Rc<dyn Fn() -> bool>>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            let earlier = self.0.take();
+            STOP.with(|s| *s.borrow_mut() = earlier);
+        }
+    }
+    let _restore = Restore(STOP.with(|s| s.replace(Some(stop))));
+    f()
+}
+
+/// Whether this thread's [`stoppable`] question says stop. (Asked with
+/// the thread's cell released: the question may run Python, which may
+/// evaluate again.) Out of line and cold: inlined and asked with a test
+/// of the step count in every step, it cost the roobot's evaluation 2.4 %
+/// (1.605 -> 1.644 ms).
+#[cold]
+#[inline(never)]
+fn stop_asked() -> bool {
+    let stop = STOP.with(|s| s.borrow().clone());
+    stop.is_some_and(|f| f())
+}
+
 /// Runs `scene`'s `[evolve]` evaluation; `observe` sees the scene before
 /// the first step and after every step.
 pub fn evaluate_with(
@@ -525,34 +570,42 @@ pub fn evaluate_with(
     if let Some(end) = spec.ending(&scene.world) {
         ended = end;
     } else {
-        while done < steps {
-            if let Some(w) = &mut work {
-                w.before(&scene);
+        // In runs of `STOP_EVERY` steps, asking between them whether to
+        // stop: no test in the step's own loop.
+        'run: while done < steps {
+            if stop_asked() {
+                return Err(INTERRUPTED.into());
             }
-            if scene.step(dt).is_err() {
-                ended = Ended::BlowUp;
-                break;
-            }
-            if let Some(w) = &mut work {
-                w.after(&scene, dt);
-            }
-            done += 1;
-            observe(&scene);
-            if let Some(r) = &mut recorder {
-                r.step(&scene.world);
-            }
-            if let Some(r) = &mut terms {
-                r.step(&scene.world);
-            }
-            let c = spec.centre(&scene.world);
-            if !c.is_finite() {
-                ended = Ended::BlowUp;
-                break;
-            }
-            last = c;
-            if let Some(end) = spec.ending(&scene.world) {
-                ended = end;
-                break;
+            let until = steps.min(done + STOP_EVERY);
+            while done < until {
+                if let Some(w) = &mut work {
+                    w.before(&scene);
+                }
+                if scene.step(dt).is_err() {
+                    ended = Ended::BlowUp;
+                    break 'run;
+                }
+                if let Some(w) = &mut work {
+                    w.after(&scene, dt);
+                }
+                done += 1;
+                observe(&scene);
+                if let Some(r) = &mut recorder {
+                    r.step(&scene.world);
+                }
+                if let Some(r) = &mut terms {
+                    r.step(&scene.world);
+                }
+                let c = spec.centre(&scene.world);
+                if !c.is_finite() {
+                    ended = Ended::BlowUp;
+                    break 'run;
+                }
+                last = c;
+                if let Some(end) = spec.ending(&scene.world) {
+                    ended = end;
+                    break 'run;
+                }
             }
         }
     }
