@@ -209,10 +209,9 @@ pub(crate) fn outcomes(
             .collect::<Result<Vec<_>, _>>()
     };
     // A few genomes (no more than threads) on the global pool: one
-    // evaluation's time, not worth the watch for Ctrl-C (it took one
-    // roobot genome 268 -> 285 us a call on an AMD EPYC, 264 -> 375 us on
-    // an Intel Xeon). A pool of the call's own (`threads`) costs more to
-    // make than the watch.
+    // evaluation's time, not worth the watch for Ctrl-C (which took one
+    // roobot genome 264 -> 375 us a call on a 2-core Intel Xeon). A pool of
+    // the call's own (`threads`) costs more to make than the watch.
     if pool.is_none() && rows.len() <= rayon::current_num_threads() {
         return py.detach(|| on(pool, work)).map_err(runtime_error);
     }

@@ -494,10 +494,10 @@ pub struct Evaluation {
     pub terms: Vec<f64>,
 }
 
-/// What an evaluation stopped by [`stoppable`]'s flag returns as its error.
+/// What an evaluation stopped under [`stoppable`] returns as its error.
 pub const INTERRUPTED: &str = "interrupted";
 
-/// Steps between two looks at [`stoppable`]'s flag.
+/// Steps between two of [`stoppable`]'s questions.
 const STOP_EVERY: u64 = 256;
 
 thread_local! {
