@@ -506,18 +506,7 @@ fn outcomes_the_archive_refuses_leave_the_run_as_it_was() {
     let text = format!(
         "{GRAPH}[archive]\nmeasures = [{{ kind = \"size\" }}, {{ kind = \"feet\" }}]\nbins = [4, 4]\nranges = [[0.0, 0.4], [0.0, 8.0]]\n"
     );
-    let spec = ProblemSpec {
-        file: "bodies.toml".into(),
-        text,
-    };
-    let choices = Choices {
-        generations: Some(3),
-        population: Some(4),
-        seed: Some(5),
-        optimiser: Some(animats_evolve::OptimiserKind::MapElites),
-        ..Choices::default()
-    };
-    let config = Config::new(spec, &choices).unwrap();
+    let config = map_elites(&text, 3);
     let mut never = State::new(config.clone()).unwrap();
     pool(1).install(|| never.advance(3)).unwrap();
     let problem = config.problem.build().unwrap();
