@@ -111,8 +111,8 @@ pub const MAX_HALVINGS: u32 = 4;
 
 /// The largest magnitude of a fitness weight (`distance_weight`,
 /// `time_weight`, `energy_weight`, `target_weight`, each term's `weight`):
-/// beyond it a weight times a distance or a day's time can overflow the
-/// fitness to infinity, where the optimisers cannot rank.
+/// far above any useful weight, and far below those (10³⁰⁸) that made
+/// every fitness infinite, which no optimiser can rank.
 pub const MAX_WEIGHT: f64 = 1e12;
 
 /// `x` as a fitness weight: finite and at most [`MAX_WEIGHT`] in magnitude.
