@@ -143,7 +143,10 @@ fn a_rock_box_inside_out_or_without_a_finite_width_is_refused() {
             "to = [0, 0, 0]",
             "along y, within a finite width: from 0.2, to 0",
         ),
-        ("from = [-1e308, 0, 0]\nto = [1e308, 1, 1]", "along x"),
+        (
+            "from = [-1e308, 0, 0]\nto = [1e308, 1, 1]",
+            "along x, within a finite width: from -1e308, to 1e308",
+        ),
     ] {
         let e = rocks(box_).map(|_| ()).unwrap_err().to_string();
         println!("{e}");

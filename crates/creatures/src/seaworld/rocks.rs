@@ -5,7 +5,7 @@
 //! [−0.5, 0.5] and y in [0.2, 1.2].
 
 use crate::random::Random;
-use animats_engine::{DVec3, ModelError, ParticleDef, ParticleId, World};
+use animats_engine::{DVec3, ModelError, ParticleDef, ParticleId, Shown, World};
 
 /// How to scatter rocks.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -49,7 +49,7 @@ pub fn scatter(
     if !(c.density > 0.0 && c.density.is_finite()) {
         return Err(ModelError::new(
             "density",
-            format!("must be > 0, got {}", c.density),
+            format!("must be > 0, got {}", Shown(c.density)),
         ));
     }
     for (axis, a, z) in [
@@ -62,7 +62,11 @@ pub fn scatter(
         if !(a <= z && (z - a).is_finite()) {
             return Err(ModelError::new(
                 "to",
-                format!("must be at or beyond `from` along {axis}, within a finite width: from {a}, to {z}"),
+                format!(
+                    "must be at or beyond `from` along {axis}, within a finite width: from {}, to {}",
+                    Shown(a),
+                    Shown(z)
+                ),
             ));
         }
     }
