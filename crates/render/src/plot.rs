@@ -64,18 +64,24 @@ pub fn step_plot_png(plot: &Plot) -> Result<Vec<u8>, String> {
         // Points that cannot be placed (NaN, infinite, beyond ±10³⁰⁰, where
         // the axis's padding would overflow) are left out: a fitness of
         // `inf` from a scene's weights must not make the axes infinite.
-        let placed = |&&(x, y): &&(f64, f64)| x.is_finite() && y.is_finite() && y.abs() <= 1e300;
-        let pts = plot
+        let placed: Vec<Vec<(f64, f64)>> = plot
             .series
             .iter()
-            .flat_map(|s| s.points.iter().filter(placed));
+            .map(|s| {
+                s.points
+                    .iter()
+                    .copied()
+                    .filter(|&(x, y)| x.is_finite() && y.is_finite() && y.abs() <= 1e300)
+                    .collect()
+            })
+            .collect();
         let (mut x0, mut x1, mut y0, mut y1) = (
             f64::INFINITY,
             f64::NEG_INFINITY,
             f64::INFINITY,
             f64::NEG_INFINITY,
         );
-        for &(x, y) in pts {
+        for &(x, y) in placed.iter().flatten() {
             x0 = x0.min(x);
             x1 = x1.max(x);
             y0 = y0.min(y);
@@ -108,10 +114,9 @@ pub fn step_plot_png(plot: &Plot) -> Result<Vec<u8>, String> {
             .axis_desc_style(("sans-serif", 16))
             .draw()
             .map_err(|e| e.to_string())?;
-        for (i, s) in plot.series.iter().enumerate() {
+        for (i, (s, points)) in plot.series.iter().zip(&placed).enumerate() {
             let colour = COLOURS[i % COLOURS.len()];
-            let mut steps = Vec::with_capacity(2 * s.points.len());
-            let points: Vec<(f64, f64)> = s.points.iter().filter(placed).copied().collect();
+            let mut steps = Vec::with_capacity(2 * points.len());
             for (k, &(x, y)) in points.iter().enumerate() {
                 if k > 0 {
                     steps.push((x, points[k - 1].1));
