@@ -709,7 +709,7 @@ impl State {
 
     /// Takes the outcomes of `generation`'s genomes, in the order of
     /// [`Generation::genomes`].
-    pub fn tell(&mut self, generation: Generation, outcomes: &[Outcome]) -> Result<(), String> {
+    pub fn tell(&mut self, generation: &Generation, outcomes: &[Outcome]) -> Result<(), String> {
         let asked = generation.len();
         if outcomes.len() != asked {
             return Err(format!(
@@ -720,8 +720,8 @@ impl State {
         let problem = self.bodies()?;
         let mut rows = Vec::with_capacity(generation.lanes.len());
         let mut at = 0;
-        for (lane, population) in generation.lanes {
-            let n = population.len();
+        for (lane, population) in &generation.lanes {
+            let (lane, n) = (*lane, population.len());
             let l = self
                 .lanes
                 .get_mut(lane)
@@ -1139,7 +1139,7 @@ fn advance_lane(
             })?,
         };
         let began = std::time::Instant::now();
-        rows.push(record(lane, Some(problem), population, &outcomes)?);
+        rows.push(record(lane, Some(problem), &population, &outcomes)?);
         if let Some(t) = tracer {
             t.done(k, g, Piece::Tell, began);
         }
@@ -1385,8 +1385,7 @@ impl<'a> Overlapped<'a> {
                 })
                 .collect();
             let began = std::time::Instant::now();
-            let row =
-                outcomes.and_then(|o| record(lane, Some(self.problem), f.population.clone(), &o));
+            let row = outcomes.and_then(|o| record(lane, Some(self.problem), &f.population, &o));
             let row = match row {
                 Ok(row) => row,
                 Err(e) => {
@@ -1516,7 +1515,7 @@ fn longest_first(
 fn record(
     lane: &mut Lane,
     problem: Option<&dyn Problem>,
-    population: Vec<Vec<f64>>,
+    population: &[Vec<f64>],
     outcomes: &[Outcome],
 ) -> Result<LogRow, String> {
     if population.is_empty() || population.len() != outcomes.len() {

@@ -204,7 +204,7 @@ fn a_body_run_is_the_same_on_any_thread_count_and_after_a_checkpoint() {
             .enumerate()
             .map(|(i, x)| problem.evaluate_screened(x, g.screen(i)).unwrap())
             .collect();
-        s.tell(g, &outcomes).unwrap();
+        s.tell(&g, &outcomes).unwrap();
     }
     assert_eq!(s.log_csv(), one.log_csv());
 }
@@ -451,7 +451,7 @@ fn overlapped_generations_are_one_run_on_any_threads_and_paths() {
             .enumerate()
             .map(|(i, x)| problem.evaluate_screened(x, g.screen(i)).unwrap())
             .collect();
-        s.tell(g, &outcomes).unwrap();
+        s.tell(&g, &outcomes).unwrap();
     }
     assert_eq!(s, one);
     // Not the run without overlap.
@@ -521,10 +521,10 @@ fn outcomes_the_archive_refuses_leave_the_run_as_it_was() {
         let mut bad = outcomes.clone();
         bad.last_mut().unwrap().measures.pop();
         let before = s.clone();
-        let e = s.tell(g.clone(), &bad).unwrap_err();
+        let e = s.tell(&g, &bad).unwrap_err();
         assert!(e.contains("1 measures told, the archive has 2"), "{e}");
         assert_eq!(s, before, "a refused generation moved the run");
-        s.tell(g, &outcomes).unwrap();
+        s.tell(&g, &outcomes).unwrap();
     }
     assert_eq!(s.log_csv(), never.log_csv());
     assert_eq!(s, never);

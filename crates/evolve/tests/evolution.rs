@@ -247,7 +247,7 @@ fn external(config: Config, reverse: bool) -> State {
             outcomes[i] = Some(problem.evaluate(genomes[i]).unwrap());
         }
         let outcomes: Vec<_> = outcomes.into_iter().map(Option::unwrap).collect();
-        s.tell(g, &outcomes).unwrap();
+        s.tell(&g, &outcomes).unwrap();
     }
     s
 }
@@ -280,7 +280,7 @@ fn a_run_evaluated_elsewhere_equals_one_advanced_here() {
     // Outcomes of the wrong count are refused.
     let mut s = State::new(a.config.clone()).unwrap();
     let g = s.ask().unwrap();
-    assert!(s.tell(g, &[]).is_err());
+    assert!(s.tell(&g, &[]).is_err());
 }
 
 /// The roobot's problem, counting and recording its evaluations, failing

@@ -407,7 +407,7 @@ impl Evolution {
             )));
         }
         // Outcomes refused leave the generation asked, to be told again.
-        me.state.tell(g.clone(), &o).map_err(value_error)?;
+        me.state.tell(g, &o).map_err(value_error)?;
         me.pending = None;
         self.sync(&me.state);
         Ok(())
