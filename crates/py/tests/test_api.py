@@ -248,10 +248,9 @@ def test_ctrl_c_stops_an_evaluation_of_many_genomes(root, ctrl_c):
 def test_ctrl_c_stops_one_long_evaluation_within_it(root, tmp_path, ctrl_c, cli):
     # One walker for 80,000 simulated seconds (about two minutes of steps):
     # Ctrl-C 0.3 s in ends the evaluations under way, not only those not yet
-    # begun, from `evaluate` (one genome on the global pool, one on a pool
-    # of its own, fewer genomes than its threads) and `evaluate_scenes`.
-    # (A few genomes on the global pool, up to its threads, are not
-    # watched: docs/PYTHON.md.)
+    # begun, from `evaluate` (one genome on the global pool, two there, one
+    # on a pool of its own, fewer genomes than its threads) and
+    # `evaluate_scenes`.
     text = (root / "scenes" / "walker.toml").read_text()
     assert "[evolve]\ncontroller = \"gait\"\nduration = 10.0\n" in text
     long = text.replace(
@@ -265,6 +264,7 @@ def test_ctrl_c_stops_one_long_evaluation_within_it(root, tmp_path, ctrl_c, cli)
     one = scene.start()[None, :]
     for call in (
         lambda: animats.evaluate(scene, one),  # on the calling thread
+        lambda: animats.evaluate(scene, np.tile(one, (2, 1))),  # the global pool
         lambda: animats.evaluate(scene, one, threads=1),  # on a pool of its own
         lambda: animats.evaluate(scene, np.tile(one, (3, 1)), threads=4),
         lambda: animats.evaluate_scenes([long]),
