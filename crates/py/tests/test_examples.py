@@ -92,3 +92,23 @@ def test_the_pyribs_example_fills_the_scenes_grid_with_hopping_gaits(tmp_path):
         assert "no heat map" in out
     else:
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_ray_example_writes_the_log_of_the_command_it_names(tmp_path):
+    pytest.importorskip("ray")
+    # Run from a folder of its own (it reads `scenes/walker.toml` and
+    # writes `walker-ray/` where it starts), as from the repository root.
+    (tmp_path / "scenes").symlink_to(ROOT / "scenes")
+    out = run_example("ray_evolve.py", cwd=tmp_path)
+    evaluations = number(r"(\d+) evaluations in [\d.]+ s on 2 actors \(0 shares retried\)", out)
+    best = number(r"; best ([-\d.]+)", out)
+    named = ("the same as: animats evolve scenes/walker.toml --optimiser cma-es "
+             "--generations 50 --lanes 2 --seed 1 --out walker-cli")
+    assert named in out, out
+    # That run, here (whose log is the command line's: test_api.py).
+    run = animats.Evolution(str(ROOT / "scenes" / "walker.toml"), optimiser="cma-es",
+                            generations=50, lanes=2, seed=1)
+    run.run()
+    assert (tmp_path / "walker-ray" / "log.csv").read_text() == run.log_csv()
+    assert evaluations == run.evaluations
+    assert best == pytest.approx(run.best_fitness, abs=5e-4)
