@@ -628,11 +628,40 @@ impl State {
         more: &(dyn Fn() -> bool + Sync),
         seen: Option<&(dyn Fn(&LogRow) + Sync)>,
     ) -> Result<(), String> {
+        let goals: Vec<u64> = self
+            .lanes
+            .iter()
+            .map(|l| l.generation.saturating_add(generations))
+            .collect();
+        self.advance_towards(problem, &goals, tracer, more, seen)
+    }
+
+    /// [`State::advance_by_while`] with each lane's own goal: lane `k`
+    /// towards generation `goals[k]` (never past the configured total),
+    /// each lane not there by at least one generation, then on while
+    /// `more()` says so. Python's `Evolution.run` saves a checkpoint
+    /// between these, towards the goals it set at its start.
+    pub fn advance_towards(
+        &mut self,
+        problem: &dyn Problem,
+        goals: &[u64],
+        tracer: Option<&crate::schedule::Tracer>,
+        more: &(dyn Fn() -> bool + Sync),
+        seen: Option<&(dyn Fn(&LogRow) + Sync)>,
+    ) -> Result<(), String> {
+        if goals.len() != self.lanes.len() {
+            return Err(format!(
+                "{} goals for {} lanes",
+                goals.len(),
+                self.lanes.len()
+            ));
+        }
         let target = self.config.generations;
         let todo: Vec<u64> = self
             .lanes
             .iter()
-            .map(|l| generations.min(target.saturating_sub(l.generation)))
+            .zip(goals)
+            .map(|(l, &g)| g.min(target).saturating_sub(l.generation))
             .collect();
         let rows = advance_lanes(&mut self.lanes, &todo, problem, tracer, more, seen)?;
         if let Some(t) = tracer {

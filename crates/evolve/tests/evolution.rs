@@ -408,6 +408,45 @@ fn lanes_that_never_wait_for_each_other_log_what_lanes_in_step_do() {
 }
 
 #[test]
+fn lanes_advanced_towards_goals_of_their_own_stop_there_and_log_the_same() {
+    // Python's `Evolution.run(generations=n, checkpoint=...)`: each lane
+    // towards its own goal, in stretches of one generation a lane, the
+    // lanes uneven between them.
+    let config = Config::thesis(3, 30, 7);
+    let together = run(config.clone(), 1, 30);
+    let problem = config.problem.build().unwrap();
+    let mut s = State::new(config).unwrap();
+    let taken = AtomicU64::new(0);
+    let more = || taken.fetch_add(1, Ordering::SeqCst) < 4;
+    pool(2)
+        .install(|| s.advance_towards(problem.as_ref(), &[30, 30, 30], None, &more, None))
+        .unwrap();
+    let uneven: Vec<u64> = s.lanes.iter().map(|l| l.generation).collect();
+    assert_eq!(uneven.iter().sum::<u64>(), 3 + 4, "{uneven:?}");
+    let goals: Vec<u64> = uneven.iter().map(|g| g + 5).collect();
+    for _ in 0..20 {
+        pool(2)
+            .install(|| s.advance_towards(problem.as_ref(), &goals, None, &|| false, None))
+            .unwrap();
+    }
+    let at: Vec<u64> = s.lanes.iter().map(|l| l.generation).collect();
+    assert_eq!(at, goals, "each lane stops at its goal");
+    // Goals past the total stop at it.
+    while !s.done() {
+        pool(2)
+            .install(|| s.advance_towards(problem.as_ref(), &[99, 99, 99], None, &|| true, None))
+            .unwrap();
+    }
+    assert!(s.lanes.iter().all(|l| l.generation == 30));
+    assert_eq!(s.log_csv(), together.log_csv());
+    assert_eq!(s.best_toml(), together.best_toml());
+    let err = s
+        .advance_towards(problem.as_ref(), &[1, 2], None, &|| true, None)
+        .unwrap_err();
+    assert!(err.contains("2 goals for 3 lanes"), "{err}");
+}
+
+#[test]
 fn a_runs_defaults_and_checks_are_the_librarys() {
     use animats_evolve::optimiser::OptimiserKind;
     use animats_evolve::{Choices, LogMode, ProblemSpec};

@@ -17,6 +17,9 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
+/// The checkpoint's name in a run's directory, as `animats evolve` names it.
+const CHECKPOINT: &str = "checkpoint.json";
+
 fn kind(name: &str) -> PyResult<OptimiserKind> {
     OptimiserKind::parse(name).map_err(value_error)
 }
@@ -457,14 +460,27 @@ impl Evolution {
     /// to the end) here, in parallel, the GIL released. Ctrl-C stops it
     /// (`KeyboardInterrupt`) once each thread's generation in flight
     /// ends: the run stands at whole generations, and `run()` goes on to
-    /// the same results as a run never stopped.
-    #[pyo3(signature = (generations = None, threads = None))]
+    /// the same results as a run never stopped. With `checkpoint` (a
+    /// directory), the run is saved there as `save` saves it, as `animats
+    /// evolve` does: every `checkpoint_every` seconds (all lanes stopping
+    /// at whole generations for it), on Ctrl-C and at the end, so that
+    /// `Evolution.resume(checkpoint)` goes on from the last save.
+    #[pyo3(signature = (generations = None, threads = None, *, checkpoint = None, checkpoint_every = 5.0))]
     fn run(
         &self,
         py: Python<'_>,
         generations: Option<u64>,
         threads: Option<usize>,
+        checkpoint: Option<PathBuf>,
+        checkpoint_every: f64,
     ) -> PyResult<()> {
+        if checkpoint_every.is_nan() || checkpoint_every < 0.0 {
+            return Err(value_error(format!(
+                "checkpoint_every must be at least 0 seconds, got {checkpoint_every}"
+            )));
+        }
+        let every = std::time::Duration::try_from_secs_f64(checkpoint_every)
+            .unwrap_or(std::time::Duration::MAX);
         let mut guard = self.lock()?;
         if guard.pending.is_some() {
             return Err(value_error(
@@ -475,8 +491,20 @@ impl Evolution {
         let n = generations.unwrap_or(guard.state.config.generations);
         let Inner { state, problem, .. } = &mut *guard;
         let problem = problem.as_ref();
+        // Each lane's goal, kept across the stretches between saves.
+        let goals: Vec<u64> = state
+            .lanes
+            .iter()
+            .map(|l| l.generation.saturating_add(n))
+            .collect();
+        let reached = |state: &State| {
+            state
+                .lanes
+                .iter()
+                .zip(&goals)
+                .all(|(l, &g)| l.generation >= g.min(state.config.generations))
+        };
         let stop = std::sync::atomic::AtomicBool::new(false);
-        let more = || !stop.load(std::sync::atomic::Ordering::Relaxed);
         let progress = &self.progress;
         let seen = |row: &animats_evolve::run::LogRow| {
             if let Ok(mut p) = progress.lock() {
@@ -489,11 +517,25 @@ impl Evolution {
                 }
             }
         };
-        let ran = crate::interruptible(py, &pool, &stop, || {
-            state.advance_by_while(problem, n, None, &more, Some(&seen))
-        });
-        self.sync(state);
-        ran?.map_err(runtime_error)
+        loop {
+            let begun = std::time::Instant::now();
+            let more = || {
+                !stop.load(std::sync::atomic::Ordering::Relaxed)
+                    && (checkpoint.is_none() || begun.elapsed() < every)
+            };
+            let ran = crate::interruptible(py, &pool, &stop, || {
+                state.advance_towards(problem, &goals, None, &more, Some(&seen))
+            });
+            self.sync(state);
+            // (After Ctrl-C too: the run stands at whole generations.)
+            if let Some(dir) = &checkpoint {
+                save_files(state, dir)?;
+            }
+            ran?.map_err(runtime_error)?;
+            if reached(state) {
+                return Ok(());
+            }
+        }
     }
 
     /// True when every lane has done its generations.
@@ -641,24 +683,88 @@ impl Evolution {
         Ok(Some(d))
     }
 
-    /// Writes `log.csv` and `best.toml` into `directory` (created if
-    /// needed), each file whole or not at all.
+    /// Writes `log.csv`, `best.toml` and a quality-diversity run's
+    /// `archive.csv` into `directory` (created if needed), then
+    /// `checkpoint.json`, each file whole or not at all, as `animats
+    /// evolve` writes them: `Evolution.resume(directory)` or `animats
+    /// evolve --resume directory` continue the run from there to the same
+    /// bits as a run never stopped. Refused while a generation is asked
+    /// and not yet told.
     fn save(&self, directory: PathBuf) -> PyResult<()> {
-        std::fs::create_dir_all(&directory).map_err(|e| {
-            pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", directory.display()))
-        })?;
-        let io = |e: std::io::Error| pyo3::exceptions::PyOSError::new_err(e.to_string());
-        animats_files::write_atomically(&directory.join("log.csv"), self.log_csv()?.as_bytes())
-            .map_err(|e| io(std::io::Error::other(e.to_string())))?;
-        if let Some(b) = self.best_toml()? {
-            animats_files::write_atomically(&directory.join("best.toml"), b.as_bytes())
-                .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        let me = self.lock()?;
+        if me.pending.is_some() {
+            return Err(value_error(
+                "tell the outcomes of the last generation first: a run is saved between generations",
+            ));
         }
-        // A quality-diversity run: its archive, as `animats evolve` writes it.
-        if let Some(csv) = self.lock()?.state.archive_csv() {
-            animats_files::write_atomically(&directory.join("archive.csv"), csv.as_bytes())
-                .map_err(|e| io(std::io::Error::other(e.to_string())))?;
-        }
-        Ok(())
+        save_files(&me.state, &directory)
     }
+
+    /// The run saved in `directory` (its `checkpoint.json`, written by
+    /// `save` or by `animats evolve`), to go on with `run()` or
+    /// `ask()`/`tell()`: it keeps its scene, optimiser, lanes and seed;
+    /// `generations` may raise its total (never below those done).
+    #[staticmethod]
+    #[pyo3(signature = (directory, *, generations = None, device = "cpu"))]
+    fn resume(directory: PathBuf, generations: Option<u64>, device: &str) -> PyResult<Evolution> {
+        if let Some(g) = generations {
+            if !(1..=100_000_000).contains(&g) {
+                return Err(value_error("generations must be between 1 and 100000000"));
+            }
+        }
+        let path = directory.join(CHECKPOINT);
+        if !path.exists() {
+            return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!(
+                "{}: no checkpoint here (`Evolution.save` or `animats evolve` writes one)",
+                path.display()
+            )));
+        }
+        let mut state = animats_evolve::checkpoint::load(&path).map_err(value_error)?;
+        let choices = Choices {
+            generations,
+            ..Choices::default()
+        };
+        state
+            .resume(&choices)
+            .map_err(|e| value_error(format!("{}: {e}", directory.display())))?;
+        let batches = crate::evaluate::device_batches(device)?;
+        let problem = state
+            .config
+            .problem
+            .build_on(batches)
+            .map_err(crate::scene_error)?;
+        Ok(Evolution {
+            progress: Mutex::new(progress_of(&state)),
+            generations: state.config.generations,
+            inner: Mutex::new(Inner {
+                state,
+                problem,
+                pending: None,
+            }),
+        })
+    }
+}
+
+/// `state`'s files in `directory` (created if needed), as `animats evolve`
+/// writes them: log.csv, best.toml, an archive's archive.csv, then the
+/// checkpoint, each whole or not at all.
+fn save_files(state: &State, directory: &std::path::Path) -> PyResult<()> {
+    std::fs::create_dir_all(directory).map_err(|e| {
+        pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", directory.display()))
+    })?;
+    let write = |name: &str, bytes: &[u8]| {
+        animats_files::write_atomically(&directory.join(name), bytes)
+            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
+    };
+    write("log.csv", state.log_csv().as_bytes())?;
+    if let Some(b) = state.best_toml().map_err(runtime_error)? {
+        write("best.toml", b.as_bytes())?;
+    }
+    if let Some(csv) = state.archive_csv() {
+        write("archive.csv", csv.as_bytes())?;
+    }
+    // Last: a checkpoint on disk never stands for more than the files
+    // beside it.
+    let checkpoint = animats_evolve::checkpoint::encode(state).map_err(runtime_error)?;
+    write(CHECKPOINT, checkpoint.as_bytes())
 }

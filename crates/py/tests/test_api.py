@@ -280,6 +280,95 @@ def test_ctrl_c_stops_one_long_evaluation_within_it(root, tmp_path, ctrl_c, cli)
     assert one[0] == json.loads(cli("evaluate", walker, "--json"))["fitness"]
 
 
+def test_a_saved_run_resumes_to_the_same_bits_here_and_on_the_command_line(cli, crawler, tmp_path):
+    args = dict(lanes=2, seed=5, optimiser="cma-es")
+    flags = ["--optimiser", "cma-es", "--lanes", 2, "--seed", 5]
+    straight = animats.Evolution(str(crawler), generations=6, **args)
+    straight.run()
+    cli("evolve", crawler, *flags, "--generations", 6, "--out", tmp_path / "cli6")
+    files = ("log.csv", "best.toml")
+    # Saved in Python after 3 generations, resumed in Python.
+    part = animats.Evolution(str(crawler), generations=6, **args)
+    part.run(generations=3)
+    part.save(tmp_path / "py")
+    again = animats.Evolution.resume(tmp_path / "py")
+    assert (again.generation, again.done, again.evaluations) == (3, False, part.evaluations)
+    assert again.config == part.config
+    again.run()
+    assert again.log_csv() == straight.log_csv()
+    again.save(tmp_path / "py")
+    for f in files:
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli6" / f).read_bytes(), f
+    # Saved by `run` itself, after every generation: the same run.
+    saving = animats.Evolution(str(crawler), generations=6, **args)
+    saving.run(checkpoint=tmp_path / "saving", checkpoint_every=0.0)
+    assert saving.log_csv() == straight.log_csv()
+    assert animats.Evolution.resume(tmp_path / "saving").done
+    with pytest.raises(ValueError, match="checkpoint_every"):
+        saving.run(checkpoint=tmp_path / "saving", checkpoint_every=float("nan"))
+    # Python's checkpoint continued by the command line.
+    part.save(tmp_path / "py3")
+    cli("evolve", "--resume", tmp_path / "py3", "--generations", 6)
+    for f in files:
+        assert (tmp_path / "py3" / f).read_bytes() == (tmp_path / "cli6" / f).read_bytes(), f
+    # The command line's checkpoint continued in Python, its total raised.
+    cli("evolve", crawler, *flags, "--generations", 3, "--out", tmp_path / "cli3")
+    there = animats.Evolution.resume(tmp_path / "cli3", generations=6)
+    assert there.generation == 3
+    there.run()
+    assert there.log_csv() == straight.log_csv()
+    # What is refused: fewer generations than done, no checkpoint, a
+    # damaged one, and a save between an ask and its tell.
+    with pytest.raises(ValueError, match="fewer than the 6 already done"):
+        animats.Evolution.resume(tmp_path / "py", generations=5)
+    with pytest.raises(FileNotFoundError, match="no checkpoint here"):
+        animats.Evolution.resume(tmp_path / "nowhere")
+    damaged = tmp_path / "damaged"
+    damaged.mkdir()
+    text = (tmp_path / "py3" / "checkpoint.json").read_text()
+    (damaged / "checkpoint.json").write_text(text.replace('"seed":5', '"seed":6', 1))
+    assert (damaged / "checkpoint.json").read_text() != text
+    with pytest.raises(ValueError, match="corrupt"):
+        animats.Evolution.resume(damaged)
+    asked = animats.Evolution.resume(tmp_path / "cli3", generations=6)
+    asked.ask()
+    with pytest.raises(ValueError, match="tell the outcomes"):
+        asked.save(tmp_path / "asked")
+    assert not (tmp_path / "asked" / "checkpoint.json").exists()
+
+
+def test_python_m_animats_evolve_stops_on_ctrl_c_and_resumes(cli, crawler, tmp_path):
+    import signal
+    import subprocess
+    import sys
+
+    args = ["--optimiser", "ga", "--lanes", "3", "--seed", "8"]
+    cmd = [sys.executable, "-m", "animats.evolve", str(crawler), *args, "--generations",
+           "100000000", "--no-check", "--out", str(tmp_path / "py")]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, (out, err)
+    m = re.search(r"interrupted at generation (\d+); continue with "
+                  r"`python -m animats.evolve --resume (.+)`", err)
+    assert m and m.group(2) == str(tmp_path / "py"), err
+    saved = animats.Evolution.resume(tmp_path / "py")
+    assert int(m.group(1)) == saved.generation > 0
+    total = saved.generation + 20
+    r = subprocess.run([sys.executable, "-m", "animats.evolve", "--resume", str(tmp_path / "py"),
+                        "--generations", str(total), "--no-check"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    cli("evolve", crawler, *args, "--generations", total, "--no-check", "--out", tmp_path / "cli")
+    for f in ("log.csv", "best.toml"):
+        assert (tmp_path / "py" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+    # A scene with --resume, or another seed, is refused.
+    for extra in ([str(crawler)], ["--seed", "9"]):
+        r = subprocess.run([sys.executable, "-m", "animats.evolve", *extra, "--resume",
+                            str(tmp_path / "py")], capture_output=True, text=True)
+        assert r.returncode != 0 and "keeps its" in r.stderr, r.stderr
+
+
 def test_ask_and_tell_elsewhere_equal_run_here(crawler):
     here = animats.Evolution(str(crawler), lanes=2, generations=5, seed=2, optimiser="ga")
     here.run()

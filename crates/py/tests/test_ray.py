@@ -71,6 +71,36 @@ def test_a_worker_killed_mid_generation_costs_time_not_results(cluster, cli, tmp
         assert (tmp_path / "ray" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
 
 
+def test_a_driver_that_dies_resumes_from_its_last_save_to_the_same_bits(cluster, cli, crawler, tmp_path):
+    flags = ["--optimiser", "cma-es", "--lanes", 2, "--seed", 3]
+    cli("evolve", crawler, *flags, "--generations", 7, "--out", tmp_path / "cli")
+    args = dict(optimiser="cma-es", lanes=2, seed=3, actors=2)
+
+    class Died(Exception):
+        pass
+
+    def die(generation, pool):
+        if generation == 5:
+            raise Died()
+
+    # Saved after every generation (checkpoint_every=0): the driver dies
+    # as generation 5's shares go out, and generation 4's save stands.
+    with pytest.raises(Died):
+        distributed.evolve(str(crawler), generations=7, out=tmp_path / "ray", on_generation=die,
+                           checkpoint_every=0, **args)
+    assert not (tmp_path / "ray" / "checked.toml").exists()
+    assert animats.Evolution.resume(tmp_path / "ray").generation == 4
+    # Choices the run was not made with are refused, as is a scene.
+    with pytest.raises(ValueError, match="keeps its seed"):
+        distributed.evolve(out=tmp_path / "ray", resume=True, seed=4)
+    with pytest.raises(ValueError, match="keeps its scene"):
+        distributed.evolve(str(crawler), out=tmp_path / "ray", resume=True)
+    run, stats = distributed.evolve(out=tmp_path / "ray", resume=True, **args)
+    assert stats.generations == 3 and run.generation == 7
+    for f in ("log.csv", "best.toml", "checked.toml"):
+        assert (tmp_path / "ray" / f).read_bytes() == (tmp_path / "cli" / f).read_bytes(), f
+
+
 def test_more_actors_than_cpus_are_refused_not_left_waiting(cluster):
     with pytest.raises(ValueError, match="CPUs"):
         distributed.Pool("roobot", actors=3)

@@ -261,15 +261,32 @@ def _problem_text(scene: Any) -> tuple:
     return (s.file, s.text)
 
 
+def _resumed(
+    out: Optional[str], generations: Optional[int], given: dict, device: str = "cpu"
+) -> "_animats.Evolution":
+    """The run saved in ``out``, refusing choices it was not made with."""
+    if out is None:
+        raise ValueError("resume=True continues the run saved in `out`: give `out`")
+    run = _animats.Evolution.resume(out, generations=generations, device=device)
+    config = run.config
+    for key, value in given.items():
+        if value is not None and value != config[key]:
+            raise ValueError(
+                f"{out}: a resumed run keeps its {key} ({config[key]}), got {value}; "
+                "give only the generations"
+            )
+    return run
+
+
 def evolve(
-    scene: Any = "roobot",
+    scene: Any = None,
     *,
-    generations: int = 100,
+    generations: Optional[int] = None,
     lanes: Optional[int] = None,
-    seed: int = 1,
+    seed: Optional[int] = None,
     optimiser: Optional[str] = None,
     population: Optional[int] = None,
-    restarts: int = 0,
+    restarts: Optional[int] = None,
     actors: int = 2,
     device: str = "cpu",
     address: Optional[str] = None,
@@ -277,14 +294,23 @@ def evolve(
     on_generation: Optional[Callable[[int, Pool], None]] = None,
     progress: bool = False,
     check: bool = True,
+    resume: bool = False,
+    checkpoint_every: float = 5.0,
 ) -> "tuple[_animats.Evolution, Stats]":
     """An ``animats evolve`` run whose evaluations are spread over Ray
-    actors; the same arguments and defaults, and the same ``log.csv``,
+    actors; the same arguments and defaults (``scene``: the roobot,
+    ``generations``: 100, ``seed``: 1, ``restarts``: 0), and the same ``log.csv``,
     ``best.toml`` and ``checked.toml`` (written into ``out`` if given: the
     winner checked at a quarter of the step where the driver runs, as
     ``animats evolve`` does at its end, the report in ``Stats.check``;
     ``check=False`` skips that, as ``--no-check``, and removes an earlier
-    ``checked.toml``). ``address``: the cluster
+    ``checked.toml``). With ``out``, the run is also saved there
+    (``Evolution.save``: ``checkpoint.json`` beside the log) after the
+    first generation that ends ``checkpoint_every`` seconds or more after
+    the last save, and at the end; ``resume=True`` continues the run saved
+    in ``out`` (a driver that died, or ``animats evolve --out``'s run) to
+    the same bits as one never stopped: it keeps its scene and choices,
+    and ``generations`` may raise its total. ``address``: the cluster
     (``"auto"`` on a machine that ran ``ray start``); without it, Ray starts
     a local one unless one is already initialised. ``device``: where the
     actors evaluate (``Pool``'s; on ``"cuda"`` the same bytes again).
@@ -292,30 +318,43 @@ def evolve(
     sent."""
     import ray
 
+    if not checkpoint_every >= 0.0:
+        raise ValueError(f"checkpoint_every must be at least 0 seconds, got {checkpoint_every}")
+    given = dict(lanes=lanes, seed=seed, optimiser=optimiser, population=population,
+                 restarts=restarts)
+    if resume:
+        if scene is not None:
+            raise ValueError("a resumed run keeps its scene: give `out` and `resume=True` only")
+        run = _resumed(out, generations, given)
+    else:
+        run = _animats.Evolution(
+            "roobot" if scene is None else scene,
+            lanes=lanes,
+            generations=100 if generations is None else generations,
+            seed=1 if seed is None else seed,
+            optimiser=optimiser,
+            population=population,
+            restarts=0 if restarts is None else restarts,
+        )
     if not ray.is_initialized():
         ray.init(address=address, log_to_driver=False)
-    run = _animats.Evolution(
-        scene,
-        lanes=lanes,
-        generations=generations,
-        seed=seed,
-        optimiser=optimiser,
-        population=population,
-        restarts=restarts,
-    )
     pool = Pool(problem_text=run.problem_text(), actors=actors, device=device)
     try:
-        last = time.monotonic()
+        last = saved = time.monotonic()
         while not run.done:
             g = run.generation + 1
             genomes, _ = run.ask()
             hook = None if on_generation is None else (lambda p, g=g: on_generation(g, p))
             run.tell(pool.outcomes(genomes, on_dispatch=hook, screens=run.screens()))
             pool.stats.generations += 1
+            if out is not None and not run.done and time.monotonic() - saved >= checkpoint_every:
+                run.save(out)
+                saved = time.monotonic()
             if progress and time.monotonic() - last > 5:
                 last = time.monotonic()
                 print(
-                    f"generation {run.generation}/{generations}, best {run.best_fitness}",
+                    f"generation {run.generation}/{run.config['generations']}, "
+                    f"best {run.best_fitness}",
                     flush=True,
                 )
         if out is not None:
