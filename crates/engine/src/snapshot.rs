@@ -2,7 +2,7 @@
 //! branching a run, and for the Python API's `snapshot` / `restore`.
 //!
 //! A snapshot holds everything that changes while a world runs: the clock,
-//! every particle's position, velocity, mass and volume, and the parameters
+//! every particle's position, velocity, mass, volume and radius, and the parameters
 //! that actuators and users drive (spring, angle-joint and torque-joint
 //! parameters, constant forces, gravity). It does not hold the world's
 //! structure (which particles, which forces join them, the integrator): it
@@ -38,8 +38,13 @@ pub struct Snapshot {
     pub velocities: Vec<[f64; 3]>,
     /// Masses, kg.
     pub masses: Vec<f64>,
-    /// Volumes, m³ (radii follow).
+    /// Volumes, m³.
     pub volumes: Vec<f64>,
+    /// Radii, m, as they were: a radius given with a particle is not the
+    /// cube root of its volume to the last bit. (Absent from snapshots
+    /// written before it was held: then each radius follows its volume.)
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub radii: Vec<f64>,
     /// Each spring's (stiffness, damping, rest length).
     pub springs: Vec<[f64; 3]>,
     /// Each angle joint's (stiffness, damping, rest angle).
@@ -83,6 +88,7 @@ impl World {
             velocities: self.state.vel.iter().map(|v| v.to_array()).collect(),
             masses: self.particles.mass.clone(),
             volumes: self.particles.volume.clone(),
+            radii: self.particles.radius.clone(),
             springs: f
                 .springs
                 .iter()
@@ -170,6 +176,12 @@ impl World {
         if let Some(x) = s.volumes.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
             return Err(ModelError::new("volumes", format!("must be >= 0, got {x}")));
         }
+        if !s.radii.is_empty() && s.radii.len() != n {
+            return Err(mismatch("radii", s.radii.len(), n));
+        }
+        if let Some(x) = s.radii.iter().find(|x| !(x.is_finite() && **x >= 0.0)) {
+            return Err(ModelError::new("radii", format!("must be >= 0, got {x}")));
+        }
         if let Some(k) = s
             .springs
             .iter()
@@ -220,7 +232,11 @@ impl World {
             p.mass[i] = s.masses[i];
             p.set_inv_mass(i, if p.fixed[i] { 0.0 } else { 1.0 / s.masses[i] });
             p.volume[i] = s.volumes[i];
-            p.radius[i] = sphere_radius(s.volumes[i]);
+            p.radius[i] = s
+                .radii
+                .get(i)
+                .copied()
+                .unwrap_or_else(|| sphere_radius(s.volumes[i]));
         }
         let f = &mut self.forces;
         for (k, q) in s.springs.iter().enumerate() {
