@@ -71,6 +71,12 @@ impl<T: Actuated> Actuator<T> {
         self.level
     }
 
+    /// Sets the level without touching the world: for a snapshot's
+    /// restore, whose world holds the value the level gave.
+    pub fn set_level_alone(&mut self, level: f64) {
+        self.level = crate::sensor::unit(level);
+    }
+
     /// The level the actuator started at.
     pub fn initial_level(&self) -> f64 {
         self.initial_level

@@ -30,6 +30,19 @@ pub trait Brain: Send {
         None
     }
 
+    /// Its own state as it runs (an FSM's current state, a recurrent
+    /// network's activations), for a scene's snapshot; `None` for a brain
+    /// whose outputs follow from its inputs and the time alone.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        None
+    }
+
+    /// Takes back a [`Brain::save_state`] of this brain (or of one built
+    /// the same way); the error says why not.
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        crate::kept::nothing(kept, &format!("a {} brain", self.kind()))
+    }
+
     /// The brain as itself, for code that reads a built-in kind's
     /// parameters (the GPU's packer reads a neural network's layers); a
     /// user's brain need not say.

@@ -43,4 +43,15 @@ pub trait Actor: Send {
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         None
     }
+    /// Its own state as it runs (a timer, a brain's state, a random
+    /// stream), for a scene's snapshot; `None` for an actor that keeps
+    /// none outside the world.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        None
+    }
+    /// Takes back an [`Actor::save_state`] of this actor (or of one built
+    /// the same way); the error says why not.
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        crate::kept::nothing(kept, "an actor")
+    }
 }

@@ -23,6 +23,7 @@ pub mod brains;
 pub mod controller;
 pub mod env;
 pub mod jellyfish;
+pub mod kept;
 pub mod nervous_system;
 pub mod quadruped;
 pub mod random;

@@ -210,6 +210,33 @@ impl NervousSystem {
         Ok(())
     }
 
+    /// Each controller's brain's own state ([`Brain::save_state`]), in
+    /// the scene's order.
+    pub fn brain_states(&self) -> Vec<Option<crate::kept::Kept>> {
+        self.controllers
+            .iter()
+            .map(|c| c.brain.save_state())
+            .collect()
+    }
+
+    /// Takes back [`NervousSystem::brain_states`]; the error names the
+    /// controller.
+    pub fn set_brain_states(&mut self, kept: &[Option<crate::kept::Kept>]) -> Result<(), String> {
+        if kept.len() != self.controllers.len() {
+            return Err(format!(
+                "the snapshot holds {} controllers' states for {} controllers",
+                kept.len(),
+                self.controllers.len()
+            ));
+        }
+        for (c, k) in self.controllers.iter_mut().zip(kept) {
+            c.brain
+                .load_state(k.as_ref())
+                .map_err(|e| format!("controller `{}`: {e}", c.name))?;
+        }
+        Ok(())
+    }
+
     fn read_sensors(&mut self, world: &World) {
         self.levels.clear();
         for (_, s) in &self.sensors {

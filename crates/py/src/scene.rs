@@ -275,8 +275,9 @@ pub struct World {
 }
 
 /// The state of a world at one instant (positions, velocities, the
-/// parameters actuators drive, actuator levels). Controllers' and
-/// creatures' own state (an FSM's current state) is not part of it.
+/// parameters actuators drive, actuator levels, and the controllers' and
+/// creatures' own state: an FSM's current state, a CTRNN's activations):
+/// restored, the world steps on as it did from there, bit for bit.
 #[pyclass(frozen, module = "animats")]
 pub struct Snapshot {
     inner: animats_scene::SceneSnapshot,

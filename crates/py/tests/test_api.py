@@ -61,15 +61,22 @@ def test_snapshot_and_restore_continue_bit_for_bit(root):
     snap = w.snapshot()
     w.step(500)
     a = w.positions()
+    va = w.velocities()
     w.restore(snap)
     assert w.time == snap.time
-    # The pogo's FSM keeps its own state (documented): drive it by hand.
-    w.set_actuators([0.5])
-    w.step(1)
+    # The pogo's FSM's own state is in the snapshot: it steps on alike.
+    w.step(500)
+    assert np.array_equal(w.positions(), a) and np.array_equal(w.velocities(), va)
     w.restore(snap)
     w2 = animats.load(root / "scenes" / "pogo.toml").world()
     w2.step(300)
     assert np.array_equal(w2.positions(), w.positions())
+    # Into a world of another scene: refused, and that world unchanged.
+    walker = animats.load(root / "scenes" / "walker.toml").world()
+    before = walker.positions()
+    with pytest.raises(ValueError, match="another world|snapshot holds"):
+        walker.restore(snap)
+    assert np.array_equal(walker.positions(), before)
 
 
 def test_a_pile_restored_goes_on_bit_for_bit_with_its_sleeping_rocks(root):

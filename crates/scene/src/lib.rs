@@ -143,12 +143,16 @@ pub struct Bell {
 }
 
 /// The state of a scene at one instant (see [`Scene::snapshot`]).
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct SceneSnapshot {
     /// The world's state.
     pub world: animats_engine::Snapshot,
     /// Each actuator's level, in the scene's order.
     pub levels: Vec<f64>,
+    /// Each controller's brain's own state, in the scene's order.
+    pub brains: Vec<Option<animats_creatures::kept::Kept>>,
+    /// Each creature's and other actor's own state, in the scene's order.
+    pub actors: Vec<Option<animats_creatures::kept::Kept>>,
 }
 
 /// Steps between the divergence guard's checks (it sums the energy).
@@ -216,22 +220,67 @@ impl Scene {
         self.advance(dt).map_err(|e| e.to_string())
     }
 
-    /// Everything that changes as the scene runs, but for its controllers'
-    /// and creatures' own state (an FSM's state, a timer): the world's
-    /// [`animats_engine::Snapshot`] and the actuators' levels.
+    /// Everything that changes as the scene runs: the world's
+    /// [`animats_engine::Snapshot`], the actuators' levels, and the
+    /// controllers' and creatures' own state (an FSM's state, a recurrent
+    /// network's activations, a timer, a random stream).
     pub fn snapshot(&self) -> SceneSnapshot {
         SceneSnapshot {
             world: self.world.snapshot(),
             levels: self.nervous.actuator_levels(),
+            brains: self.nervous.brain_states(),
+            actors: self.actors.iter().map(|a| a.save_state()).collect(),
         }
     }
 
     /// Puts back a [`Scene::snapshot`] of this scene (or of one built from
-    /// the same file).
+    /// the same file): it steps on as the scene did from there, bit for
+    /// bit. A snapshot of another scene is refused, and this one left as
+    /// it was.
     pub fn restore(&mut self, s: &SceneSnapshot) -> Result<(), String> {
+        if s.actors.len() != self.actors.len() {
+            return Err(format!(
+                "the snapshot holds {} creatures' and actors' states for {}",
+                s.actors.len(),
+                self.actors.len()
+            ));
+        }
+        if s.levels.len() != self.nervous.actuators.len() {
+            return Err(format!(
+                "the snapshot holds {} actuator levels for {} actuators",
+                s.levels.len(),
+                self.nervous.actuators.len()
+            ));
+        }
+        let before = self.world.snapshot();
+        // A world's restore changes nothing when it refuses.
+        self.world.restore(&s.world).map_err(|e| e.to_string())?;
+        if let Err(e) = self.restore_states(s) {
+            let _ = self.world.restore(&before);
+            return Err(e);
+        }
         self.nervous.set_levels(&mut self.world, &s.levels)?;
         // After the levels: the world's own values are the exact ones.
         self.world.restore(&s.world).map_err(|e| e.to_string())
+    }
+
+    /// The brains' and actors' states of `s`, all or none.
+    fn restore_states(&mut self, s: &SceneSnapshot) -> Result<(), String> {
+        let brains = self.nervous.brain_states();
+        let actors: Vec<_> = self.actors.iter().map(|a| a.save_state()).collect();
+        let mut load = |brains: &[_], actors: &[Option<animats_creatures::kept::Kept>]| {
+            self.nervous.set_brain_states(brains)?;
+            self.actors
+                .iter_mut()
+                .zip(actors)
+                .try_for_each(|(a, k)| a.load_state(k.as_ref()))
+        };
+        let done = load(&s.brains, &s.actors);
+        if done.is_err() {
+            // Their own states always fit.
+            let _ = load(&brains, &actors);
+        }
+        done
     }
 
     /// The state was set by hand (positions, velocities): the divergence

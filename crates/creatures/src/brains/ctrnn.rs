@@ -190,6 +190,24 @@ impl Brain for Ctrnn {
         "ctrnn"
     }
 
+    /// The neurons' states `y`.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new(self.state.clone()))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        let y: &Vec<f64> = crate::kept::required(kept, "a ctrnn brain")?;
+        if y.len() != self.state.len() {
+            return Err(format!(
+                "a ctrnn brain of {} neurons: the snapshot holds {}",
+                self.state.len(),
+                y.len()
+            ));
+        }
+        self.state.clone_from(y);
+        Ok(())
+    }
+
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
     }

@@ -330,9 +330,39 @@ impl Fsm {
     }
 }
 
+/// What an [`Fsm`] keeps in a snapshot: its state, when it entered it,
+/// its levels, whether it has begun.
+struct FsmKept {
+    current: usize,
+    entered: f64,
+    levels: Vec<f64>,
+    started: bool,
+}
+
 impl Brain for Fsm {
     fn kind(&self) -> &'static str {
         "fsm"
+    }
+
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new(FsmKept {
+            current: self.current,
+            entered: self.entered,
+            levels: self.levels.clone(),
+            started: self.started,
+        }))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        let k: &FsmKept = crate::kept::required(kept, "an fsm brain")?;
+        if k.current >= self.states.len() || k.levels.len() != self.levels.len() {
+            return Err("an fsm brain: the snapshot is of another machine".into());
+        }
+        self.current = k.current;
+        self.entered = k.entered;
+        self.levels.clone_from(&k.levels);
+        self.started = k.started;
+        Ok(())
     }
 
     fn as_any(&self) -> Option<&dyn std::any::Any> {

@@ -251,9 +251,40 @@ impl JellyfishFsm {
 /// dome mass (n, in dome radii), then the pulse's and each steering
 /// actuator's initial level (1 + n); outputs the pulse level and each
 /// steering level (1 + n), "rest" being the initial level.
+/// What a [`JellyfishFsm`] keeps in a snapshot: its behaviour now and
+/// before, its energy, its pulse's phase and the depth it holds.
+#[derive(Clone, Copy)]
+struct JellyfishKept {
+    behaviour: Behaviour,
+    previous: Behaviour,
+    energy: f64,
+    phase: f64,
+    hover_depth: Option<f64>,
+}
+
 impl crate::brain::Brain for JellyfishFsm {
     fn kind(&self) -> &'static str {
         "jellyfish-fsm"
+    }
+
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new(JellyfishKept {
+            behaviour: self.behaviour,
+            previous: self.previous,
+            energy: self.energy,
+            phase: self.phase,
+            hover_depth: self.hover_depth,
+        }))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        let k: &JellyfishKept = crate::kept::required(kept, "a jellyfish's brain")?;
+        self.behaviour = k.behaviour;
+        self.previous = k.previous;
+        self.energy = k.energy;
+        self.phase = k.phase;
+        self.hover_depth = k.hover_depth;
+        Ok(())
     }
 
     fn think(&mut self, t: f64, dt: f64, inputs: &[f64], outputs: &mut [f64]) {

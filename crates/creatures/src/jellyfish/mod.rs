@@ -154,4 +154,32 @@ impl Actor for Jellyfish {
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
     }
+
+    /// Its brain's state and its forces' levels.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        let levels: Vec<f64> = std::iter::once(self.pulse.level())
+            .chain(self.steer.iter().map(|s| s.level()))
+            .collect();
+        Some(crate::kept::Kept::new((
+            Brain::save_state(&self.fsm),
+            levels,
+        )))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        type K = (Option<crate::kept::Kept>, Vec<f64>);
+        let (fsm, levels) = crate::kept::required::<K>(kept, &self.name)?;
+        if levels.len() != 1 + self.steer.len() {
+            return Err(format!(
+                "{}: the snapshot is of another jellyfish",
+                self.name
+            ));
+        }
+        Brain::load_state(&mut self.fsm, fsm.as_ref())?;
+        self.pulse.set_level_alone(levels[0]);
+        for (s, &l) in self.steer.iter_mut().zip(&levels[1..]) {
+            s.set_level_alone(l);
+        }
+        Ok(())
+    }
 }

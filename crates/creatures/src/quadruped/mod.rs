@@ -370,6 +370,16 @@ impl LegAt {
 }
 
 impl Actor for Quadruped {
+    /// Whether its experiment has begun.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new(self.performed))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        self.performed = *crate::kept::required::<bool>(kept, &self.name)?;
+        Ok(())
+    }
+
     fn act(&mut self, world: &mut World, _dt: f64) {
         let Some(demo) = self.demo else { return };
         let t = world.time();

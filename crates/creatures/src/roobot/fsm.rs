@@ -244,6 +244,18 @@ impl crate::brain::Brain for HopFsm {
         "hop"
     }
 
+    /// Its state and last transition.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new((self.state, self.last_transition)))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        type K = (HopState, Option<(HopState, HopState)>);
+        let &(state, last) = crate::kept::required::<K>(kept, "a hop brain")?;
+        (self.state, self.last_transition) = (state, last);
+        Ok(())
+    }
+
     fn as_any(&self) -> Option<&dyn std::any::Any> {
         Some(self)
     }

@@ -121,9 +121,43 @@ impl Raibert {
     }
 }
 
+/// What a [`Raibert`] controller keeps in a snapshot: its stance and its
+/// last readings.
+#[derive(Clone, Copy)]
+struct RaibertKept {
+    in_stance: bool,
+    thrusting: bool,
+    stance_started: f64,
+    last_stance: f64,
+    last_angle: Option<f64>,
+    last_pitch: Option<f64>,
+}
+
 impl Brain for Raibert {
     fn kind(&self) -> &'static str {
         "raibert"
+    }
+
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new(RaibertKept {
+            in_stance: self.in_stance,
+            thrusting: self.thrusting,
+            stance_started: self.stance_started,
+            last_stance: self.last_stance,
+            last_angle: self.last_angle,
+            last_pitch: self.last_pitch,
+        }))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        let k = *crate::kept::required::<RaibertKept>(kept, "a raibert brain")?;
+        self.in_stance = k.in_stance;
+        self.thrusting = k.thrusting;
+        self.stance_started = k.stance_started;
+        self.last_stance = k.last_stance;
+        self.last_angle = k.last_angle;
+        self.last_pitch = k.last_pitch;
+        Ok(())
     }
 
     /// Inputs [`INPUTS`]; outputs the leg's, hip's and ankle's levels.

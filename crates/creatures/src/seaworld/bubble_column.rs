@@ -170,6 +170,22 @@ impl BubbleColumn {
 }
 
 impl Actor for BubbleColumn {
+    /// Its random stream, when the next bubble rises, how many rose.
+    fn save_state(&self) -> Option<crate::kept::Kept> {
+        Some(crate::kept::Kept::new((
+            self.random.clone(),
+            self.next_spawn,
+            self.recycled,
+        )))
+    }
+
+    fn load_state(&mut self, kept: Option<&crate::kept::Kept>) -> Result<(), String> {
+        let (random, next, recycled) =
+            crate::kept::required::<(Random, f64, u64)>(kept, "a bubble column")?;
+        (self.random, self.next_spawn, self.recycled) = (random.clone(), *next, *recycled);
+        Ok(())
+    }
+
     fn act(&mut self, world: &mut World, _dt: f64) {
         // Bubbles that left the water go back to the base.
         for i in 0..self.bubbles.len() {
