@@ -527,11 +527,19 @@ impl Evolution {
                 state.advance_towards(problem, &goals, None, &more, Some(&seen))
             });
             self.sync(state);
-            // (After Ctrl-C too: the run stands at whole generations.)
+            // A failed evaluation is not saved; after Ctrl-C the run stands
+            // at whole generations, and is.
+            let interrupted = match ran {
+                Ok(Err(e)) => return Err(runtime_error(e)),
+                Ok(Ok(())) => None,
+                Err(interrupt) => Some(interrupt),
+            };
             if let Some(dir) = &checkpoint {
                 save_files(state, dir)?;
             }
-            ran?.map_err(runtime_error)?;
+            if let Some(interrupt) = interrupted {
+                return Err(interrupt);
+            }
             if reached(state) {
                 return Ok(());
             }
