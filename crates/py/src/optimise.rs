@@ -257,6 +257,25 @@ impl Evolution {
         }
     }
 
+    /// A run of `state`, its problem built to evaluate on `device`.
+    fn of(state: State, device: &str) -> PyResult<Evolution> {
+        let batches = crate::evaluate::device_batches(device)?;
+        let problem = state
+            .config
+            .problem
+            .build_on(batches)
+            .map_err(crate::scene_error)?;
+        Ok(Evolution {
+            progress: Mutex::new(progress_of(&state)),
+            generations: state.config.generations,
+            inner: Mutex::new(Inner {
+                state,
+                problem,
+                pending: None,
+            }),
+        })
+    }
+
     /// The progress (a copy; the lock is held for no longer).
     fn lanes(&self) -> Vec<LaneProgress> {
         self.progress.lock().map(|p| p.clone()).unwrap_or_default()
@@ -298,21 +317,7 @@ impl Evolution {
             restarts: (restarts > 0).then_some(restarts),
         };
         let config = Config::new(spec, &choices).map_err(value_error)?;
-        let batches = crate::evaluate::device_batches(device)?;
-        let problem = config
-            .problem
-            .build_on(batches)
-            .map_err(crate::scene_error)?;
-        let state = State::new(config).map_err(value_error)?;
-        Ok(Evolution {
-            progress: Mutex::new(progress_of(&state)),
-            generations: state.config.generations,
-            inner: Mutex::new(Inner {
-                state,
-                problem,
-                pending: None,
-            }),
-        })
+        Evolution::of(State::new(config).map_err(value_error)?, device)
     }
 
     /// The next generation of every lane not yet done: `(genomes, lanes)`,
@@ -735,21 +740,7 @@ impl Evolution {
         state
             .resume(&choices)
             .map_err(|e| value_error(format!("{}: {e}", directory.display())))?;
-        let batches = crate::evaluate::device_batches(device)?;
-        let problem = state
-            .config
-            .problem
-            .build_on(batches)
-            .map_err(crate::scene_error)?;
-        Ok(Evolution {
-            progress: Mutex::new(progress_of(&state)),
-            generations: state.config.generations,
-            inner: Mutex::new(Inner {
-                state,
-                problem,
-                pending: None,
-            }),
-        })
+        Evolution::of(state, device)
     }
 }
 
