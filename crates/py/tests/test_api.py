@@ -352,10 +352,17 @@ def test_python_m_animats_evolve_stops_on_ctrl_c_and_resumes(cli, crawler, tmp_p
     args = ["--optimiser", "ga", "--lanes", "3", "--seed", "8"]
     cmd = [sys.executable, "-m", "animats.evolve", str(crawler), *args, "--generations",
            "100000000", "--no-check", "--out", str(tmp_path / "py")]
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    time.sleep(3.0)
-    p.send_signal(signal.SIGINT)
-    out, err = p.communicate(timeout=60)
+    # SIGINT as a terminal's Ctrl-C sends it. (A process started in the
+    # background, as CI may be, hands SIGINT on ignored, and Python then
+    # keeps it so: the child gets it back.)
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    try:
+        time.sleep(3.0)
+        p.send_signal(signal.SIGINT)
+        out, err = p.communicate(timeout=60)
+    finally:
+        p.kill()
     assert p.returncode == 130, (out, err)
     m = re.search(r"interrupted at generation (\d+); continue with "
                   r"`python -m animats.evolve --resume (.+)`", err)
