@@ -142,6 +142,8 @@ pub struct Bell {
     pub tentacles: Vec<usize>,
 }
 
+use animats_creatures::kept::Kept;
+
 /// The state of a scene at one instant (see [`Scene::snapshot`]).
 #[derive(Clone, Debug)]
 pub struct SceneSnapshot {
@@ -150,9 +152,9 @@ pub struct SceneSnapshot {
     /// Each actuator's level, in the scene's order.
     pub levels: Vec<f64>,
     /// Each controller's brain's own state, in the scene's order.
-    pub brains: Vec<Option<animats_creatures::kept::Kept>>,
+    pub brains: Vec<Option<Kept>>,
     /// Each creature's and other actor's own state, in the scene's order.
-    pub actors: Vec<Option<animats_creatures::kept::Kept>>,
+    pub actors: Vec<Option<Kept>>,
 }
 
 /// Steps between the divergence guard's checks (it sums the energy).
@@ -245,42 +247,35 @@ impl Scene {
                 self.actors.len()
             ));
         }
-        if s.levels.len() != self.nervous.actuators.len() {
-            return Err(format!(
-                "the snapshot holds {} actuator levels for {} actuators",
-                s.levels.len(),
-                self.nervous.actuators.len()
-            ));
-        }
-        let before = self.world.snapshot();
-        // A world's restore changes nothing when it refuses.
-        self.world.restore(&s.world).map_err(|e| e.to_string())?;
-        if let Err(e) = self.restore_states(s) {
-            let _ = self.world.restore(&before);
+        let (brains, levels) = (self.nervous.brain_states(), self.nervous.actuator_levels());
+        let actors: Vec<_> = self.actors.iter().map(|a| a.save_state()).collect();
+        if let Err(e) = self.load_parts(&s.brains, &s.actors, &s.levels) {
+            // Put back (its own parts always fit).
+            let _ = self.load_parts(&brains, &actors, &levels);
             return Err(e);
         }
-        self.nervous.set_levels(&mut self.world, &s.levels)?;
-        // After the levels: the world's own values are the exact ones.
-        self.world.restore(&s.world).map_err(|e| e.to_string())
+        // The world last: its actuated values are the exact ones, and a
+        // world's restore changes nothing when it refuses.
+        if let Err(e) = self.world.restore(&s.world) {
+            let _ = self.load_parts(&brains, &actors, &levels);
+            return Err(e.to_string());
+        }
+        Ok(())
     }
 
-    /// The brains' and actors' states of `s`, all or none.
-    fn restore_states(&mut self, s: &SceneSnapshot) -> Result<(), String> {
-        let brains = self.nervous.brain_states();
-        let actors: Vec<_> = self.actors.iter().map(|a| a.save_state()).collect();
-        let mut load = |brains: &[_], actors: &[Option<animats_creatures::kept::Kept>]| {
-            self.nervous.set_brain_states(brains)?;
-            self.actors
-                .iter_mut()
-                .zip(actors)
-                .try_for_each(|(a, k)| a.load_state(k.as_ref()))
-        };
-        let done = load(&s.brains, &s.actors);
-        if done.is_err() {
-            // Their own states always fit.
-            let _ = load(&brains, &actors);
+    /// The brains', actors' and actuators' parts of a snapshot; the world
+    /// untouched.
+    fn load_parts(
+        &mut self,
+        brains: &[Option<Kept>],
+        actors: &[Option<Kept>],
+        levels: &[f64],
+    ) -> Result<(), String> {
+        self.nervous.set_brain_states(brains)?;
+        for (a, k) in self.actors.iter_mut().zip(actors) {
+            a.load_state(k.as_ref())?;
         }
-        done
+        self.nervous.set_levels_alone(levels)
     }
 
     /// The state was set by hand (positions, velocities): the divergence

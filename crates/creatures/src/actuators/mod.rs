@@ -40,6 +40,17 @@ impl AnyActuator {
         }
     }
 
+    /// Sets the level (clamped to [0, 1]) without driving the parameter:
+    /// for a snapshot's restore, whose world holds the value.
+    pub fn set_level_alone(&mut self, level: f64) {
+        match self {
+            AnyActuator::Spring(a) => a.set_level_alone(level),
+            AnyActuator::AngleJoint(a) => a.set_level_alone(level),
+            AnyActuator::TorqueJoint(a) => a.set_level_alone(level),
+            AnyActuator::ConstantForce(a) => a.set_level_alone(level),
+        }
+    }
+
     /// Whether a gate can hold it off: a motor's torque and a force's scale
     /// have a zero that is "off"; a rest length or a rest angle has none.
     pub fn can_gate(&self) -> bool {
