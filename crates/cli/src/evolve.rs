@@ -99,7 +99,7 @@ fn optimiser_names() -> impl clap::builder::TypedValueParser<Value = OptimiserKi
     clap::builder::PossibleValuesParser::new(names).try_map(|s| OptimiserKind::parse(&s))
 }
 
-const CHECKPOINT: &str = "checkpoint.json";
+const CHECKPOINT: &str = checkpoint::FILE;
 /// Seconds between progress lines when stderr is not a terminal.
 const PROGRESS_EVERY: f64 = 5.0;
 
@@ -221,20 +221,11 @@ fn save(dir: &Path, state: &State) -> Result<(), Failure> {
 /// archive.csv, the checkpoint last), made in memory side by side while
 /// the lanes stand still, to be written by [`Writing`] while they go on.
 fn periodic_files(dir: &Path, state: &State) -> Result<Vec<(PathBuf, Vec<u8>)>, Failure> {
-    let io = Failure::Other;
-    let ((log, best), (archive, checkpoint)) = rayon::join(
-        || (state.log_csv(), state.best_toml()),
-        || (state.archive_csv(), checkpoint::encode(state)),
-    );
-    let mut files = vec![(dir.join("log.csv"), log.into_bytes())];
-    if let Some(best) = best.map_err(io)? {
-        files.push((dir.join("best.toml"), best.into_bytes()));
-    }
-    if let Some(csv) = archive {
-        files.push((dir.join("archive.csv"), csv.into_bytes()));
-    }
-    files.push((dir.join(CHECKPOINT), checkpoint.map_err(io)?.into_bytes()));
-    Ok(files)
+    Ok(checkpoint::run_files(state)
+        .map_err(Failure::Other)?
+        .into_iter()
+        .map(|(name, text)| (dir.join(name), text.into_bytes()))
+        .collect())
 }
 
 /// A run's periodic save being written by a thread of its own, so that

@@ -27,6 +27,31 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     })
 }
 
+/// A checkpoint's name in a run's directory.
+pub const FILE: &str = "checkpoint.json";
+
+/// The files a run saves as it goes, by name, in the order they are
+/// written: log.csv, best.toml (once there is a best), an archive's
+/// archive.csv, then the checkpoint ([`FILE`]) last, so that one on disk
+/// never stands for more than the files beside it. Made side by side on
+/// the current rayon pool. `animats evolve` writes them during a run and
+/// Python's `Evolution.save` whenever asked.
+pub fn run_files(state: &State) -> Result<Vec<(&'static str, String)>, String> {
+    let ((log, best), (archive, checkpoint)) = rayon::join(
+        || (state.log_csv(), state.best_toml()),
+        || (state.archive_csv(), encode(state)),
+    );
+    let mut files = vec![("log.csv", log)];
+    if let Some(best) = best? {
+        files.push(("best.toml", best));
+    }
+    if let Some(csv) = archive {
+        files.push(("archive.csv", csv));
+    }
+    files.push((FILE, checkpoint?));
+    Ok(files)
+}
+
 /// Writes `state` to `path` atomically.
 pub fn save(path: &Path, state: &State) -> Result<(), String> {
     animats_files::write_atomically(path, encode(state)?.as_bytes())

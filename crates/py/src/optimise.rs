@@ -17,9 +17,6 @@ use pyo3::types::PyDict;
 use std::path::PathBuf;
 use std::sync::{Mutex, MutexGuard};
 
-/// The checkpoint's name in a run's directory, as `animats evolve` names it.
-const CHECKPOINT: &str = "checkpoint.json";
-
 fn kind(name: &str) -> PyResult<OptimiserKind> {
     OptimiserKind::parse(name).map_err(value_error)
 }
@@ -725,7 +722,7 @@ impl Evolution {
                 return Err(value_error("generations must be between 1 and 100000000"));
             }
         }
-        let path = directory.join(CHECKPOINT);
+        let path = directory.join(animats_evolve::checkpoint::FILE);
         if !path.exists() {
             return Err(pyo3::exceptions::PyFileNotFoundError::new_err(format!(
                 "{}: no checkpoint here (`Evolution.save` or `animats evolve` writes one)",
@@ -745,25 +742,15 @@ impl Evolution {
 }
 
 /// `state`'s files in `directory` (created if needed), as `animats evolve`
-/// writes them: log.csv, best.toml, an archive's archive.csv, then the
-/// checkpoint, each whole or not at all.
+/// writes them during a run (`checkpoint::run_files`), each whole or not
+/// at all.
 fn save_files(state: &State, directory: &std::path::Path) -> PyResult<()> {
     std::fs::create_dir_all(directory).map_err(|e| {
         pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", directory.display()))
     })?;
-    let write = |name: &str, bytes: &[u8]| {
-        animats_files::write_atomically(&directory.join(name), bytes)
-            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
-    };
-    write("log.csv", state.log_csv().as_bytes())?;
-    if let Some(b) = state.best_toml().map_err(runtime_error)? {
-        write("best.toml", b.as_bytes())?;
+    for (name, text) in animats_evolve::checkpoint::run_files(state).map_err(runtime_error)? {
+        animats_files::write_atomically(&directory.join(name), text.as_bytes())
+            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))?;
     }
-    if let Some(csv) = state.archive_csv() {
-        write("archive.csv", csv.as_bytes())?;
-    }
-    // Last: a checkpoint on disk never stands for more than the files
-    // beside it.
-    let checkpoint = animats_evolve::checkpoint::encode(state).map_err(runtime_error)?;
-    write(CHECKPOINT, checkpoint.as_bytes())
+    Ok(())
 }
