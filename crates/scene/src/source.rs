@@ -41,6 +41,19 @@ impl Source<'_> {
         first
     }
 
+    /// Byte offset of the line holding the header `[name]` (a table, not
+    /// an array of tables), if the file has one.
+    pub fn table_offset(&self, name: &str) -> Option<usize> {
+        let mut offset = 0;
+        for line in self.text.split_inclusive('\n') {
+            if header(line).is_some_and(|(h, array)| !array && h == name) {
+                return Some(offset);
+            }
+            offset += line.len();
+        }
+        None
+    }
+
     /// The table entry that encloses byte `offset`: `name[k]` for the k-th
     /// (0-based) `[[name]]` header before it, `name` for a `[name]` table, or
     /// `None` at top level.

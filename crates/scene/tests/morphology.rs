@@ -400,6 +400,36 @@ fn an_evogym_structure_is_a_starting_body() {
     assert_eq!(scene.world.len(), p.body(start).unwrap().nodes.len());
 }
 
+/// A step too small for the evaluation is refused as it is on a random
+/// start (`evolve.duration` names the steps), before the start body's
+/// settle would take 0.5 s of them: with `dt = 1e-300` that settle ran on
+/// for ever. The error names the line of the user's file where `[evolve]`'s
+/// `duration` is written (it named the line of the body's developed text).
+#[test]
+fn a_start_body_with_a_step_too_small_is_refused_before_it_settles() {
+    for name in ["bodies_lattice", "bodies_walk"] {
+        let text = std::fs::read_to_string(format!("{ROOT}/scenes/{name}.toml")).unwrap();
+        let tiny = text.replacen("dt = 0.0005", "dt = 1e-300", 1);
+        assert_ne!(tiny, text);
+        let evolve = text.lines().position(|l| l == "[evolve]").unwrap();
+        let line = evolve
+            + 1
+            + text
+                .lines()
+                .skip(evolve)
+                .position(|l| l.starts_with("duration ="))
+                .unwrap();
+        let e = MorphologyProblem::parse(&tiny, "m.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with(&format!("m.toml:{line}: evolve.duration: "))
+                && e.contains("more than 1e12"),
+            "{name}: {e}"
+        );
+    }
+}
+
 #[test]
 fn every_check_names_its_reason() {
     let p = MorphologyProblem::parse(&walk(), "bodies_walk.toml").unwrap();

@@ -42,6 +42,19 @@ pub struct MorphologyProblem {
     batches: Option<crate::evaluate::Batches>,
 }
 
+/// An error in the text developed from the user's file, placed in that
+/// file: in a table the user wrote (`[evolve]`), at the line where they
+/// wrote the field; elsewhere (the body's generated entries) at no line,
+/// since the developed text's lines are not the file's.
+fn in_user_file(src: &Source, mut e: SceneError) -> SceneError {
+    e.line = e
+        .entry
+        .as_deref()
+        .and_then(|t| src.table_offset(t))
+        .map(|o| src.field_line(o, e.field.as_deref().unwrap_or("")));
+    e
+}
+
 impl MorphologyProblem {
     /// Parses and checks a scene with a `[morphology]` table: every key,
     /// the rest of the scene (built once without a body), the start body
@@ -136,27 +149,37 @@ impl MorphologyProblem {
             grid,
             batches: None,
         };
+        // The start body's own checks but its settle first (their reasons
+        // say more than a failed development would), then the [evolve]
+        // table on it (or on a random body): that bounds the steps, so that
+        // a step too small for the evaluation is refused before the settle
+        // would take as many of them.
+        let refused = |problem: &MorphologyProblem, g: &[f64], r: Refusal| {
+            // A settle that blew up at a step past the body's own
+            // stability limit: say so.
+            let why = match r {
+                Refusal::SettleBlowUp => problem
+                    .develop(g, "")
+                    .ok()
+                    .and_then(|t| crate::parse(&t, file).ok())
+                    .and_then(|s| crate::build::step_warning(&s.world, &s.names, s.dt))
+                    .map(|w| format!(" ({w})")),
+                _ => None,
+            };
+            here.err(
+                "start",
+                format!(
+                    "the starting body fails its own checks: {r}{}",
+                    why.unwrap_or_default()
+                ),
+            )
+        };
         if let Some(g) = &problem.start {
-            problem.check(g).map_err(|r| {
-                // A settle that blew up at a step past the body's own
-                // stability limit: say so.
-                let why = match r {
-                    Refusal::SettleBlowUp => problem
-                        .develop(g, "")
-                        .ok()
-                        .and_then(|t| crate::parse(&t, file).ok())
-                        .and_then(|s| crate::build::step_warning(&s.world, &s.names, s.dt))
-                        .map(|w| format!(" ({w})")),
-                    _ => None,
-                };
-                here.err(
-                    "start",
-                    format!(
-                        "the starting body fails its own checks: {r}{}",
-                        why.unwrap_or_default()
-                    ),
-                )
-            })?;
+            let body = problem
+                .body(g)
+                .map_err(|_| refused(&problem, g, Refusal::Malformed))?;
+            check::static_checks(&body, &problem.morphology)
+                .map_err(|r| refused(&problem, g, r))?;
         }
         let probe = match &problem.start {
             Some(g) => g.clone(),
@@ -165,8 +188,11 @@ impl MorphologyProblem {
         let text = problem
             .develop(&probe, "")
             .map_err(|m| SceneError::file(file, m))?;
-        let scene = SceneProblem::parse(&text, file)?;
+        let scene = SceneProblem::parse(&text, file).map_err(|e| in_user_file(&src, e))?;
         problem.spec = scene.spec().clone();
+        if let Some(g) = &problem.start {
+            problem.check(g).map_err(|r| refused(&problem, g, r))?;
+        }
         Ok(problem)
     }
 
