@@ -83,6 +83,11 @@ impl<E: Env> VecEnv<E> {
         &self.copies[0].env
     }
 
+    /// Copy `k`, if there is one.
+    pub fn get(&self, k: usize) -> Option<&E> {
+        self.copies.get(k).map(|c| &c.env)
+    }
+
     /// Resets every copy, copy `k` with seed `seed + k`.
     pub fn reset(&mut self, seed: u64) -> Result<(), String> {
         for (k, c) in self.copies.iter_mut().enumerate() {

@@ -14,8 +14,6 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2}
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
-type Dyn = Box<dyn animats_creatures::env::Env>;
-
 /// How to make one copy: the scene, the episode's length and step when
 /// they are not the scene's, the physics steps per action (or the rate to
 /// act at) and what is observed (`None`: the scene's sensors, or its state
@@ -79,10 +77,6 @@ impl Recipe {
         let observation = self.observation.unwrap_or(env.observation());
         env.with_actions(skip, observation).map_err(value_error)
     }
-
-    fn make(&self, noise: f64) -> PyResult<Dyn> {
-        Ok(Box::new(self.make_scene(noise)?))
-    }
 }
 
 /// What the software renderer draws of the scene now, and the camera
@@ -96,6 +90,23 @@ fn picture(env: &SceneEnv, distance: f64) -> (animats_render::Picture, animats_r
     let centre = env.watched_centre();
     let target = animats_engine::DVec3::new(centre.x, centre.y.max(0.0), centre.z);
     (picture, animats_render::Camera::framing(target, distance))
+}
+
+/// `width` × `height` checked: 16 to 4096 pixels each.
+fn picture_size(width: u32, height: u32) -> PyResult<()> {
+    if !(16..=4096).contains(&width) || !(16..=4096).contains(&height) {
+        return Err(value_error(format!(
+            "width and height must be between 16 and 4096 pixels, got {width} × {height}"
+        )));
+    }
+    Ok(())
+}
+
+/// The camera's distance that frames `start` (the body at the reset) in
+/// a picture of `width` × `height`: `animats render`'s snug framing.
+fn framing(start: &[(animats_engine::DVec3, f64)], width: u32, height: u32) -> f64 {
+    let aspect = f64::from(width) / f64::from(height);
+    animats_view::snug(start.iter().copied(), 50.0, aspect).map_or(3.0, |(_, d)| d)
 }
 
 fn obs<'py>(py: Python<'py>, e: &dyn animats_creatures::env::Env) -> Bound<'py, PyArray1<f64>> {
@@ -203,15 +214,10 @@ impl Env {
         width: u32,
         height: u32,
     ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
-        if !(16..=4096).contains(&width) || !(16..=4096).contains(&height) {
-            return Err(value_error(format!(
-                "width and height must be between 16 and 4096 pixels, got {width} × {height}"
-            )));
-        }
-        let aspect = f64::from(width) / f64::from(height);
+        picture_size(width, height)?;
         let distance = {
             let start = self.body.lock().map_err(|_| runtime_error("poisoned"))?;
-            animats_view::snug(start.iter().copied(), 50.0, aspect).map_or(3.0, |(_, d)| d)
+            framing(&start, width, height)
         };
         let (picture, camera) = picture(&*self.lock()?, distance);
         let rgb = py.detach(|| animats_render::render(&picture, &camera, width, height).rgb);
@@ -297,8 +303,12 @@ impl Env {
 /// (reward 0), as Gymnasium's vector environments do by default.
 #[pyclass(module = "animats")]
 pub struct VecEnv {
-    env: Mutex<RustVecEnv<Dyn>>,
+    env: Mutex<RustVecEnv<SceneEnv>>,
     transitions: Mutex<Vec<Transition>>,
+    /// The moving spheres (centre, radius) of a copy at its reset, which
+    /// `render` frames: the same for every copy and every reset (a reset's
+    /// noise is in the velocities only).
+    body: Vec<(animats_engine::DVec3, f64)>,
 }
 
 type Stepped<'py> = (
@@ -309,12 +319,15 @@ type Stepped<'py> = (
 );
 
 impl VecEnv {
-    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, RustVecEnv<Dyn>>> {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, RustVecEnv<SceneEnv>>> {
         crate::lock(&self.env, "environment")
     }
 }
 
-fn observations<'py>(py: Python<'py>, v: &RustVecEnv<Dyn>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+fn observations<'py>(
+    py: Python<'py>,
+    v: &RustVecEnv<SceneEnv>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let mut o = vec![0.0; v.len() * v.observation_size()];
     v.observe(&mut o);
     let a = Array2::from_shape_vec((v.len(), v.observation_size()), o).map_err(runtime_error)?;
@@ -347,11 +360,16 @@ impl VecEnv {
             )));
         }
         let recipe = Recipe::new(scene, seconds, dt, frame_skip, act_hz, observation)?;
-        recipe.make(noise)?;
+        recipe.make_scene(noise)?;
         let v = py
-            .detach(|| RustVecEnv::new(n, seed, |_| recipe.make(noise).map_err(|e| e.to_string())))
+            .detach(|| {
+                RustVecEnv::new(n, seed, |_| {
+                    recipe.make_scene(noise).map_err(|e| e.to_string())
+                })
+            })
             .map_err(value_error)?;
         Ok(VecEnv {
+            body: body(v.first()),
             env: Mutex::new(v),
             transitions: Mutex::new(vec![
                 Transition {
@@ -401,6 +419,56 @@ impl VecEnv {
         let terminated = PyArray1::from_vec(py, out.iter().map(|t| t.terminated).collect());
         let truncated = PyArray1::from_vec(py, out.iter().map(|t| t.truncated).collect());
         Ok((observations(py, &v)?, rewards, terminated, truncated))
+    }
+
+    /// The copies numbered in `copies` (default: every copy) now, drawn
+    /// as `Env.render` draws one: a `(copies, height, width, 3)` uint8
+    /// array, each picture following its copy's `[evolve]` particles and
+    /// framing the body as it stands at a reset. The pictures are drawn in
+    /// parallel, the GIL released.
+    #[pyo3(signature = (width = 480, height = 320, copies = None))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        width: u32,
+        height: u32,
+        copies: Option<Vec<i64>>,
+    ) -> PyResult<Bound<'py, numpy::PyArray4<u8>>> {
+        use rayon::prelude::*;
+        picture_size(width, height)?;
+        let distance = framing(&self.body, width, height);
+        let pictures = {
+            let v = self.lock()?;
+            let n = v.len();
+            let copies = copies.unwrap_or_else(|| (0..n as i64).collect());
+            copies
+                .iter()
+                .map(|&k| {
+                    usize::try_from(k)
+                        .ok()
+                        .and_then(|k| v.get(k))
+                        .map(|e| picture(e, distance))
+                        .ok_or_else(|| {
+                            value_error(format!(
+                                "copies: there is no copy {k} (copies 0 to {})",
+                                n - 1
+                            ))
+                        })
+                })
+                .collect::<PyResult<Vec<_>>>()?
+        };
+        let k = pictures.len();
+        let rgb: Vec<u8> = py.detach(|| {
+            let frames: Vec<Vec<u8>> = pictures
+                .par_iter()
+                .map(|(picture, camera)| animats_render::render(picture, camera, width, height).rgb)
+                .collect();
+            frames.concat()
+        });
+        let a =
+            numpy::ndarray::Array4::from_shape_vec((k, height as usize, width as usize, 3), rgb)
+                .map_err(runtime_error)?;
+        Ok(a.into_pyarray(py))
     }
 
     /// Copies.

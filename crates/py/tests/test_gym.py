@@ -181,3 +181,48 @@ def test_the_native_vector_environment_is_n_single_environments():
         if ended:  # the next-step reset is exercised in the test above
             break
     assert compared >= 50
+
+
+def test_the_vector_environment_draws_each_copy_as_a_single_one_does(pogo_env):
+    n = 3
+    vec = animats.VecEnv(str(pogo_env), n, seed=7, noise=0.2)
+    singles = [animats.Env(str(pogo_env), noise=0.2) for _ in range(n)]
+    for k, e in enumerate(singles):
+        e.reset(7 + k)
+    rng = np.random.default_rng(1)
+    for _ in range(30):
+        a = rng.random((n, 1))
+        vec.step(a)
+        for k, e in enumerate(singles):
+            e.step(a[k])
+    every = vec.render(240, 160)
+    assert every.shape == (n, 160, 240, 3) and every.dtype == np.uint8
+    for k, e in enumerate(singles):
+        assert np.array_equal(every[k], e.render(240, 160)), f"copy {k}"
+    # The noise set the copies apart: their pictures differ.
+    assert np.any(every[0] != every[1])
+    assert np.array_equal(vec.render(240, 160, [2, 0]), every[[2, 0]])
+    with pytest.raises(ValueError, match="no copy 3"):
+        vec.render(copies=[3])
+    with pytest.raises(ValueError, match="no copy -1"):
+        vec.render(copies=[-1])
+    with pytest.raises(ValueError, match="between 16 and 4096"):
+        vec.render(8, 8)
+
+
+def test_make_vec_renders_every_copy_in_rgb_array_mode(pogo_env):
+    env = gymnasium.make_vec(
+        "animats/Scene-v0", num_envs=2, scene=str(pogo_env), render_mode="rgb_array"
+    )
+    assert isinstance(env, animats.gym.AnimatsVectorEnv)
+    env.reset(seed=0)
+    frames = env.render()
+    assert isinstance(frames, tuple) and len(frames) == 2
+    assert all(f.shape == (320, 480, 3) and f.dtype == np.uint8 for f in frames)
+    assert frames[0].std() > 10, "not a blank picture"
+    assert env.metadata["render_fps"] == round(1.0 / env.dt)
+    assert env.render_copies([1], 64, 48).shape == (1, 48, 64, 3)
+    plain = gymnasium.make_vec("animats/Scene-v0", num_envs=2, scene=str(pogo_env))
+    assert plain.render() is None
+    with pytest.raises(ValueError, match="render_mode"):
+        gymnasium.make_vec("animats/Scene-v0", num_envs=2, scene=str(pogo_env), render_mode="human")

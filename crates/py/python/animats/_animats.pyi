@@ -207,3 +207,6 @@ class VecEnv:
     def step(
         self, actions: F64
     ) -> Tuple[F64, F64, npt.NDArray[np.bool_], npt.NDArray[np.bool_]]: ...
+    def render(
+        self, width: int = 480, height: int = 320, copies: Optional[List[int]] = None
+    ) -> npt.NDArray[np.uint8]: ...

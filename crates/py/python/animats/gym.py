@@ -39,7 +39,10 @@ axis), ``energy`` (J, the actuators' positive work) and ``ended``
 ``gymnasium.make_vec(id, num_envs=N)`` gives :class:`AnimatsVectorEnv`, the
 native vector environment that steps all N copies in one call in Rust (in
 parallel for large N, the GIL released); ``vectorization_mode="sync"`` gives
-Gymnasium's own ``SyncVectorEnv`` of N single environments instead.
+Gymnasium's own ``SyncVectorEnv`` of N single environments instead. With
+``render_mode="rgb_array"`` its ``render()`` returns every copy's picture,
+as a tuple (Gymnasium's vector convention); ``render_copies`` draws chosen
+copies only.
 """
 
 from __future__ import annotations
@@ -162,7 +165,7 @@ class AnimatsVectorEnv(VectorEnv):
     ended is reset at the next ``step`` (its action ignored, reward 0):
     Gymnasium's default "next step" autoreset."""
 
-    metadata = {"render_modes": [], "autoreset_mode": AutoresetMode.NEXT_STEP}
+    metadata = {"render_modes": ["rgb_array"], "autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(
         self,
@@ -176,9 +179,9 @@ class AnimatsVectorEnv(VectorEnv):
         observation: Optional[str] = None,
         act_hz: Optional[float] = None,
     ) -> None:
-        if render_mode is not None:
+        if render_mode not in (None, "rgb_array"):
             raise ValueError(
-                "vector environments do not render; render a single one (render_mode=\"rgb_array\")"
+                f'render_mode must be None or "rgb_array", got {render_mode!r}'
             )
         self._env = _animats.VecEnv(
             scene, num_envs, 0, noise, seconds, dt, frame_skip, act_hz, observation
@@ -192,7 +195,8 @@ class AnimatsVectorEnv(VectorEnv):
         self.observation_names = self._env.observation_names
         self.action_names = self._env.action_names
         self.dt = self._env.dt
-        self.render_mode = None
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": max(1, round(1.0 / self.dt))}
         self._np_random_seed = None
 
     def reset(
@@ -209,6 +213,20 @@ class AnimatsVectorEnv(VectorEnv):
         a = np.ascontiguousarray(actions, dtype=np.float64).reshape(self.num_envs, -1)
         obs, rewards, terminated, truncated = self._env.step(a)
         return obs, rewards, terminated, truncated, {}
+
+    def render(self) -> Optional[tuple[np.ndarray, ...]]:
+        """Every copy now, ``(320, 480, 3)`` uint8 each, in a tuple
+        (``render_mode="rgb_array"``; as a single environment draws it)."""
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self._env.render(480, 320))
+
+    def render_copies(
+        self, copies: Any, width: int = 480, height: int = 320
+    ) -> np.ndarray:
+        """The copies numbered in ``copies`` now, ``(len(copies), height,
+        width, 3)`` uint8, drawn in parallel (whatever the ``render_mode``)."""
+        return self._env.render(width, height, [int(k) for k in copies])
 
 
 def _roobot_vector(num_envs: int = 1, **kwargs: Any) -> AnimatsVectorEnv:
