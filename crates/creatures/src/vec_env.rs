@@ -30,24 +30,37 @@ pub struct VecEnv<E: Env> {
 }
 
 impl<E: Env> VecEnv<E> {
-    /// Copies made by `make` (called `n` times, with the copy's index), each
-    /// reset with seed `seed + k`.
+    /// Copies made by `make` (called `n` times, with the copy's index, in
+    /// parallel on the current rayon pool from `2 × CHUNK` copies), each
+    /// reset with seed `seed + k`. The first error `make` returns, in copy
+    /// order, is returned.
     pub fn new(
         n: usize,
         seed: u64,
-        mut make: impl FnMut(usize) -> Result<E, String>,
+        make: impl Fn(usize) -> Result<E, String> + Sync,
     ) -> Result<VecEnv<E>, String> {
         if n == 0 {
             return Err("a vector environment needs at least one copy".into());
         }
-        let mut copies = Vec::with_capacity(n);
-        for k in 0..n {
-            copies.push(Copy {
-                env: make(k)?,
+        let one = |k| {
+            make(k).map(|env| Copy {
+                env,
                 done: false,
                 seed: 0,
-            });
-        }
+            })
+        };
+        let copies: Vec<Copy<E>> = if n >= 2 * CHUNK {
+            // (Every copy made, then the first error in copy order: the
+            // same error whatever the thread count.)
+            let made: Vec<Result<Copy<E>, String>> = (0..n)
+                .into_par_iter()
+                .with_min_len(CHUNK)
+                .map(one)
+                .collect();
+            made.into_iter().collect::<Result<_, _>>()?
+        } else {
+            (0..n).map(one).collect::<Result<_, _>>()?
+        };
         let obs = copies[0].env.observation_size();
         let act = copies[0].env.action_size();
         if act == 0 {
@@ -88,14 +101,24 @@ impl<E: Env> VecEnv<E> {
         self.copies.get(k).map(|c| &c.env)
     }
 
-    /// Resets every copy, copy `k` with seed `seed + k`.
+    /// Resets every copy, copy `k` with seed `seed + k` (in parallel as
+    /// [`VecEnv::step`]).
     pub fn reset(&mut self, seed: u64) -> Result<(), String> {
-        for (k, c) in self.copies.iter_mut().enumerate() {
+        let one = |(k, c): (usize, &mut Copy<E>)| {
             c.seed = seed.wrapping_add(k as u64);
             c.env.reset(c.seed)?;
             c.done = false;
+            Ok::<(), String>(())
+        };
+        if self.copies.len() >= 2 * CHUNK {
+            self.copies
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(CHUNK)
+                .try_for_each(one)
+        } else {
+            self.copies.iter_mut().enumerate().try_for_each(one)
         }
-        Ok(())
     }
 
     /// Every copy's observation, copy by copy, into `out` (`len ×

@@ -516,3 +516,20 @@ def test_a_step_past_the_stability_limit_is_a_runtime_warning(root, tmp_path):
         warnings.simplefilter("error")
         for name in ("bodies_swim.toml", "bodies_walk.toml", "walker.toml"):
             assert animats.load(root / "scenes" / name).warnings == []
+
+
+def test_ctrl_c_stops_the_making_of_a_large_vector_environment(root, ctrl_c):
+    # 200,000 walkers take about 40 s to make on one core (0.2 ms each);
+    # Ctrl-C 0.3 s in stops the making.
+    walker = str(root / "scenes" / "walker.toml")
+    began = time.monotonic()
+    with ctrl_c(0.3), pytest.raises(KeyboardInterrupt):
+        animats.VecEnv(walker, 200_000, act_hz=50.0)
+    assert time.monotonic() - began < 3.0
+    # Nothing of it lingers: the next one is made and steps as any other.
+    v = animats.VecEnv(walker, 3, act_hz=50.0)
+    one = animats.Env(walker, act_hz=50.0)
+    one.reset(2)
+    a = np.full((3, len(v.action_names)), 0.7)
+    o, *_ = v.step(a)
+    assert np.array_equal(o[2], one.step(a[2])[0])
