@@ -135,6 +135,13 @@ fn evaluate_and_evolve_refuse_what_they_cannot_use() {
             "dt = -1e300",
             "world.dt: must be > 0, got -1e300",
         ),
+        // (A step longer than the evaluation scored nothing: fitness 0,
+        // `ended timeout`, exit 0.)
+        (
+            "dt = 0.0005",
+            "dt = 30.0",
+            "evolve.duration: 10 s is shorter than half a step (30 s, [world] dt): nothing to evaluate",
+        ),
     ] {
         let at = walker.rfind(from).expect(from);
         let scene = write(

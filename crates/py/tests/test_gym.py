@@ -33,6 +33,26 @@ def test_a_scene_without_sensors_observes_its_state(root):
         gymnasium.make("animats/Scene-v0", scene=walker, observation="sensors")
 
 
+def test_an_episode_of_no_steps_or_too_many_is_refused(root):
+    # (A step longer than the episode made one of no steps, each "ended"
+    # at its first step.)
+    walker = str(root / "scenes" / "walker.toml")
+    for kw, expect in [
+        (dict(dt=30.0), "shorter than half a step of 30 s"),
+        (dict(dt=1e300), "shorter than half a step"),
+        (dict(seconds=1e-300), "shorter than half a step of 0.0005 s"),
+        (dict(dt=1e-300), "more than 1e12"),
+        (dict(dt=float("nan")), "dt must be a positive number"),
+        (dict(seconds=-1.0), "seconds must be a positive number"),
+    ]:
+        with pytest.raises(ValueError, match=expect):
+            animats.Env(walker, **kw)
+        with pytest.raises(ValueError, match=expect):
+            animats.VecEnv(walker, 2, **kw)
+    e = animats.Env(walker, seconds=0.0005)
+    assert e.max_steps == 1
+
+
 @pytest.mark.parametrize("observation", ["sensors", "state", "both"])
 @pytest.mark.parametrize("frame_skip", [1, 7, None])
 @pytest.mark.parametrize("render_mode", [None, "rgb_array"])

@@ -157,7 +157,15 @@ impl SceneEnv {
         if let Some(d) = dt {
             self.dt = Some(positive("dt", d)?);
         }
-        let steps = self.spec.duration / self.dt.unwrap_or(self.scene.dt);
+        let step = self.dt.unwrap_or(self.scene.dt);
+        let steps = self.spec.duration / step;
+        if steps.round() < 1.0 {
+            return Err(format!(
+                "an episode of {} s is shorter than half a step of {} s: nothing to step",
+                animats_engine::Shown(self.spec.duration),
+                animats_engine::Shown(step)
+            ));
+        }
         if steps > crate::evaluate::MAX_STEPS {
             return Err(format!(
                 "an episode of {steps:.3e} steps, more than {:e}",

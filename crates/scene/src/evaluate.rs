@@ -326,6 +326,15 @@ impl EvolveSpec {
                 ),
             ));
         }
+        if (duration / dt).round() < 1.0 {
+            return Err(at.err(
+                "duration",
+                format!(
+                    "{duration} s is shorter than half a step ({} s, [world] dt): nothing to evaluate",
+                    Shown(dt)
+                ),
+            ));
+        }
         if duration / dt > MAX_STEPS {
             return Err(at.err(
                 "duration",
