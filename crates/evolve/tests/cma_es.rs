@@ -261,3 +261,29 @@ fn a_long_converged_run_never_asks_for_nan() {
     }
     assert!(o.best().unwrap().1.is_finite());
 }
+
+/// A genome past what an optimiser can hold is refused, naming the count:
+/// CMA-ES's n × n covariance at 2⁴⁰ genes overflowed its size and hung.
+#[test]
+fn a_genome_too_long_for_the_optimiser_is_refused() {
+    use animats_evolve::optimiser::{MAX_CMA_GENES, MAX_GENES};
+    let with = |kind, n| Setup {
+        kind,
+        start: vec![0.0; n],
+        ..setup(0.0, 1)
+    };
+    for kind in [OptimiserKind::CmaEs, OptimiserKind::Ga] {
+        let most = if kind == OptimiserKind::CmaEs {
+            MAX_CMA_GENES
+        } else {
+            MAX_GENES
+        };
+        assert!(with(kind, most).validate().is_ok(), "{kind:?}");
+        let e = with(kind, most + 1).validate().unwrap_err();
+        assert!(
+            e.contains(&format!("has {} genes, more than", most + 1)),
+            "{kind:?}: {e}"
+        );
+        assert!(AnyOptimiser::new(&with(kind, most + 1)).is_err());
+    }
+}

@@ -94,6 +94,13 @@ impl Optimiser {
             setup.start = s.as_array().to_vec();
         } else if setup.start.is_empty() {
             let d = dim.ok_or_else(|| value_error("give dim, start or problem"))?;
+            // (Checked before the zeros are made: 2**40 of them hung.)
+            if d > animats_evolve::optimiser::MAX_GENES {
+                return Err(value_error(format!(
+                    "dim: {d} genes, more than any optimiser takes ({})",
+                    animats_evolve::optimiser::MAX_GENES
+                )));
+            }
             setup.start = vec![0.0; d];
         }
         if let Some(d) = dim {

@@ -533,3 +533,12 @@ def test_ctrl_c_stops_the_making_of_a_large_vector_environment(root, ctrl_c):
     a = np.full((3, len(v.action_names)), 0.7)
     o, *_ = v.step(a)
     assert np.array_equal(o[2], one.step(a[2])[0])
+
+
+def test_an_optimiser_of_too_many_genes_is_refused():
+    # (dim=2**40 hung, making 8 TB of zeros.)
+    with pytest.raises(ValueError, match="more than any optimiser takes"):
+        animats.Optimiser("cma-es", dim=2**40)
+    with pytest.raises(ValueError, match="more than cma-es takes"):
+        animats.Optimiser("cma-es", dim=10_001)
+    assert animats.Optimiser("ga", dim=10_001).ask().shape == (32, 10_001)
