@@ -202,13 +202,38 @@ impl Slope {
     }
 }
 
+/// How far (in cells) a cell's index may lie from the field's origin
+/// before it is held there (`Heightfield::cell_of`): 2⁶², so that the
+/// cells searched around it (at most 8 further) stay within an `i64`.
+const FAR_CELLS: f64 = (1u64 << 62) as f64;
+
+/// The cells around a probe `vertical` m above (or below) a field of
+/// `cell` m to search for its nearest point: as many as that distance
+/// spans, plus one, at most 8 (compared before the cast: a blown-up
+/// distance saturated `as i64` and the `+ 1` overflowed).
+fn span_for(vertical: f64, cell: f64) -> i64 {
+    let cells = (vertical.abs() / cell).ceil();
+    if cells >= 7.0 {
+        8
+    } else {
+        cells as i64 + 1
+    }
+}
+
 impl Steps {
     /// Which tread lies under `s` (0 before the first riser, `count` on top).
     fn tread(&self, s: f64) -> i64 {
         if s < self.start {
             return 0;
         }
-        (((s - self.start) / self.depth).floor() as i64 + 1).min(i64::from(self.count))
+        // (Compared before the cast: far along, `as i64` saturates and the
+        // `+ 1` overflowed.)
+        let t = ((s - self.start) / self.depth).floor();
+        if t >= f64::from(self.count) {
+            i64::from(self.count)
+        } else {
+            (t as i64 + 1).min(i64::from(self.count))
+        }
     }
 
     /// The height of the ground `s` m along the direction.
@@ -337,7 +362,11 @@ impl Heightfield {
             (z - self.origin.y) / self.cell,
         );
         let (i, j) = (u.floor(), v.floor());
-        (i as i64, j as i64, u - i, v - j)
+        // The index held within ±2⁶² cells: a blown-up particle's
+        // saturated `as i64` and the next cell's index overflowed (the
+        // search reaches 8 cells past it).
+        let index = |k: f64| k.clamp(-FAR_CELLS, FAR_CELLS) as i64;
+        (index(i), index(j), u - i, v - j)
     }
 
     /// The surface's height under (x, z), m.
@@ -370,7 +399,7 @@ impl Heightfield {
         // The nearest point is no farther than the point straight below (or
         // above), so it lies within |vertical| of (x, z) across.
         // (Capped: past 8 cells the nearest of those searched is taken.)
-        let span = ((vertical.abs() / self.cell).ceil() as i64 + 1).min(8);
+        let span = span_for(vertical, self.cell);
         let (i0, j0, _, _) = self.cell_of(p.x, p.z);
         let (best, nearest, face) = self.nearest_within(p, i0, j0, span, true);
         let below = vertical < 0.0;
@@ -585,7 +614,7 @@ mod tests {
                 ][k % 7];
                 let p = DVec3::new(x, h.height(x, z) + scale * (2.0 * uniform() - 1.0), z);
                 let vertical = p.y - h.height(p.x, p.z);
-                let span = ((vertical.abs() / cell).ceil() as i64 + 1).min(8);
+                let span = span_for(vertical, cell);
                 let (i0, j0, _, _) = h.cell_of(p.x, p.z);
                 let (d2, q, n) = h.nearest_within(p, i0, j0, span, true);
                 let (d2_all, q_all, n_all) = h.nearest_within(p, i0, j0, span, false);

@@ -86,8 +86,7 @@ AN_FN double an_dot3(const double *a, const double *b) {
 }
 
 /* Steps::tread: which tread lies under s (0 before the first riser,
- * count on top). (Past 9.2e18 treads the engine's i64 wraps; this
- * saturates.) */
+ * count on top). */
 AN_FN long long an_tread(const double *tp, double s) {
     if (s < tp[3]) {
         return 0;
@@ -178,13 +177,14 @@ AN_FN void an_vertex(const double *tp, const double *h, long long i, long long j
     out[2] = tp[1] + (double)j * tp[2];
 }
 
-/* Heightfield::cell_of: the cell under (x, z) and where in it. */
+/* Heightfield::cell_of: the cell under (x, z) and where in it, the index
+ * held within ±2^62 cells (FAR_CELLS). */
 AN_FN void an_cell_of(const double *tp, double x, double z, long long *i, long long *j,
                       double *fu, double *fv) {
     double u = (x - tp[0]) / tp[2], v = (z - tp[1]) / tp[2];
     double fi = floor(u), fj = floor(v);
-    *i = an_to_i64(fi);
-    *j = an_to_i64(fj);
+    *i = an_to_i64(an_clamp(fi, -4611686018427387904.0, 4611686018427387904.0));
+    *j = an_to_i64(an_clamp(fj, -4611686018427387904.0, 4611686018427387904.0));
     *fu = u - fi;
     *fv = v - fj;
 }
@@ -394,8 +394,7 @@ AN_FN double an_hf_nearest(const double *tp, const double *h, const double *p, l
     return best;
 }
 
-/* Heightfield::probe. (Past 9.2e18 cells the engine's i64 wraps; this
- * saturates.) */
+/* Heightfield::probe. */
 AN_COLD int an_hf_probe(const double *tp, const double *h, const double *p, double reach,
                       double *dist, double *normal) {
     double vertical = p[1] - an_hf_height(tp, h, p[0], p[2]);

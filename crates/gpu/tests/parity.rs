@@ -433,13 +433,28 @@ fn particles_starting_in_or_on_the_terrain_are_the_engine_s_to_the_bit() {
             let (off, _) = terrain.probe(on, 1.0).unwrap();
             assert!(off.abs() < 1e-12, "{ground}: the particle is {off} m off");
             worlds.push(pair);
+            // A particle far past the field's edge, falling onto its flat
+            // extension: at 10¹⁸ m its cell's index lies past 2⁶² cells,
+            // held there (it saturated, and the next cell's overflowed).
+            let mut far = World::new();
+            far.set_gravity(DVec3::new(0.0, -9.8, 0.0));
+            far.set_integrator(kind);
+            let x = 1e18;
+            far.add_particle(
+                ParticleDef::new(0.2)
+                    .at(DVec3::new(x, terrain.height(x, 0.5) + 0.05, 0.5))
+                    .with_radius(0.02),
+            )
+            .unwrap();
+            far.add_floor(floor.clone()).unwrap();
+            worlds.push(far);
             let inside = worlds
                 .iter()
                 .filter(|w| w.particle_ids().any(|p| w.clearance(p) < -0.01))
                 .count();
             assert!(
                 inside >= 4,
-                "{ground}: only {inside} of 7 start in the ground"
+                "{ground}: only {inside} of 8 start in the ground"
             );
             let what = format!("particles in and on {ground}, {kind:?}, contact {contact}");
             assert_same(&mut worlds, 1e-3, 200, 2, &what);

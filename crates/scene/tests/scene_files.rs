@@ -208,3 +208,110 @@ fn a_restored_snapshot_of_every_shipped_scene_steps_to_the_same_bits() {
         "restored and stepped differently: {failed:?}"
     );
 }
+
+/// Hostile values in every shipped scene: each number written in a
+/// scene (the first of an array) replaced in turn by NaN, ±∞, −1, 0,
+/// 10³⁰⁰ and 10⁻³⁰⁰. Whatever the scene,
+/// its `[evolve]` and its `[morphology]` make of it, each is refused with
+/// an error or builds and steps (until it blows up, for at most 100 steps
+/// or 50 ms),
+/// never panics, and takes at most a few seconds (`dt = 1e-300` in a
+/// lattice scene once settled its start body for ever; a walker on rough
+/// ground blown up to 10³⁰⁰ m overflowed the terrain's cell index).
+#[test]
+fn hostile_numbers_in_every_shipped_scene_are_refused_or_run_never_panic() {
+    use animats_scene::evaluate::SceneProblem;
+    use animats_scene::morphology::MorphologyProblem;
+    use std::panic::{catch_unwind, AssertUnwindSafe};
+    const VALUES: [&str; 7] = ["nan", "inf", "-inf", "-1.0", "0", "1e300", "1e-300"];
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
+        .collect();
+    paths.sort();
+    let (mut cases, mut refused, mut failures) = (0, 0, Vec::new());
+    let mut slowest = (0.0, String::new());
+    for path in &paths {
+        let file = path.to_str().unwrap();
+        let text = std::fs::read_to_string(path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        for (i, line) in lines.iter().enumerate() {
+            let Some((key, value)) = line.split_once('=') else {
+                continue;
+            };
+            let (key, value) = (key.trim(), value.trim_start());
+            let is_key =
+                !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+            // The first number of the value (of an array's first element).
+            let start = value.find(|c: char| c.is_ascii_digit() || c == '-');
+            let Some(start) =
+                start.filter(|&s| is_key && value[..s].chars().all(|c| c == '[' || c == ' '))
+            else {
+                continue;
+            };
+            let end = value[start..]
+                .find(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+' | '_')))
+                .map_or(value.len(), |e| start + e);
+            let prefix = &line[..line.len() - value.len()];
+            for v in VALUES {
+                let mut edited = lines.clone();
+                let new_line = format!("{prefix}{}{v}{}", &value[..start], &value[end..]);
+                edited[i] = &new_line;
+                let text = edited.join("\n");
+                let what = format!("{file}:{}: `{}` → `{new_line}`", i + 1, line.trim());
+                let began = std::time::Instant::now();
+                let outcome = catch_unwind(AssertUnwindSafe(|| {
+                    let ok = if text.contains("[morphology]") {
+                        MorphologyProblem::parse(&text, file).is_ok()
+                    } else if text.contains("[evolve]") {
+                        SceneProblem::parse(&text, file).is_ok()
+                    } else {
+                        true
+                    };
+                    match animats_scene::parse(&text, file) {
+                        Ok(mut scene) if ok => {
+                            // 100 steps, or fewer for a step past 0.5 ms
+                            // (one of 10³⁰⁰ s, its collisions located by
+                            // halving, takes a pile of rocks 1.5 s).
+                            let steps = (0.05 / scene.dt).ceil().clamp(1.0, 100.0) as usize;
+                            for _ in 0..steps {
+                                if scene.step(scene.dt).is_err() {
+                                    break;
+                                }
+                            }
+                            true
+                        }
+                        _ => false,
+                    }
+                }));
+                let took = began.elapsed().as_secs_f64();
+                if took > slowest.0 {
+                    slowest = (took, what.clone());
+                }
+                cases += 1;
+                match outcome {
+                    Ok(true) => {}
+                    Ok(false) => refused += 1,
+                    Err(_) => failures.push(what),
+                }
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} panicked:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    assert!(
+        cases > 8000 && refused > cases / 4,
+        "{cases} cases, {refused} refused"
+    );
+    assert!(slowest.0 < 10.0, "{:.1} s: {}", slowest.0, slowest.1);
+    eprintln!(
+        "{cases} cases, {refused} refused; slowest {:.2} s: {}",
+        slowest.0, slowest.1
+    );
+}
