@@ -209,9 +209,9 @@ fn a_restored_snapshot_of_every_shipped_scene_steps_to_the_same_bits() {
     );
 }
 
-/// Hostile values in every shipped scene: each number written in a
-/// scene (the first of an array) replaced in turn by NaN, ±∞, −1, 0,
-/// 10³⁰⁰ and 10⁻³⁰⁰. Whatever the scene,
+/// Hostile values in every shipped scene: each key's line left out, and
+/// each number written (the first of an array) replaced in turn by NaN,
+/// ±∞, −1, 0, 10³⁰⁰ and 10⁻³⁰⁰. Whatever the scene,
 /// its `[evolve]` and its `[morphology]` make of it, each is refused with
 /// an error or builds and steps (until it blows up, for at most 100 steps
 /// or 50 ms),
@@ -219,7 +219,7 @@ fn a_restored_snapshot_of_every_shipped_scene_steps_to_the_same_bits() {
 /// lattice scene once settled its start body for ever; a walker on rough
 /// ground blown up to 10³⁰⁰ m overflowed the terrain's cell index).
 #[test]
-fn hostile_numbers_in_every_shipped_scene_are_refused_or_run_never_panic() {
+fn hostile_edits_of_every_shipped_scene_are_refused_or_run_never_panic() {
     use animats_scene::evaluate::SceneProblem;
     use animats_scene::morphology::MorphologyProblem;
     use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -244,21 +244,30 @@ fn hostile_numbers_in_every_shipped_scene_are_refused_or_run_never_panic() {
             let (key, value) = (key.trim(), value.trim_start());
             let is_key =
                 !key.is_empty() && key.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
-            // The first number of the value (of an array's first element).
-            let start = value.find(|c: char| c.is_ascii_digit() || c == '-');
-            let Some(start) =
-                start.filter(|&s| is_key && value[..s].chars().all(|c| c == '[' || c == ' '))
-            else {
+            if !is_key {
                 continue;
-            };
-            let end = value[start..]
-                .find(|c: char| !(c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+' | '_')))
-                .map_or(value.len(), |e| start + e);
-            let prefix = &line[..line.len() - value.len()];
-            for v in VALUES {
+            }
+            // The line left out, and the first number of the value (of an
+            // array's first element) replaced by each of VALUES.
+            let mut edits = vec![String::new()];
+            let start = value.find(|c: char| c.is_ascii_digit() || c == '-');
+            if let Some(start) = start.filter(|&s| value[..s].chars().all(|c| c == '[' || c == ' '))
+            {
+                let end = value[start..]
+                    .find(|c: char| {
+                        !(c.is_ascii_alphanumeric() || matches!(c, '.' | '-' | '+' | '_'))
+                    })
+                    .map_or(value.len(), |e| start + e);
+                let prefix = &line[..line.len() - value.len()];
+                edits.extend(
+                    VALUES
+                        .iter()
+                        .map(|v| format!("{prefix}{}{v}{}", &value[..start], &value[end..])),
+                );
+            }
+            for new_line in &edits {
                 let mut edited = lines.clone();
-                let new_line = format!("{prefix}{}{v}{}", &value[..start], &value[end..]);
-                edited[i] = &new_line;
+                edited[i] = new_line;
                 let text = edited.join("\n");
                 let what = format!("{file}:{}: `{}` → `{new_line}`", i + 1, line.trim());
                 let began = std::time::Instant::now();
