@@ -17,7 +17,11 @@ use rayon::prelude::*;
 const CHUNK: usize = 64;
 
 struct Copy<E> {
-    env: E,
+    /// Boxed: an environment may be kilobytes (a scene's is 5.7 kB), and
+    /// a million of them moved through a parallel collect, or a slot of
+    /// that size written for each copy not made after a Ctrl-C, took
+    /// seconds.
+    env: Box<E>,
     done: bool,
     seed: u64,
 }
@@ -44,7 +48,7 @@ impl<E: Env> VecEnv<E> {
         }
         let one = |k| {
             make(k).map(|env| Copy {
-                env,
+                env: Box::new(env),
                 done: false,
                 seed: 0,
             })
@@ -98,7 +102,7 @@ impl<E: Env> VecEnv<E> {
 
     /// Copy `k`, if there is one.
     pub fn get(&self, k: usize) -> Option<&E> {
-        self.copies.get(k).map(|c| &c.env)
+        self.copies.get(k).map(|c| &*c.env)
     }
 
     /// Resets every copy, copy `k` with seed `seed + k` (in parallel as
