@@ -149,11 +149,11 @@ impl MorphologyProblem {
             grid,
             batches: None,
         };
-        // The start body's own checks but its settle first (their reasons
-        // say more than a failed development would), then the [evolve]
-        // table on it (or on a random body): that bounds the steps, so that
-        // a step too small for the evaluation is refused before the settle
-        // would take as many of them.
+        // The start body's checks other than its settle first (their
+        // reasons say more than a failed development would), then the
+        // [evolve] table on it (or on a random body), which bounds the
+        // steps: a step too small for the evaluation is refused before the
+        // settle would take as many of them. The settle last.
         let refused = |problem: &MorphologyProblem, g: &[f64], r: Refusal| {
             // A settle that blew up at a step past the body's own
             // stability limit: say so.
