@@ -222,6 +222,9 @@ def test_another_thread_sees_a_run_s_progress_and_waits_for_its_log():
             # Any call but the progress waits for the run: this log is the
             # whole run's (it was "Already mutably borrowed").
             during = run.log_csv()
+            # (The thread itself ends a moment after the run lets go: under
+            # load it was still alive here.)
+            worker.join(timeout=60)
             assert not worker.is_alive()
         time.sleep(0.02)
     worker.join()
