@@ -193,10 +193,8 @@ impl NervousSystem {
         self.actuators.iter().map(|(_, a)| a.level()).collect()
     }
 
-    /// Sets every actuator's level (a program driving the creature, e.g.
-    /// from Python); controllers overwrite the ones they drive at the next
-    /// step.
-    pub fn set_levels(&mut self, world: &mut World, levels: &[f64]) -> Result<(), String> {
+    /// One level for each actuator, or an error saying how many.
+    fn check_levels(&self, levels: &[f64]) -> Result<(), String> {
         if levels.len() != self.actuators.len() {
             return Err(format!(
                 "{} levels given for {} actuators",
@@ -204,6 +202,14 @@ impl NervousSystem {
                 self.actuators.len()
             ));
         }
+        Ok(())
+    }
+
+    /// Sets every actuator's level (a program driving the creature, e.g.
+    /// from Python); controllers overwrite the ones they drive at the next
+    /// step.
+    pub fn set_levels(&mut self, world: &mut World, levels: &[f64]) -> Result<(), String> {
+        self.check_levels(levels)?;
         for ((_, a), l) in self.actuators.iter_mut().zip(levels) {
             a.set_level(world, *l);
         }
@@ -240,13 +246,7 @@ impl NervousSystem {
     /// Sets every actuator's level without touching the world: for a
     /// snapshot's restore, whose world holds the values the levels gave.
     pub fn set_levels_alone(&mut self, levels: &[f64]) -> Result<(), String> {
-        if levels.len() != self.actuators.len() {
-            return Err(format!(
-                "{} levels given for {} actuators",
-                levels.len(),
-                self.actuators.len()
-            ));
-        }
+        self.check_levels(levels)?;
         for ((_, a), l) in self.actuators.iter_mut().zip(levels) {
             a.set_level_alone(*l);
         }
@@ -303,13 +303,7 @@ impl NervousSystem {
     /// (the Python environments). Levels must be finite; they are clamped
     /// to [0, 1].
     pub fn drive(&mut self, world: &mut World, levels: &[f64], dt: f64) -> Result<(), String> {
-        if levels.len() != self.actuators.len() {
-            return Err(format!(
-                "{} levels given for {} actuators",
-                levels.len(),
-                self.actuators.len()
-            ));
-        }
+        self.check_levels(levels)?;
         if let Some(i) = levels.iter().position(|l| !l.is_finite()) {
             return Err(format!(
                 "the level of actuator `{}` is not finite: {}",

@@ -2,7 +2,19 @@
 // std's transcendental functions: an independent reference here
 #![allow(clippy::disallowed_methods)]
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+/// The `scenes/` folder and its scene files, sorted.
+fn shipped_scenes() -> (PathBuf, Vec<PathBuf>) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut paths: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
+        .collect();
+    paths.sort();
+    (dir, paths)
+}
 
 #[test]
 fn every_shipped_scene_builds_and_runs_a_second() {
@@ -128,13 +140,7 @@ fn a_particle_named_twice_in_a_list_is_refused() {
 /// oscillator's phase, a jellyfish's timer) is part of the snapshot.
 #[test]
 fn a_restored_snapshot_of_every_shipped_scene_steps_to_the_same_bits() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
-        .collect();
-    paths.sort();
+    let (dir, mut paths) = shipped_scenes();
     // The shipped CTRNN walker holds every weight at 0 (evolution writes
     // them): one with weights of its own, whose activations move.
     let ctrnn = std::fs::read_to_string(dir.join("walker_ctrnn.toml")).unwrap();
@@ -224,13 +230,7 @@ fn hostile_edits_of_every_shipped_scene_are_refused_or_run_never_panic() {
     use animats_scene::morphology::MorphologyProblem;
     use std::panic::{catch_unwind, AssertUnwindSafe};
     const VALUES: [&str; 7] = ["nan", "inf", "-inf", "-1.0", "0", "1e300", "1e-300"];
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let mut paths: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().and_then(|e| e.to_str()) == Some("toml"))
-        .collect();
-    paths.sort();
+    let (_, paths) = shipped_scenes();
     let (mut cases, mut refused, mut failures) = (0, 0, Vec::new());
     let mut slowest = (0.0, String::new());
     for path in &paths {
