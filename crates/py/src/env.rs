@@ -71,7 +71,7 @@ impl Recipe {
             .map_err(value_error)?;
         let skip = match (self.frame_skip, self.act_hz) {
             (Some(k), _) => k,
-            (None, Some(hz)) => env.frame_skip_for(hz),
+            (None, Some(hz)) => env.frame_skip_for(hz).map_err(value_error)?,
             (None, None) => 1,
         };
         let observation = self.observation.unwrap_or(env.observation());

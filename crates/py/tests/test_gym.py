@@ -44,6 +44,11 @@ def test_an_episode_of_no_steps_or_too_many_is_refused(root):
         (dict(dt=1e-300), "more than 1e12"),
         (dict(dt=float("nan")), "dt must be a positive number"),
         (dict(seconds=-1.0), "seconds must be a positive number"),
+        # An action held longer than the episode (act_hz tiny once made
+        # frame_skip 4294967295 quietly).
+        (dict(seconds=1.0, act_hz=0.5), "act_hz 0.5 asks for an action every 2 s, longer than the episode \\(1 s\\)"),
+        (dict(act_hz=1e-300), "longer than the episode"),
+        (dict(seconds=1.0, frame_skip=2001), "frame_skip 2001 holds each action longer than the episode"),
     ]:
         with pytest.raises(ValueError, match=expect):
             animats.Env(walker, **kw)
@@ -51,6 +56,8 @@ def test_an_episode_of_no_steps_or_too_many_is_refused(root):
             animats.VecEnv(walker, 2, **kw)
     e = animats.Env(walker, seconds=0.0005)
     assert e.max_steps == 1
+    assert animats.Env(walker, seconds=1.0, frame_skip=2000).max_steps == 1
+    assert animats.Env(walker, seconds=1.0, act_hz=1.0).max_steps == 1
 
 
 @pytest.mark.parametrize("observation", ["sensors", "state", "both"])

@@ -186,6 +186,14 @@ impl SceneEnv {
         if frame_skip == 0 {
             return Err("frame_skip must be at least 1".into());
         }
+        let steps = self.physics_limit();
+        if u64::from(frame_skip) > steps {
+            return Err(format!(
+                "frame_skip {frame_skip} holds each action longer than the episode ({} s, {steps} steps of {} s)",
+                animats_engine::Shown(self.spec.duration),
+                animats_engine::Shown(self.scene.dt)
+            ));
+        }
         if observation != Observation::State && self.scene.nervous.sensors.is_empty() {
             return Err(
                 "the scene has no [[sensor]]: observe its state (observation = \"state\"), or give it sensors".into(),
@@ -199,10 +207,27 @@ impl SceneEnv {
     }
 
     /// The physics steps per action that make the agent act at about
-    /// `hz` times a simulated second with the scene's step.
-    pub fn frame_skip_for(&self, hz: f64) -> u32 {
-        let dt = self.dt.unwrap_or(self.scene.dt);
-        ((1.0 / hz / dt).round() as u32).max(1)
+    /// `hz` times a simulated second with the scene's step (every step if
+    /// `hz` is faster than the steps); refused if one action would last
+    /// longer than the episode.
+    pub fn frame_skip_for(&self, hz: f64) -> Result<u32, String> {
+        let skip = (1.0 / hz / self.scene.dt).round();
+        if !(hz > 0.0 && skip <= self.physics_limit() as f64) {
+            return Err(format!(
+                "act_hz {} asks for an action every {} s, longer than the episode ({} s)",
+                animats_engine::Shown(hz),
+                animats_engine::Shown(1.0 / hz),
+                animats_engine::Shown(self.spec.duration)
+            ));
+        }
+        if skip > f64::from(u32::MAX) {
+            return Err(format!(
+                "act_hz {} asks for an action every {skip:e} steps, more than frame_skip's {}",
+                animats_engine::Shown(hz),
+                u32::MAX
+            ));
+        }
+        Ok((skip as u32).max(1))
     }
 
     /// The names of the observations, in order.

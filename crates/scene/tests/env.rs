@@ -197,3 +197,37 @@ fn the_state_is_relative_to_the_centre_of_mass() {
     assert_eq!(bounds[0], (f64::NEG_INFINITY, f64::INFINITY));
     assert_eq!(bounds[o.len() - 1], (0.0, 1.0));
 }
+
+#[test]
+fn an_action_may_last_the_whole_episode_but_no_longer() {
+    let text = pogo(); // 5 s at the pogo's step
+    let env = || SceneEnv::parse(&text, "pogo.toml", 0.0).unwrap();
+    let steps = env().max_steps();
+    // One action for the whole episode is an open-loop creature: allowed.
+    let whole = env().with_actions(steps as u32, Observation::Both).unwrap();
+    assert_eq!(whole.max_steps(), 1);
+    let err = env()
+        .with_actions(steps as u32 + 1, Observation::Both)
+        .err()
+        .expect("an action longer than the episode");
+    assert!(
+        err.contains(&format!("frame_skip {}", steps + 1)) && err.contains("5 s"),
+        "{err}"
+    );
+    // act_hz: about 50 Hz is 1/(50 dt) steps; faster than the steps is
+    // every step; one action in 10 s of a 5 s episode is refused, and so
+    // is a rate whose steps overflow frame_skip.
+    let dt = env().scene().dt;
+    assert_eq!(
+        env().frame_skip_for(50.0),
+        Ok((1.0 / 50.0 / dt).round() as u32)
+    );
+    assert_eq!(env().frame_skip_for(1e9), Ok(1));
+    assert_eq!(env().frame_skip_for(0.2), Ok(steps as u32));
+    let err = env().frame_skip_for(0.1).unwrap_err();
+    assert!(
+        err.contains("act_hz 0.1 asks for an action every 10 s, longer than the episode (5 s)"),
+        "{err}"
+    );
+    assert!(env().frame_skip_for(1e-300).is_err());
+}
