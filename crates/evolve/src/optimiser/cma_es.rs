@@ -6,8 +6,9 @@
 //! gets negative weights (scaled as the tutorial's α⁻ terms say, and each
 //! of those steps rescaled to length √n in C's metric) that shrink C along
 //! directions that failed. The eigendecomposition of C is refreshed every
-//! `λ / (c1 + cμ) / n / 10` evaluations (cyclic Jacobi: small, exact and
-//! deterministic).
+//! `λ / (c1 + cμ) / n / 10` evaluations ([`super::eigen`]: Jacobi
+//! rotations up to 64 genes, Householder and QL above; both the same bits
+//! on every platform).
 //!
 //! It minimises internally; [`Optimiser`] maximises, so fitness is negated.
 //!
@@ -30,6 +31,7 @@
 //! generation's values (at least 1e-9 × max(1, |median|)), so that a
 //! candidate outside the box ranks below an equal one inside.
 
+use super::eigen::symmetric_eigen;
 use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
 use animats_engine::math;
 use serde::{Deserialize, Serialize};
@@ -274,7 +276,7 @@ impl CmaEs {
                 self.c[j * n + i] = v;
             }
         }
-        let (values, vectors) = jacobi_eigen(&self.c, n);
+        let (values, vectors) = symmetric_eigen(&self.c, n);
         self.d = values.iter().map(|v| v.max(1e-300).sqrt()).collect();
         self.b = vectors;
     }
@@ -481,131 +483,5 @@ impl Optimiser for CmaEs {
 
     fn generation(&self) -> u64 {
         self.generation
-    }
-}
-
-/// Eigenvalues and eigenvectors (as the columns of a row-major matrix) of a
-/// symmetric `n × n` matrix, by cyclic Jacobi rotations.
-///
-/// The eigenvectors are accumulated as rows (`vt`, the transpose of the
-/// result), so that each rotation updates two contiguous rows of them
-/// instead of two columns `n` apart: the same operations on the same
-/// numbers, so the same bits, a 100 × 100 matrix in 57 % of the time
-/// (docs/PERFORMANCE.md). The matrix's own column update stays strided:
-/// rounding leaves it not exactly symmetric, so its columns cannot be read
-/// from its rows.
-pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
-    let mut a = m.to_vec();
-    let mut vt = vec![0.0; n * n];
-    for i in 0..n {
-        vt[i * n + i] = 1.0;
-    }
-    for _sweep in 0..100 {
-        let off: f64 = (0..n)
-            .flat_map(|i| (0..n).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i * n + j] * a[i * n + j])
-            .sum();
-        let diag: f64 = (0..n).map(|i| a[i * n + i] * a[i * n + i]).sum();
-        if off <= 1e-30 * diag || off == 0.0 {
-            break;
-        }
-        for p in 0..n {
-            for q in p + 1..n {
-                let apq = a[p * n + q];
-                if apq == 0.0 {
-                    continue;
-                }
-                let theta = (a[q * n + q] - a[p * n + p]) / (2.0 * apq);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for k in 0..n {
-                    let akp = a[k * n + p];
-                    let akq = a[k * n + q];
-                    a[k * n + p] = c * akp - s * akq;
-                    a[k * n + q] = s * akp + c * akq;
-                }
-                let (head, tail) = a.split_at_mut(q * n);
-                let (ap, aq) = (&mut head[p * n..(p + 1) * n], &mut tail[..n]);
-                for (apk, aqk) in ap.iter_mut().zip(aq.iter_mut()) {
-                    let (x, y) = (*apk, *aqk);
-                    *apk = c * x - s * y;
-                    *aqk = s * x + c * y;
-                }
-                let (head, tail) = vt.split_at_mut(q * n);
-                let (vp, vq) = (&mut head[p * n..(p + 1) * n], &mut tail[..n]);
-                for (vkp, vkq) in vp.iter_mut().zip(vq.iter_mut()) {
-                    let (x, y) = (*vkp, *vkq);
-                    *vkp = c * x - s * y;
-                    *vkq = s * x + c * y;
-                }
-            }
-        }
-    }
-    let mut v = vec![0.0; n * n];
-    for (i, row) in vt.chunks_exact(n.max(1)).enumerate() {
-        for (k, &x) in row.iter().enumerate() {
-            v[k * n + i] = x;
-        }
-    }
-    ((0..n).map(|i| a[i * n + i]).collect(), v)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::jacobi_eigen;
-    use crate::optimiser::Random;
-
-    /// Each pair is an eigenpair (‖A v − λ v‖ within 1e-12 of ‖A‖), the
-    /// vectors orthonormal to 1e-13, and the values sum to the trace, for
-    /// random symmetric matrices and covariances B Bᵀ of 1 to 100 rows.
-    #[test]
-    fn jacobi_gives_orthonormal_eigenpairs() {
-        let mut rng = Random::for_entry(7, 0);
-        let mut rnd = || rng.uniform() - 0.5;
-        for n in [1usize, 2, 3, 7, 16, 33, 100] {
-            for covariance in [false, true] {
-                let mut m = vec![0.0; n * n];
-                for i in 0..n {
-                    for j in i..n {
-                        let x = rnd();
-                        m[i * n + j] = x;
-                        m[j * n + i] = x;
-                    }
-                }
-                if covariance {
-                    let b = m.clone();
-                    for i in 0..n {
-                        for j in 0..n {
-                            m[i * n + j] = (0..n).map(|k| b[i * n + k] * b[j * n + k]).sum();
-                        }
-                    }
-                }
-                let norm = m.iter().map(|x| x * x).sum::<f64>().sqrt();
-                let (values, v) = jacobi_eigen(&m, n);
-                for (i, &l) in values.iter().enumerate() {
-                    let residual = (0..n)
-                        .map(|r| {
-                            let av: f64 = (0..n).map(|k| m[r * n + k] * v[k * n + i]).sum();
-                            (av - l * v[r * n + i]).powi(2)
-                        })
-                        .sum::<f64>()
-                        .sqrt();
-                    assert!(residual <= 1e-12 * norm, "n {n}, pair {i}: {residual}");
-                    if covariance {
-                        assert!(l >= -1e-12 * norm, "n {n}: a covariance's value {l}");
-                    }
-                    for j in 0..n {
-                        let dot: f64 = (0..n).map(|k| v[k * n + i] * v[k * n + j]).sum();
-                        let want = if i == j { 1.0 } else { 0.0 };
-                        assert!((dot - want).abs() <= 1e-13, "n {n}: vᵢ·vⱼ {dot}");
-                    }
-                }
-                let trace: f64 = (0..n).map(|i| m[i * n + i]).sum();
-                let sum: f64 = values.iter().sum();
-                assert!((trace - sum).abs() <= 1e-12 * norm.max(1.0), "n {n}");
-            }
-        }
     }
 }

@@ -20,7 +20,7 @@
 //! a candidate outside [0, 1] is drawn again (up to [`RESAMPLES`] times,
 //! then clipped), as pyribs resamples out-of-bounds solutions.
 
-use super::cma_es::jacobi_eigen;
+use super::eigen::symmetric_eigen;
 use super::{gaussian, Random};
 use crate::archive::Added;
 use serde::{Deserialize, Serialize};
@@ -140,7 +140,7 @@ impl CmaEmitter {
                 self.cov[i * n + j] = self.cov[j * n + i];
             }
         }
-        let (values, vectors) = jacobi_eigen(&self.cov, n);
+        let (values, vectors) = symmetric_eigen(&self.cov, n);
         self.eigenvalues = values.iter().map(|v| v.abs().max(1e-300)).collect();
         self.basis = vectors;
         let max = self.eigenvalues.iter().cloned().fold(0.0, f64::max);
