@@ -11,9 +11,9 @@
 //! in EISPACK), every inner loop along a contiguous row: about 9 n³
 //! operations against Jacobi's 6 n³ for each of its several sweeps. One
 //! thread, a dense covariance (`cargo run --release -p animats-bench
-//! --example cma_es_genes`, Intel Xeon, 2026-12-03): Jacobi 0.071, 7.8,
-//! 280 ms at 20, 100, 300 rows, minutes at 1,000; Householder-QL 0.019,
-//! 1.2, 25, 1,130 ms.
+//! --example cma_es_genes`, Intel Xeon, 2026-12-03): Jacobi 0.065, 7.0,
+//! 265 ms at 20, 100, 300 rows, minutes at 1,000; Householder-QL 0.018,
+//! 1.1, 23, 980 ms.
 
 /// The largest covariance decomposed by Jacobi rotations; larger ones by
 /// Householder and QL.

@@ -158,7 +158,7 @@ pub const MAX_GENES: usize = 1_000_000;
 
 /// The most genes CMA-ES and CMA-ME take: their covariance holds n²
 /// numbers (800 MB at this size) and its decomposition costs n³ (at 1,000
-/// genes 1.1 s a decomposition, 0.13 s a generation, on one core of an
+/// genes 0.98 s a decomposition, 0.13 s a generation, on one core of an
 /// Intel Xeon: `cargo run --release -p animats-bench --example
 /// cma_es_genes`).
 pub const MAX_CMA_GENES: usize = 10_000;
