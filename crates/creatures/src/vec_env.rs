@@ -11,6 +11,10 @@
 
 use crate::env::{Env, Transition};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// What a step or reset stopped by its flag returns.
+pub const INTERRUPTED: &str = "interrupted";
 
 /// Copies stepped per rayon task: below this, threads cost more than they
 /// save (a roobot step is about a microsecond, waking a thread 100 µs).
@@ -108,7 +112,16 @@ impl<E: Env> VecEnv<E> {
     /// Resets every copy, copy `k` with seed `seed + k` (in parallel as
     /// [`VecEnv::step`]).
     pub fn reset(&mut self, seed: u64) -> Result<(), String> {
+        self.reset_unless(seed, &AtomicBool::new(false))
+    }
+
+    /// [`VecEnv::reset`], which copies not yet reset when `stop` is set
+    /// refuse with [`INTERRUPTED`]: the copies are then part reset.
+    pub fn reset_unless(&mut self, seed: u64, stop: &AtomicBool) -> Result<(), String> {
         let one = |(k, c): (usize, &mut Copy<E>)| {
+            if stop.load(Ordering::Relaxed) {
+                return Err(INTERRUPTED.to_string());
+            }
             c.seed = seed.wrapping_add(k as u64);
             c.env.reset(c.seed)?;
             c.done = false;
@@ -137,6 +150,17 @@ impl<E: Env> VecEnv<E> {
     /// row-major) and writes the transitions into `out` (`len` long). A copy
     /// whose episode ended at the previous call is reset instead.
     pub fn step(&mut self, actions: &[f64], out: &mut [Transition]) -> Result<(), String> {
+        self.step_unless(actions, out, &AtomicBool::new(false))
+    }
+
+    /// [`VecEnv::step`], which copies not yet stepped when `stop` is set
+    /// refuse with [`INTERRUPTED`]: the copies are then part stepped.
+    pub fn step_unless(
+        &mut self,
+        actions: &[f64],
+        out: &mut [Transition],
+        stop: &AtomicBool,
+    ) -> Result<(), String> {
         let n = self.copies.len();
         if actions.len() != n * self.act {
             return Err(format!(
@@ -157,6 +181,9 @@ impl<E: Env> VecEnv<E> {
         }
         let act = self.act;
         let one = |(c, (a, t)): (&mut Copy<E>, (&[f64], &mut Transition))| {
+            if stop.load(Ordering::Relaxed) {
+                return Err(INTERRUPTED.to_string());
+            }
             if c.done {
                 // Each copy's own stream of seeds: the same whatever the threads.
                 c.seed = c.seed.wrapping_add(n as u64);

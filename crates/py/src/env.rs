@@ -309,7 +309,15 @@ pub struct VecEnv {
     /// `render` frames: the same for every copy and every reset (a reset's
     /// noise is in the velocities only).
     body: Vec<(animats_engine::DVec3, f64)>,
+    /// A Ctrl-C stopped the last step or reset part way: some copies moved
+    /// on, others not, until a reset.
+    part_done: std::sync::atomic::AtomicBool,
 }
+
+/// Copies reset, or copies × physics steps stepped, from which a Ctrl-C
+/// is listened for (a walker's step is about a microsecond, its reset
+/// 10 µs: below this, tens of milliseconds at most).
+const LONG: usize = 1 << 14;
 
 type Stepped<'py> = (
     Bound<'py, PyArray2<f64>>,
@@ -321,6 +329,28 @@ type Stepped<'py> = (
 impl VecEnv {
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, RustVecEnv<SceneEnv>>> {
         crate::lock(&self.env, "environment")
+    }
+
+    /// `work` (a step or reset of every copy, told to stop by its flag)
+    /// with the GIL released; if it is `long`, a Ctrl-C stops it part way
+    /// and marks the copies part done. (Listening costs a hand-over to
+    /// another thread, 25 µs a call: more than a step of a few copies.)
+    fn interruptible(
+        &self,
+        py: Python<'_>,
+        long: bool,
+        work: impl FnOnce(&std::sync::atomic::AtomicBool) -> Result<(), String> + Send,
+    ) -> PyResult<Result<(), String>> {
+        use std::sync::atomic::Ordering;
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        if !long {
+            return Ok(py.detach(|| work(&stop)));
+        }
+        let out = crate::interruptible(py, &None, &stop, || work(&stop));
+        if out.is_err() {
+            self.part_done.store(true, Ordering::Relaxed);
+        }
+        out
     }
 }
 
@@ -376,6 +406,7 @@ impl VecEnv {
         Ok(VecEnv {
             body: body(v.first()),
             env: Mutex::new(v),
+            part_done: std::sync::atomic::AtomicBool::new(false),
             transitions: Mutex::new(vec![
                 Transition {
                     reward: 0.0,
@@ -393,7 +424,11 @@ impl VecEnv {
     fn reset<'py>(&self, py: Python<'py>, seed: u64) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let mut v = self.lock()?;
         let env = &mut *v;
-        py.detach(|| env.reset(seed)).map_err(runtime_error)?;
+        let long = env.len() >= LONG;
+        self.interruptible(py, long, |stop| env.reset_unless(seed, stop))?
+            .map_err(runtime_error)?;
+        self.part_done
+            .store(false, std::sync::atomic::Ordering::Relaxed);
         observations(py, &v)
     }
 
@@ -416,10 +451,17 @@ impl VecEnv {
                 shape[1]
             )));
         }
+        if self.part_done.load(std::sync::atomic::Ordering::Relaxed) {
+            return Err(value_error(
+                "a Ctrl-C stopped the last step or reset part way, some copies moved on and others not: call reset",
+            ));
+        }
         let a = &*crate::elements(&actions);
         let env = &mut *v;
         let t = &mut *out;
-        py.detach(|| env.step(a, t)).map_err(value_error)?;
+        let long = env.len() as u64 * u64::from(env.first().frame_skip()) >= LONG as u64;
+        self.interruptible(py, long, |stop| env.step_unless(a, t, stop))?
+            .map_err(value_error)?;
         let rewards = PyArray1::from_vec(py, out.iter().map(|t| t.reward).collect());
         let terminated = PyArray1::from_vec(py, out.iter().map(|t| t.terminated).collect());
         let truncated = PyArray1::from_vec(py, out.iter().map(|t| t.truncated).collect());

@@ -538,6 +538,33 @@ def test_ctrl_c_stops_the_making_of_a_large_vector_environment(root, ctrl_c):
     assert np.array_equal(o[2], one.step(a[2])[0])
 
 
+def test_ctrl_c_stops_a_long_step_of_a_vector_environment_which_must_then_be_reset(root, ctrl_c):
+    # 512 walkers each holding its action for the whole 10 s episode:
+    # about 2.5 s a step on two cores; Ctrl-C 0.15 s in stops it.
+    walker = str(root / "scenes" / "walker.toml")
+    v = animats.VecEnv(walker, 512, frame_skip=20_000)
+    v.reset(5)
+    a = np.full((512, len(v.action_names)), 0.7)
+    began = time.monotonic()
+    with ctrl_c(0.15), pytest.raises(KeyboardInterrupt):
+        v.step(a)
+    assert time.monotonic() - began < 1.5
+    # Some copies stepped, others not: stepping on is refused until a reset.
+    with pytest.raises(ValueError, match="call reset"):
+        v.step(a)
+    # Reset, it is a fresh one's equal: the same observations, and after a
+    # (whole) step the same as a single environment's.
+    o = v.reset(5)
+    fresh = animats.VecEnv(walker, 512, frame_skip=20_000)
+    assert np.array_equal(o, fresh.reset(5))
+    o, r, terminated, truncated = v.step(a)
+    one = animats.Env(walker, frame_skip=20_000)
+    one.reset(5 + 511)
+    o1, r1, *_ = one.step(a[511])
+    assert np.array_equal(o[511], o1) and r[511] == r1
+    assert truncated.all() or terminated.any()
+
+
 def test_an_optimiser_of_too_many_genes_is_refused():
     # (dim=2**40 hung, making 8 TB of zeros.)
     with pytest.raises(ValueError, match="more than any optimiser takes"):

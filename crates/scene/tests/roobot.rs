@@ -415,3 +415,40 @@ fn a_vector_of_roobots_is_the_same_bits_on_any_thread_count() {
     // The noise makes the copies differ.
     assert_ne!(o1[0..4], o1[4..8]);
 }
+
+/// A step or reset told to stop before it starts moves no copy and says
+/// so; untold, the same vector steps on as one never told.
+#[test]
+fn a_vector_step_told_to_stop_moves_no_copy() {
+    use std::sync::atomic::AtomicBool;
+    let make = || {
+        VecEnv::new(200, 3, |_| {
+            SceneEnv::parse(HOP_EVOLVER, HOP_EVOLVER_FILE, 0.05).map_err(|e| e.to_string())
+        })
+        .unwrap()
+    };
+    let transition = animats_creatures::env::Transition {
+        reward: 0.0,
+        terminated: false,
+        truncated: false,
+    };
+    let (mut v, mut w) = (make(), make());
+    let (mut out, mut out_w) = (vec![transition; 200], vec![transition; 200]);
+    let actions = vec![0.6; 200 * 3];
+    let (mut before, mut after) = (vec![0.0; 200 * 4], vec![0.0; 200 * 4]);
+    v.observe(&mut before);
+    let stop = AtomicBool::new(true);
+    let err = v.step_unless(&actions, &mut out, &stop).unwrap_err();
+    assert_eq!(err, animats_creatures::vec_env::INTERRUPTED);
+    v.observe(&mut after);
+    assert_eq!(before, after, "no copy moved");
+    assert!(v.reset_unless(9, &stop).is_err());
+    for _ in 0..50 {
+        v.step(&actions, &mut out).unwrap();
+        w.step(&actions, &mut out_w).unwrap();
+    }
+    v.observe(&mut before);
+    w.observe(&mut after);
+    assert_eq!(before, after);
+    assert_eq!(out, out_w);
+}
