@@ -244,6 +244,19 @@ impl Config {
         Ok(())
     }
 
+    /// Lane `lane`'s optimiser as the run starts it.
+    pub fn fresh_optimiser(
+        &self,
+        problem: &dyn Problem,
+        lane: usize,
+    ) -> Result<AnyOptimiser, String> {
+        AnyOptimiser::with_archive(
+            &self.setup(problem, lane),
+            problem.grid(),
+            problem.variation().is_some(),
+        )
+    }
+
     /// The optimiser of lane `lane` for `problem`.
     pub fn setup(&self, problem: &dyn Problem, lane: usize) -> Setup {
         let bounds = if self.optimiser == OptimiserKind::HillClimber && problem.relative_mutation()
@@ -437,11 +450,7 @@ impl State {
                     lane,
                     generation: 0,
                     evaluations: 0,
-                    optimiser: AnyOptimiser::with_archive(
-                        &config.setup(problem.as_ref(), lane),
-                        problem.grid(),
-                        problem.variation().is_some(),
-                    )?,
+                    optimiser: config.fresh_optimiser(problem.as_ref(), lane)?,
                     best: None,
                     ahead: None,
                 })
@@ -510,6 +519,28 @@ impl State {
         }
         if self.log.iter().any(|r| r.lane >= self.lanes.len()) {
             return Err("a log row names a lane that does not exist".into());
+        }
+        // Each lane's optimiser against the one the run's own scene and
+        // settings make: a state edited into another shape is refused here,
+        // not met part way through a generation.
+        let problem = self.config.problem.build()?;
+        let variation = problem.variation();
+        for l in &self.lanes {
+            let fresh = self.config.fresh_optimiser(problem.as_ref(), l.lane)?;
+            let lane = |e: String| format!("lane {}'s optimiser: {e}", l.lane);
+            l.optimiser.check_state(&fresh, variation).map_err(lane)?;
+            let genome = |what: &str, g: &[f64]| match variation {
+                Some(_) => crate::optimiser::check_body(what, g, variation),
+                None => crate::optimiser::check_genome(what, g, problem.dim()),
+            };
+            if let Some(b) = &l.best {
+                genome("its best", &b.genome).map_err(lane)?;
+            }
+            if let Some(a) = &l.ahead {
+                for (k, g) in a.population.iter().enumerate() {
+                    genome(&format!("candidate {k} asked ahead"), g).map_err(lane)?;
+                }
+            }
         }
         Ok(())
     }

@@ -529,3 +529,100 @@ fn outcomes_the_archive_refuses_leave_the_run_as_it_was() {
     assert_eq!(s.log_csv(), never.log_csv());
     assert_eq!(s, never);
 }
+
+/// `state` as a checkpoint after `edit` of its JSON, written with its
+/// checksum made again: what loading it says.
+fn load_edited(state: &State, edit: &dyn Fn(&mut serde_json::Value)) -> Result<State, String> {
+    let mut v = serde_json::to_value(state).unwrap();
+    edit(&mut v);
+    let edited: State = serde_json::from_value(v).unwrap();
+    let dir = std::env::temp_dir().join(format!("animats-edited-bodies-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("checkpoint.json");
+    checkpoint::save(&path, &edited).unwrap();
+    let out = checkpoint::load(&path);
+    let _ = std::fs::remove_dir_all(&dir);
+    out
+}
+
+/// A checkpoint of a body GA, of MAP-Elites over bodies and of CMA-ME
+/// edited into a state its run could not have made is refused as it loads,
+/// naming the lane and the part: a body the scene's [morphology] does not
+/// accept (a parent, an elite), a population or batch of 2^40, a CMA-ME
+/// emitter's mean one short. Untouched, each loads as it was saved.
+#[test]
+fn an_edited_body_or_archive_checkpoint_is_refused_unless_its_run_could_have_made_it() {
+    use serde_json::json;
+    let archive = "[archive]\nmeasures = [{ kind = \"size\" }, { kind = \"feet\" }]\nbins = [4, 4]\nranges = [[0.0, 0.4], [0.0, 8.0]]\n";
+    let hop_map = ProblemSpec {
+        file: "hop_map.toml".into(),
+        text: include_str!("../../../scenes/hop_map.toml").into(),
+    };
+    let cma_me = Choices {
+        lanes: Some(1),
+        generations: Some(3),
+        seed: Some(5),
+        optimiser: Some(animats_evolve::OptimiserKind::CmaMe),
+        ..Choices::default()
+    };
+    type Edit = Box<dyn Fn(&mut serde_json::Value)>;
+    type Case = (&'static str, Config, Vec<(Edit, &'static str)>);
+    let set = |pointer: &'static str, to: serde_json::Value| -> Edit {
+        Box::new(move |v| *v.pointer_mut(pointer).unwrap() = to.clone())
+    };
+    let cases: Vec<Case> = vec![
+        (
+            "body GA",
+            config(GRAPH, 3),
+            vec![
+                (
+                    set("/lanes/0/optimiser/parents/0/0", json!([1.0, 2.0])),
+                    "lane 0's optimiser: parent 0 is not a body of the scene's [morphology]",
+                ),
+                (
+                    set("/lanes/0/optimiser/size", json!(1u64 << 40)),
+                    "lane 0's optimiser: its population's size",
+                ),
+            ],
+        ),
+        (
+            "MAP-Elites over bodies",
+            map_elites(&format!("{GRAPH}{archive}"), 3),
+            vec![
+                (
+                    set("/lanes/0/optimiser/archive/elites/0/genome", json!([1.0])),
+                    "lane 0's optimiser: the elite of cell",
+                ),
+                (
+                    set("/lanes/0/optimiser/emitters/0/batch", json!(1u64 << 40)),
+                    "lane 0's optimiser: emitter 0 is not",
+                ),
+            ],
+        ),
+        (
+            "CMA-ME",
+            Config::new(hop_map, &cma_me).unwrap(),
+            vec![(
+                Box::new(|v: &mut serde_json::Value| {
+                    let mean = v.pointer_mut("/lanes/0/optimiser/emitters/0/mean").unwrap();
+                    mean.as_array_mut().unwrap().pop();
+                }),
+                "lane 0's optimiser: emitter 0: its mean: 13 numbers, not 14",
+            )],
+        ),
+    ];
+    for (name, config, edits) in cases {
+        let mut s = State::new(config).unwrap();
+        pool(2).install(|| s.advance(2)).unwrap();
+        assert_eq!(load_edited(&s, &|_| {}).unwrap(), s, "{name}");
+        for (edit, expected) in edits {
+            match load_edited(&s, &*edit) {
+                Ok(_) => panic!("{name}: an edit that should say \"{expected}\" loaded"),
+                Err(e) => assert!(
+                    e.contains("the checkpoint is inconsistent") && e.contains(expected),
+                    "{name}: {e}"
+                ),
+            }
+        }
+    }
+}

@@ -4,7 +4,8 @@
 //! of pycma's, measured by `reference/pycma.py` into `reference/pycma.json`
 //! (same start, step size and population; see the script); and in 120
 //! dimensions, where the covariance is decomposed by another method, on
-//! the sphere and an ellipsoid. Also: the
+//! the sphere and an ellipsoid. Also: every state a run passes through,
+//! restarts included, is one a checkpoint may hold; the
 //! optimiser is a pure function of its seed, and a checkpointed state
 //! resumes to the same bits.
 // std's transcendental functions: an independent reference here
@@ -236,6 +237,7 @@ fn restarts_double_the_population_and_find_lower_minima_on_rastrigin() {
             restarts,
         };
         let mut o = AnyOptimiser::new(&setup).unwrap();
+        let fresh = o.clone();
         let (mut count, mut largest) = (0, 0);
         while count < budget {
             let pop = o.ask();
@@ -243,6 +245,11 @@ fn restarts_double_the_population_and_find_lower_minima_on_rastrigin() {
             count += pop.len();
             let v: Vec<f64> = pop.iter().map(|x| -rastrigin(x)).collect();
             o.tell(&v).unwrap();
+            // Every state a run passes through, restarts included, is one a
+            // checkpoint may hold.
+            if let Err(e) = o.check_state(&fresh, None) {
+                panic!("seed {seed}, {count} evaluations: {e}");
+            }
         }
         let done = match &o {
             AnyOptimiser::CmaEs(c) => c.restarts_done,

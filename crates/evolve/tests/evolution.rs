@@ -168,6 +168,135 @@ fn corrupt_checkpoints_are_refused() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// `state` as a checkpoint after `edit` of its JSON, written with its
+/// checksum made again (as a hand edit or another program could): what
+/// loading it says.
+pub fn load_edited(
+    state: &State,
+    path: &std::path::Path,
+    edit: &dyn Fn(&mut serde_json::Value),
+) -> Result<State, String> {
+    let mut v = serde_json::to_value(state).unwrap();
+    edit(&mut v);
+    let edited: State = serde_json::from_value(v).unwrap();
+    checkpoint::save(path, &edited).unwrap();
+    checkpoint::load(path)
+}
+
+/// An edit: the number at `pointer` set to `to`.
+fn set(pointer: &'static str, to: serde_json::Value) -> Box<dyn Fn(&mut serde_json::Value)> {
+    Box::new(move |v| *v.pointer_mut(pointer).unwrap() = to.clone())
+}
+
+/// An edit: the last element of the array at `pointer` left out.
+fn shorten(pointer: &'static str) -> Box<dyn Fn(&mut serde_json::Value)> {
+    Box::new(move |v| {
+        v.pointer_mut(pointer)
+            .unwrap()
+            .as_array_mut()
+            .unwrap()
+            .pop();
+    })
+}
+
+/// A checkpoint whose optimiser was edited into a state its run could not
+/// have made (found by fuzzing: a population of 2^63 or a vector one short
+/// panicked part way through the next generation) is refused as it loads,
+/// naming the lane and the part, for the hill climber, the GA and CMA-ES;
+/// untouched, each loads as it was saved.
+#[test]
+fn an_edited_checkpoint_is_refused_unless_its_run_could_have_made_it() {
+    use animats_evolve::{Choices, OptimiserKind, ProblemSpec};
+    use serde_json::json;
+    let dir = scratch("edited");
+    let path = dir.join("checkpoint.json");
+    type Edits = Vec<(Box<dyn Fn(&mut serde_json::Value)>, &'static str)>;
+    let cases: Vec<(OptimiserKind, Edits)> = vec![
+        (
+            OptimiserKind::HillClimber,
+            vec![
+                (
+                    set("/lanes/0/optimiser/population", json!(1u64 << 63)),
+                    "lane 0's optimiser: its population",
+                ),
+                (
+                    set("/lanes/1/optimiser/start/0", json!(7.0)),
+                    "lane 1's optimiser: its start",
+                ),
+                (
+                    set("/lanes/1/optimiser/best/genome", json!([1.0])),
+                    "lane 1's optimiser: the best has 1 genes, not 14",
+                ),
+            ],
+        ),
+        (
+            OptimiserKind::Ga,
+            vec![
+                (
+                    set("/lanes/0/optimiser/size", json!(1u64 << 63)),
+                    "lane 0's optimiser: its population's size",
+                ),
+                (
+                    shorten("/lanes/1/optimiser/fitness"),
+                    "lane 1's optimiser: a population of 32 with 31 fitnesses",
+                ),
+                (
+                    set("/lanes/0/optimiser/bounds/hi/0", json!(-1.0)),
+                    "lane 0's optimiser: its bounds",
+                ),
+            ],
+        ),
+        (
+            OptimiserKind::CmaEs,
+            vec![
+                (
+                    shorten("/lanes/0/optimiser/d"),
+                    "lane 0's optimiser: its axes' lengths: 13 numbers, not 14",
+                ),
+                (
+                    set("/lanes/1/optimiser/sigma", json!(-1.0)),
+                    "lane 1's optimiser: its σ: a number that is not finite and above 0",
+                ),
+                (
+                    set("/lanes/0/optimiser/lambda", json!(12)),
+                    "lane 0's optimiser: its population",
+                ),
+                (
+                    set("/lanes/0/optimiser/restarts_done", json!(40)),
+                    "lane 0's optimiser: its restarts",
+                ),
+                (
+                    set("/lanes/1/optimiser/pending", json!([[1.0]])),
+                    "lane 1's optimiser: 1 candidates pending in a population of 11",
+                ),
+            ],
+        ),
+    ];
+    for (kind, edits) in cases {
+        let choices = Choices {
+            lanes: Some(2),
+            generations: Some(3),
+            seed: Some(5),
+            optimiser: Some(kind),
+            ..Choices::default()
+        };
+        let config = Config::new(ProblemSpec::thesis(), &choices).unwrap();
+        let mut s = State::new(config).unwrap();
+        pool(2).install(|| s.advance(2)).unwrap();
+        assert_eq!(load_edited(&s, &path, &|_| {}).unwrap(), s, "{kind:?}");
+        for (edit, expected) in edits {
+            match load_edited(&s, &path, &*edit) {
+                Ok(_) => panic!("{kind:?}: an edit that should say \"{expected}\" loaded"),
+                Err(e) => assert!(
+                    e.contains("the checkpoint is inconsistent") && e.contains(expected),
+                    "{kind:?}: {e}"
+                ),
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The thesis's result (§5.4) in a run small enough for CI: with 6 lanes
 /// and 100 generations, at least 4 of 6 lanes evolve a stable hop (20 s
 /// upright) — for each of three seeds — and a longer run keeps improving.

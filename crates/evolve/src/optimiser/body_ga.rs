@@ -15,7 +15,7 @@
 //! - Parents and children together, best first (parents first among
 //!   equals), the best `P` survive.
 
-use super::{check_told, sane, BestSoFar, Random};
+use super::{check_body, check_same, check_told, sane, BestSoFar, Random};
 use crate::screen::Screen;
 use animats_scene::morphology::vary::RETRIES;
 use rayon::prelude::*;
@@ -160,6 +160,47 @@ impl BodyGa {
             refused: BTreeMap::new(),
             kept: 0,
         }
+    }
+
+    /// A checkpoint's body GA against the one its run's configuration
+    /// makes (`fresh`): the same set-up; at most its size in parents and
+    /// none or all of its children asked, each a body `variation`
+    /// accepts.
+    pub(crate) fn check_state(
+        &self,
+        fresh: &BodyGa,
+        variation: Option<&dyn Variation>,
+    ) -> Result<(), String> {
+        check_same(
+            "its seed and lane",
+            &(self.seed, self.lane),
+            &(fresh.seed, fresh.lane),
+        )?;
+        check_same("its population's size", &self.size, &fresh.size)?;
+        if self.parents.len() > self.size
+            || !(self.asked.is_empty() || self.asked.len() == self.size)
+        {
+            return Err(format!(
+                "{} parents and {} children asked in a population of {}",
+                self.parents.len(),
+                self.asked.len(),
+                self.size
+            ));
+        }
+        for (k, (g, f)) in self.parents.iter().enumerate() {
+            if f.is_nan() {
+                return Err(format!("parent {k}'s fitness is not a number"));
+            }
+            check_body(&format!("parent {k}"), g, variation)?;
+        }
+        for (k, g) in self.asked.iter().enumerate() {
+            check_body(&format!("child {k}"), g, variation)?;
+        }
+        self.best.check(None)?;
+        if let Some((g, _)) = self.best.get() {
+            check_body("the best", g, variation)?;
+        }
+        Ok(())
     }
 
     /// The next generation's children, made and checked by `variation`.

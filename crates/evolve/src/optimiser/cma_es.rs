@@ -32,7 +32,10 @@
 //! candidate outside the box ranks below an equal one inside.
 
 use super::eigen::symmetric_eigen;
-use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{
+    check_genomes, check_numbers, check_same, check_told, gaussian, sane, BestSoFar, Bounds,
+    Optimiser, Random, Setup,
+};
 use animats_engine::math;
 use serde::{Deserialize, Serialize};
 
@@ -182,6 +185,89 @@ impl CmaEs {
             run_best: None,
             stale: 0,
         }
+    }
+
+    /// A checkpoint's strategy against the one its run's configuration
+    /// makes (`fresh`): the same set-up; a population of the configured
+    /// one doubled at each restart done, with the parameters that
+    /// population gives; every vector and matrix of its genome's size and
+    /// finite, σ and the axes' lengths above 0.
+    pub(crate) fn check_state(&self, fresh: &CmaEs) -> Result<(), String> {
+        check_same(
+            "its seed and lane",
+            &(self.seed, self.lane),
+            &(fresh.seed, fresh.lane),
+        )?;
+        check_same(
+            "its start",
+            &(self.n, &self.start),
+            &(fresh.n, &fresh.start),
+        )?;
+        check_same("its bounds", &self.bounds, &fresh.bounds)?;
+        check_same("its initial step size", &self.sigma0, &fresh.sigma0)?;
+        let restarts = self.restarts_done.checked_add(self.restarts_left);
+        check_same("its restarts", &restarts, &Some(fresh.restarts_left))?;
+        // (IPOP doubles the population at each restart; a run of 2^24
+        // candidates a generation is not one that ran.)
+        let lambda = fresh
+            .lambda
+            .checked_shl(self.restarts_done)
+            .filter(|l| *l <= 1 << 24 && l >> self.restarts_done == fresh.lambda);
+        check_same("its population", &Some(self.lambda), &lambda)?;
+        let reference = CmaEs::new(&Setup {
+            kind: crate::optimiser::OptimiserKind::CmaEs,
+            start: self.start.clone(),
+            bounds: self.bounds.clone(),
+            population: Some(self.lambda),
+            seed: self.seed,
+            lane: self.lane,
+            sigma: Some(self.sigma0),
+            restarts: 0,
+        });
+        check_same(
+            "its weights and learning rates",
+            &(
+                &self.weights,
+                self.mueff,
+                self.cc,
+                self.cs,
+                self.c1,
+                self.cmu,
+            ),
+            &(
+                &reference.weights,
+                reference.mueff,
+                reference.cc,
+                reference.cs,
+                reference.c1,
+                reference.cmu,
+            ),
+        )?;
+        check_same(
+            "its damping and expected length",
+            &(self.damps, self.chi_n),
+            &(reference.damps, reference.chi_n),
+        )?;
+        let n = self.n;
+        check_numbers("its mean", &self.mean, n, false)?;
+        check_numbers("its σ", &[self.sigma], 1, true)?;
+        check_numbers("its covariance", &self.c, n * n, false)?;
+        check_numbers("its eigenvectors", &self.b, n * n, false)?;
+        check_numbers("its axes' lengths", &self.d, n, true)?;
+        check_numbers("its evolution path p_c", &self.pc, n, false)?;
+        check_numbers("its evolution path p_σ", &self.ps, n, false)?;
+        if !(self.pending.is_empty() || self.pending.len() == self.lambda) {
+            return Err(format!(
+                "{} candidates pending in a population of {}",
+                self.pending.len(),
+                self.lambda
+            ));
+        }
+        check_genomes("pending candidate", &self.pending, n)?;
+        if self.eigeneval > self.counteval {
+            return Err("its eigendecomposition is from evaluations not yet made".into());
+        }
+        self.best.check(Some(n))
     }
 
     /// Whether this run is done: converged, ill-conditioned or stagnant.

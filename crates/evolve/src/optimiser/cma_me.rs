@@ -21,7 +21,7 @@
 //! then clipped), as pyribs resamples out-of-bounds solutions.
 
 use super::eigen::symmetric_eigen;
-use super::{gaussian, Random};
+use super::{check_genomes, check_numbers, check_same, gaussian, Random};
 use crate::archive::Added;
 use serde::{Deserialize, Serialize};
 
@@ -111,6 +111,43 @@ impl CmaEmitter {
         };
         e.reset(x0);
         e
+    }
+
+    /// A checkpoint's emitter against the one its run's configuration
+    /// makes (`fresh`): the same set-up; every vector and matrix of its
+    /// genome's size and finite, σ above 0, none or all of a batch asked.
+    pub(crate) fn check_state(&self, fresh: &CmaEmitter) -> Result<(), String> {
+        check_same(
+            "its set-up",
+            &(self.n, self.batch, self.sigma0, self.bounded, self.lazy_gap),
+            &(
+                fresh.n,
+                fresh.batch,
+                fresh.sigma0,
+                fresh.bounded,
+                fresh.lazy_gap,
+            ),
+        )?;
+        let n = self.n;
+        check_numbers("its mean", &self.mean, n, false)?;
+        check_numbers("its σ", &[self.sigma], 1, true)?;
+        check_numbers("its evolution path p_c", &self.pc, n, false)?;
+        check_numbers("its evolution path p_σ", &self.ps, n, false)?;
+        check_numbers("its covariance", &self.cov, n * n, false)?;
+        check_numbers("its eigenvectors", &self.basis, n * n, false)?;
+        check_numbers("its eigenvalues", &self.eigenvalues, n, false)?;
+        check_numbers("its C^(−1/2)", &self.invsqrt, n * n, false)?;
+        if self.condition.is_nan() || self.updated_eval > self.current_eval {
+            return Err("its eigendecomposition's bookkeeping is malformed".into());
+        }
+        if !(self.asked.is_empty() || self.asked.len() == self.batch) {
+            return Err(format!(
+                "{} candidates asked of a batch of {}",
+                self.asked.len(),
+                self.batch
+            ));
+        }
+        check_genomes("asked candidate", &self.asked, n)
     }
 
     /// Starts again from `x0` (pyribs's `reset`).

@@ -13,7 +13,10 @@
 //!   tenth of its bounds' width (or of its magnitude, at least 0.1, when
 //!   unbounded), clamped into the bounds.
 
-use super::{check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{
+    check_genomes, check_same, check_told, gaussian, sane, BestSoFar, Bounds, Optimiser, Random,
+    Setup,
+};
 use serde::{Deserialize, Serialize};
 
 /// Tournament size.
@@ -52,6 +55,38 @@ impl Ga {
             asked: false,
             best: BestSoFar::default(),
         }
+    }
+
+    /// A checkpoint's GA against the one its run's configuration makes
+    /// (`fresh`): the same set-up; a population of its size once asked,
+    /// with a fitness each once told.
+    pub(crate) fn check_state(&self, fresh: &Ga) -> Result<(), String> {
+        check_same(
+            "its seed and lane",
+            &(self.seed, self.lane),
+            &(fresh.seed, fresh.lane),
+        )?;
+        check_same("its start", &self.start, &fresh.start)?;
+        check_same("its bounds", &self.bounds, &fresh.bounds)?;
+        check_same("its population's size", &self.size, &fresh.size)?;
+        let n = self.start.len();
+        self.best.check(Some(n))?;
+        let (asked, told) = (self.population.len(), self.fitness.len());
+        let whole = asked == self.size;
+        let fine = if self.asked {
+            whole && told == 0
+        } else if self.generation > 0 {
+            whole && told == asked
+        } else {
+            told == 0
+        };
+        if !fine {
+            return Err(format!(
+                "a population of {asked} with {told} fitnesses, at generation {} of a GA of {}",
+                self.generation, self.size
+            ));
+        }
+        check_genomes("individual", &self.population, n)
     }
 
     fn spread(&self, i: usize, x: f64, fraction: f64) -> f64 {

@@ -16,7 +16,7 @@
 //! asks λ children of the best and keeps the best of them if it beats it,
 //! a (1+λ) scheme.
 
-use super::{check_told, BestSoFar, Bounds, Optimiser, Random, Setup};
+use super::{check_genomes, check_same, check_told, BestSoFar, Bounds, Optimiser, Random, Setup};
 use serde::{Deserialize, Serialize};
 
 /// Hill climbing with the thesis's per-lane mutation size.
@@ -58,6 +58,34 @@ impl HillClimber {
             population: s.population.unwrap_or(1),
             ..HillClimber::new(s.start.clone(), s.lane, s.seed)
         }
+    }
+
+    /// A checkpoint's climber against the one its run's configuration
+    /// makes (`fresh`): the same set-up, and a best and pending children
+    /// of its genome's length.
+    pub(crate) fn check_state(&self, fresh: &HillClimber) -> Result<(), String> {
+        check_same(
+            "its seed and lane",
+            &(self.seed, self.lane),
+            &(fresh.seed, fresh.lane),
+        )?;
+        check_same("its start", &self.start, &fresh.start)?;
+        check_same("its bounds", &self.bounds, &fresh.bounds)?;
+        check_same(
+            "its population and mutation scale",
+            &(self.population, self.scale),
+            &(fresh.population, fresh.scale),
+        )?;
+        let n = self.start.len();
+        self.best.check(Some(n))?;
+        if !(self.pending.is_empty() || self.pending.len() == self.population) {
+            return Err(format!(
+                "{} children pending in a population of {}",
+                self.pending.len(),
+                self.population
+            ));
+        }
+        check_genomes("pending child", &self.pending, n)
     }
 
     /// One child of `parent`: Appendix B's mutation (see the module).

@@ -24,7 +24,9 @@
 
 use super::body_ga::{self, Made, Variation, CROSSOVER};
 use super::cma_me::CmaEmitter;
-use super::{check_told, gaussian, BestSoFar, Bounds, Random};
+use super::{
+    check_body, check_genome, check_same, check_told, gaussian, BestSoFar, Bounds, Random,
+};
 use crate::archive::{Added, Candidate, GridArchive};
 use crate::problem::Outcome;
 use animats_scene::archive::{EmitterName, Grid};
@@ -209,6 +211,91 @@ impl Qd {
             refused: BTreeMap::new(),
             kept: 0,
         })
+    }
+
+    /// A checkpoint's search against the one its run's configuration
+    /// makes (`fresh`): the same set-up, grid and emitters (a CMA-ME
+    /// emitter checked as [`CmaEmitter::check_state`] does); each emitter's
+    /// whole batch asked, or none; every genome asked, asked ahead or kept
+    /// as an elite of the genome's length and finite, or a body the
+    /// scene's `variation` accepts.
+    pub(crate) fn check_state(
+        &self,
+        fresh: &Qd,
+        variation: Option<&dyn Variation>,
+    ) -> Result<(), String> {
+        check_same(
+            "its kind, seed and lane",
+            &(self.kind, self.seed, self.lane),
+            &(fresh.kind, fresh.seed, fresh.lane),
+        )?;
+        check_same("its start", &self.x0, &fresh.x0)?;
+        check_same("its bounds", &self.bounds, &fresh.bounds)?;
+        check_same("its overlap", &self.overlap, &fresh.overlap)?;
+        check_same(
+            "its archive's grid",
+            &self.archive.grid,
+            &fresh.archive.grid,
+        )?;
+        if self.emitters.len() != fresh.emitters.len() {
+            return Err(format!(
+                "{} emitters where its configuration makes {}",
+                self.emitters.len(),
+                fresh.emitters.len()
+            ));
+        }
+        for (k, (e, f)) in self.emitters.iter().zip(&fresh.emitters).enumerate() {
+            match (e, f) {
+                (Emitter::Cma(e), Emitter::Cma(f)) => e
+                    .check_state(f)
+                    .map_err(|why| format!("emitter {k}: {why}"))?,
+                _ => check_same(&format!("emitter {k}"), e, f)?,
+            }
+        }
+        let bodies = self.varies_bodies();
+        let genome = |what: &str, g: &[f64]| {
+            if bodies {
+                check_body(what, g, variation)
+            } else {
+                check_genome(what, g, self.x0.len())
+            }
+        };
+        let batches: Vec<usize> = self.emitters.iter().map(Emitter::batch).collect();
+        let ahead = self
+            .ahead
+            .as_ref()
+            .map(|(g, c)| (g.as_slice(), c.as_slice()));
+        for (what, asked, counts) in [
+            ("asked", Some((&self.asked[..], &self.counts[..]))),
+            ("asked ahead", ahead),
+        ]
+        .into_iter()
+        .filter_map(|(w, a)| a.map(|(g, c)| (w, g, c)))
+        {
+            let whole =
+                counts == batches.as_slice() && asked.len() == batches.iter().sum::<usize>();
+            if !(whole || (asked.is_empty() && counts.is_empty())) {
+                return Err(format!(
+                    "{} candidates {what} by emitters counting {counts:?}, whose batches are {batches:?}",
+                    asked.len()
+                ));
+            }
+            for (k, g) in asked.iter().enumerate() {
+                genome(&format!("candidate {k} {what}"), g)?;
+            }
+        }
+        if self.ahead.is_some() && (!self.overlap || self.asked.is_empty()) {
+            return Err("a generation asked ahead of none untold".into());
+        }
+        for e in self.archive.elites() {
+            genome(&format!("the elite of cell {}", e.index), &e.genome)?;
+        }
+        self.best
+            .check(if bodies { None } else { Some(self.x0.len()) })?;
+        if let Some((g, _)) = self.best.get() {
+            genome("the best", g)?;
+        }
+        Ok(())
     }
 
     /// Which search this is.

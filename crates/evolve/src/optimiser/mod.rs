@@ -313,6 +313,28 @@ impl AnyOptimiser {
         })
     }
 
+    /// Checks a checkpoint's optimiser against the one its run's
+    /// configuration makes (`fresh`, of the same kind): each kind's own
+    /// `check_state`, with the scene's body `variation` if it has one.
+    pub fn check_state(
+        &self,
+        fresh: &AnyOptimiser,
+        variation: Option<&dyn Variation>,
+    ) -> Result<(), String> {
+        match (self, fresh) {
+            (AnyOptimiser::HillClimber(o), AnyOptimiser::HillClimber(f)) => o.check_state(f),
+            (AnyOptimiser::Ga(o), AnyOptimiser::Ga(f)) => o.check_state(f),
+            (AnyOptimiser::CmaEs(o), AnyOptimiser::CmaEs(f)) => o.check_state(f),
+            (AnyOptimiser::BodyGa(o), AnyOptimiser::BodyGa(f)) => o.check_state(f, variation),
+            (AnyOptimiser::Qd(o), AnyOptimiser::Qd(f)) => o.check_state(f, variation),
+            _ => Err(format!(
+                "it is {} where its configuration makes {}",
+                self.kind().name(),
+                fresh.kind().name()
+            )),
+        }
+    }
+
     /// The next generation: a body GA's made by `variation` (refused
     /// without one), any other's by its own [`Optimiser::ask`].
     pub fn ask_with(&mut self, variation: Option<&dyn Variation>) -> Result<Vec<Vec<f64>>, String> {
@@ -498,6 +520,89 @@ impl BestSoFar {
     pub fn get(&self) -> Option<(&[f64], f64)> {
         self.fitness.map(|f| (self.genome.as_slice(), f))
     }
+
+    /// A checkpoint's best: a genome of `n` finite genes with a fitness
+    /// that is a number, or nothing yet (a body's genome has no fixed
+    /// length: `n` is `None`).
+    pub(crate) fn check(&self, n: Option<usize>) -> Result<(), String> {
+        match self.fitness {
+            Some(f) if f.is_nan() => Err("the best's fitness is not a number".into()),
+            Some(_) => match n {
+                Some(n) => check_genome("the best", &self.genome, n),
+                None => check_genome("the best", &self.genome, self.genome.len()),
+            },
+            None => Ok(()),
+        }
+    }
+}
+
+/// A checkpoint's part fixed when its run started: it must equal what the
+/// run's own configuration makes (`fresh`); the error names it.
+pub(crate) fn check_same<T: PartialEq>(what: &str, stored: &T, fresh: &T) -> Result<(), String> {
+    if stored == fresh {
+        Ok(())
+    } else {
+        Err(format!(
+            "{what} is not what the run's own configuration makes"
+        ))
+    }
+}
+
+/// A checkpoint's genome: `n` finite genes.
+pub(crate) fn check_genome(what: &str, genome: &[f64], n: usize) -> Result<(), String> {
+    if genome.len() != n {
+        return Err(format!("{what} has {} genes, not {n}", genome.len()));
+    }
+    if genome.iter().any(|x| !x.is_finite()) {
+        return Err(format!("{what} has a gene that is not finite"));
+    }
+    Ok(())
+}
+
+/// A checkpoint's genomes: each of `n` finite genes.
+pub(crate) fn check_genomes(what: &str, genomes: &[Vec<f64>], n: usize) -> Result<(), String> {
+    for (k, g) in genomes.iter().enumerate() {
+        check_genome(&format!("{what} {k}"), g, n)?;
+    }
+    Ok(())
+}
+
+/// A checkpoint's body genome: finite, and one that the scene's
+/// `variation` accepts (its own check of a body, which decodes it).
+pub(crate) fn check_body(
+    what: &str,
+    genome: &[f64],
+    variation: Option<&dyn Variation>,
+) -> Result<(), String> {
+    check_genome(what, genome, genome.len())?;
+    match variation {
+        Some(v) => v
+            .check(genome)
+            .map_err(|why| format!("{what} is not a body of the scene's [morphology]: {why}")),
+        None => Err(format!(
+            "{what} is a body, but the scene has no [morphology]"
+        )),
+    }
+}
+
+/// A checkpoint's list of `len` numbers, each finite (and above 0 if
+/// `positive`).
+pub(crate) fn check_numbers(
+    what: &str,
+    x: &[f64],
+    len: usize,
+    positive: bool,
+) -> Result<(), String> {
+    if x.len() != len {
+        return Err(format!("{what}: {} numbers, not {len}", x.len()));
+    }
+    if x.iter().any(|v| !v.is_finite() || (positive && *v <= 0.0)) {
+        return Err(format!(
+            "{what}: a number that is not finite{}",
+            if positive { " and above 0" } else { "" }
+        ));
+    }
+    Ok(())
 }
 
 /// Checks a `tell` against the population asked.
