@@ -527,8 +527,10 @@ impl State {
         let variation = problem.variation();
         for l in &self.lanes {
             let fresh = self.config.fresh_optimiser(problem.as_ref(), l.lane)?;
-            let lane = |e: String| format!("lane {}'s optimiser: {e}", l.lane);
-            l.optimiser.check_state(&fresh, variation).map_err(lane)?;
+            l.optimiser
+                .check_state(&fresh, variation)
+                .map_err(|e| format!("lane {}'s optimiser: {e}", l.lane))?;
+            let lane = |e: String| format!("lane {}: {e}", l.lane);
             let genome = |what: &str, g: &[f64]| match variation {
                 Some(_) => crate::optimiser::check_body(what, g, variation),
                 None => crate::optimiser::check_genome(what, g, problem.dim()),

@@ -227,6 +227,10 @@ fn an_edited_checkpoint_is_refused_unless_its_run_could_have_made_it() {
                     set("/lanes/1/optimiser/best/genome", json!([1.0])),
                     "lane 1's optimiser: the best has 1 genes, not 14",
                 ),
+                (
+                    set("/lanes/0/best/genome", json!([1.0, f64::MAX])),
+                    "lane 0: its best has 2 genes, not 14",
+                ),
             ],
         ),
         (
