@@ -1,5 +1,5 @@
-//! What the renderer draws: spheres, rods, jellyfish bells, the floor and
-//! the water, made from the one drawing model (`animats_view::Drawing`)
+//! What the renderer draws: spheres, rods (springs and joints' axles),
+//! jellyfish bells, the floor and the water, made from the one drawing model (`animats_view::Drawing`)
 //! that the live view's page draws too.
 
 use animats_view::{BellShape, Drawing};
@@ -101,7 +101,7 @@ pub fn picture(
             shadow: b.shadow,
         })
         .collect();
-    let rods = drawing
+    let mut rods: Vec<Rod> = drawing
         .rods
         .iter()
         .zip(drawing.rod_colours(levels))
@@ -112,6 +112,20 @@ pub fn picture(
             colour: hex(colour),
         })
         .collect();
+    // Joints: their axles, drawn as rods after the springs.
+    rods.extend(
+        drawing
+            .axles
+            .iter()
+            .zip(drawing.axle_ends(positions))
+            .zip(drawing.axle_colours(levels))
+            .map(|((x, [a, b]), colour)| Rod {
+                a: DVec3::from_array(a),
+                b: DVec3::from_array(b),
+                radius: x.radius,
+                colour: hex(colour),
+            }),
+    );
     let bells = drawing
         .bells
         .iter()

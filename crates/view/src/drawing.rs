@@ -56,6 +56,32 @@ pub struct Rod {
     pub muscle: Option<usize>,
 }
 
+/// A joint, drawn as an axle through its joint particle: square to the
+/// plane of an angle joint's three particles (along z while they are in
+/// line), along a torque joint's axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Axle {
+    /// The joint particle (a particle's index).
+    pub joint: usize,
+    /// An angle joint's two ends, whose plane the axle is square to.
+    pub ends: Option<(usize, usize)>,
+    /// A torque joint's unit axis.
+    pub axis: Option<[f64; 3]>,
+    /// Half its length, m: 1.6 times the joint particle's radius.
+    pub half: f64,
+    /// m: 0.3 of the joint particle's radius, at least 2 mm.
+    pub radius: f64,
+    /// 0xRRGGBB: steel (a joint's motor's colour at each instant is
+    /// [`muscle_colour`] of its actuator's level).
+    pub colour: u32,
+    /// The actuator that drives it (an angle joint's rest angle, a torque
+    /// joint's torque), by its index among the scene's actuators.
+    pub motor: Option<usize>,
+}
+
+/// A joint's axle's colour when no actuator drives it.
+const STEEL: u32 = 0x8a_90_9a;
+
 /// A muscle's colour at `level` (its actuator's level: 0 at the shortest
 /// rest length, 1 at the longest): red when contracted, purple when
 /// relaxed, through pale grey at the middle.
@@ -116,6 +142,8 @@ pub struct Drawing {
     pub rods: Vec<Rod>,
     /// One per jellyfish.
     pub bells: Vec<BellPlan>,
+    /// One per joint: the angle joints, then the torque joints.
+    pub axles: Vec<Axle>,
     /// The floor's checker square, m, if there is a floor.
     pub floor: Option<f64>,
     /// The floor's triangles when it has a terrain (not the plane y = 0).
@@ -188,6 +216,51 @@ impl Drawing {
                 }
             })
             .collect();
+        // Joints as axles; which actuator, if any, drives each.
+        let forces = w.forces();
+        let (mut angle_motors, mut torque_motors) = (
+            vec![None; forces.angle_joints.len()],
+            vec![None; forces.torque_joints.len()],
+        );
+        for (k, (_, a)) in scene.nervous.actuators.iter().enumerate() {
+            use animats_creatures::actuators::AnyActuator;
+            let slot = match a {
+                AnyActuator::AngleJoint(a) => angle_motors.get_mut(a.target().0.index()),
+                AnyActuator::TorqueJoint(a) => torque_motors.get_mut(a.target().0.index()),
+                _ => None,
+            };
+            if let Some(m) = slot {
+                *m = Some(k);
+            }
+        }
+        let axle = |joint: usize, ends, axis, motor| Axle {
+            joint,
+            ends,
+            axis,
+            half: 1.6 * radius[joint].max(0.001),
+            radius: (0.3 * radius[joint]).max(0.002),
+            colour: STEEL,
+            motor,
+        };
+        let axles = forces
+            .angle_joints
+            .iter()
+            .zip(angle_motors)
+            .map(|(j, motor)| {
+                let (a, joint, b) = j.particles();
+                axle(joint.index(), Some((a.index(), b.index())), None, motor)
+            })
+            .chain(
+                forces
+                    .torque_joints
+                    .iter()
+                    .zip(torque_motors)
+                    .map(|(j, motor)| {
+                        let (_, joint) = j.particles();
+                        axle(joint.index(), None, Some(j.axis().to_array()), motor)
+                    }),
+            )
+            .collect();
         let bells = scene
             .creatures
             .iter()
@@ -212,6 +285,7 @@ impl Drawing {
             balls,
             rods,
             bells,
+            axles,
             floor: floor.then_some(if distance < 4.0 { 0.1 } else { 0.5 }),
             water: w
                 .forces()
@@ -229,6 +303,36 @@ impl Drawing {
             .map(|r| match r.muscle.and_then(|k| levels.get(k)) {
                 Some(&l) => muscle_colour(l),
                 None => r.colour,
+            })
+            .collect()
+    }
+
+    /// Each axle's two ends with the particles at `positions`.
+    pub fn axle_ends(&self, positions: &[DVec3]) -> Vec<[[f64; 3]; 2]> {
+        let at = |i: usize| positions.get(i).copied().unwrap_or(DVec3::ZERO);
+        self.axles
+            .iter()
+            .map(|x| {
+                let c = at(x.joint);
+                let dir = match (x.ends, x.axis) {
+                    (Some((a, b)), _) => (at(a) - c).cross(at(b) - c).normalize_or_zero(),
+                    (None, Some(axis)) => DVec3::from_array(axis),
+                    (None, None) => DVec3::ZERO,
+                };
+                let dir = if dir == DVec3::ZERO { DVec3::Z } else { dir };
+                [(c - x.half * dir).to_array(), (c + x.half * dir).to_array()]
+            })
+            .collect()
+    }
+
+    /// Each axle's colour with the actuators at `levels` (scene order): a
+    /// motor's from its level, an undriven joint's steel.
+    pub fn axle_colours(&self, levels: &[f64]) -> Vec<u32> {
+        self.axles
+            .iter()
+            .map(|x| match x.motor.and_then(|k| levels.get(k)) {
+                Some(&l) => muscle_colour(l),
+                None => x.colour,
             })
             .collect()
     }

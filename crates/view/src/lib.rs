@@ -24,7 +24,7 @@ pub mod model;
 pub mod palette;
 pub mod stage;
 
-pub use drawing::{Ball, BellPlan, BellShape, Drawing, Look, Rod};
+pub use drawing::{Axle, Ball, BellPlan, BellShape, Drawing, Look, Rod};
 pub use ground::GroundMesh;
 pub use model::{CreatureState, Describe, Dome, Part};
 pub use stage::{framing, snug, SceneStage, Stage};

@@ -95,3 +95,62 @@ fn each_jellyfish_gets_a_bell_over_its_dome_opening_towards_its_tentacles() {
         assert!((b.height / a.height - 1.20 / 0.75).abs() < 1e-12);
     }
 }
+
+/// Every joint is drawn as an axle through its joint particle: square to
+/// an angle joint's plane (perpendicular to both arms), along a torque
+/// joint's axis, 2 × 1.6 radii long; an undriven joint steel, a driven one
+/// its motor's colour (the thesis's roobot: its hip and knee are driven).
+#[test]
+fn joints_are_axles_square_to_their_plane_or_along_their_axis() {
+    for file in ["joints.toml", "hop_evolver.toml"] {
+        let s = scene(file);
+        let forces = s.world.forces();
+        let d = Drawing::of(&s, 3.0);
+        let (angles, torques) = (forces.angle_joints.len(), forces.torque_joints.len());
+        assert_eq!(d.axles.len(), angles + torques, "{file}");
+        assert!(!d.axles.is_empty(), "{file} has joints");
+        let pos = &s.world.state().pos;
+        let ends = d.axle_ends(pos);
+        let radius = &s.world.particles().radius;
+        for (k, (x, [a, b])) in d.axles.iter().zip(&ends).enumerate() {
+            let (a, b) = (DVec3::from_array(*a), DVec3::from_array(*b));
+            let centre = pos[x.joint];
+            assert!(
+                ((a + b) / 2.0 - centre).length() < 1e-12,
+                "{file}: axle {k}"
+            );
+            assert!(((b - a).length() - 3.2 * radius[x.joint].max(0.001)).abs() < 1e-12);
+            let dir = (b - a).normalize();
+            if k < angles {
+                let (p, j, q) = forces.angle_joints.iter().nth(k).unwrap().particles();
+                assert_eq!(j.index(), x.joint);
+                for arm in [pos[p.index()] - centre, pos[q.index()] - centre] {
+                    if arm.length() > 0.0 {
+                        assert!(
+                            dir.dot(arm.normalize()).abs() < 1e-9,
+                            "{file}: axle {k} not square to its arm"
+                        );
+                    }
+                }
+            } else {
+                let t = forces.torque_joints.iter().nth(k - angles).unwrap();
+                assert_eq!(t.particles().1.index(), x.joint);
+                assert!(
+                    (dir.dot(t.axis()).abs() - 1.0).abs() < 1e-12,
+                    "{file}: axle {k}"
+                );
+            }
+        }
+        // Colours: steel undriven; a motor follows its actuator's level.
+        let levels = vec![1.0; s.nervous.actuators.len()];
+        for (x, c) in d.axles.iter().zip(d.axle_colours(&levels)) {
+            match x.motor {
+                Some(_) => assert_eq!(c, animats_view::drawing::muscle_colour(1.0), "{file}"),
+                None => assert_eq!(c, x.colour, "{file}"),
+            }
+        }
+    }
+    // The roobot's joints are driven (its hip and knee motors).
+    let d = Drawing::of(&scene("hop_evolver.toml"), 3.0);
+    assert!(d.axles.iter().any(|x| x.motor.is_some()));
+}

@@ -43,6 +43,12 @@ pub struct Frame {
     /// `drawing.rods`): muscles by their activation; empty when the scene
     /// has no muscles (the rods keep their drawn colours).
     pub rods: Vec<u32>,
+    /// Each joint's axle now, its two ends (m), in the order of the
+    /// scene's `drawing.axles`.
+    pub axles: Vec<[[f64; 3]; 2]>,
+    /// Each axle's colour now (0xRRGGBB): motors by their actuator's
+    /// level; empty when no actuator drives a joint.
+    pub axle_colours: Vec<u32>,
     /// A point the camera may follow (the creature an evolution shows).
     pub focus: Option<[f64; 3]>,
     /// Why the simulation stopped, if it failed (it is paused until reset).

@@ -267,16 +267,21 @@ impl Runner {
     fn publish_frame(&mut self, fps: f64, rtf: f64) {
         self.stage.positions(&mut self.positions);
         let creatures = self.stage.creatures();
+        let shaped = !(self.drawing.bells.is_empty() && self.drawing.axles.is_empty());
+        let at: Vec<animats_engine::DVec3> = if shaped {
+            self.positions
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]].map(f64::from).into())
+                .collect()
+        } else {
+            Vec::new()
+        };
         let bells = if self.drawing.bells.is_empty() {
             Vec::new()
         } else {
-            let at: Vec<animats_engine::DVec3> = self
-                .positions
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]].map(f64::from).into())
-                .collect();
             self.drawing.bell_shapes(&at, &creatures)
         };
+        let levels = self.stage.levels();
         let frame = Frame {
             kind: "frame",
             t: self.stage.time(),
@@ -288,7 +293,13 @@ impl Runner {
             creatures,
             bells,
             rods: if self.drawing.rods.iter().any(|r| r.muscle.is_some()) {
-                self.drawing.rod_colours(&self.stage.levels())
+                self.drawing.rod_colours(&levels)
+            } else {
+                Vec::new()
+            },
+            axles: self.drawing.axle_ends(&at),
+            axle_colours: if self.drawing.axles.iter().any(|x| x.motor.is_some()) {
+                self.drawing.axle_colours(&levels)
             } else {
                 Vec::new()
             },

@@ -187,6 +187,21 @@ function build(desc) {
     springs = { mesh, rods: d.rods };
   }
 
+  // Joints as axles through their joint particle, placed by the server
+  // every frame; a motor coloured by its actuator's level.
+  let axles = null;
+  if ((d.axles ?? []).length > 0) {
+    const mesh = new THREE.InstancedMesh(rod, new THREE.MeshStandardMaterial({ roughness: 0.35, metalness: 0.5 }), d.axles.length);
+    mesh.frustumCulled = false;
+    mesh.castShadow = true;
+    const colour = new THREE.Color();
+    d.axles.forEach((x, k) => mesh.setColorAt(k, colour.setHex(x.colour)));
+    group.add(mesh);
+    axles = { mesh, radii: d.axles.map((x) => x.radius) };
+  }
+  viewer.axles = axles ? d.axles.length : 0;
+  viewer.axlesPlaced = 0;
+
   // Jellyfish: translucent bells over their dome masses, shaped by the
   // server every frame.
   const domes = d.bells.map((b) => {
@@ -211,7 +226,7 @@ function build(desc) {
     box.appendChild(div);
     return { div, particle: l.particle, lift: 3 * desc.drawing.balls[l.particle].radius + 0.05 };
   });
-  drawn = { group, spheres, springs, domes, floor, water, labels, size: desc.distance };
+  drawn = { group, spheres, springs, axles, domes, floor, water, labels, size: desc.distance };
   viewer.groundTriangles = d.ground ? floor.geometry.index.count / 3 : 0;
 
   // Depth precision: the near plane scales with the scene, or the grid
@@ -271,6 +286,25 @@ function draw(frame) {
     // Muscles coloured by their activation now (the server's colours).
     if (frame.rods && frame.rods.length === rods.length) {
       frame.rods.forEach((c, k) => mesh.setColorAt(k, tint.setHex(c)));
+      if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
+    }
+  }
+  if (drawn.axles && (frame.axles ?? []).length === drawn.axles.radii.length) {
+    const { mesh, radii } = drawn.axles;
+    frame.axles.forEach(([a, b], k) => {
+      v.set(...a);
+      w.set(...b);
+      const length = v.distanceTo(w);
+      w.sub(v);
+      if (length > 1e-9) q.setFromUnitVectors(UP, w.divideScalar(length)); else q.identity();
+      v.addScaledVector(w, 0.5 * length);
+      s3.set(radii[k], Math.max(length, 1e-6), radii[k]);
+      mesh.setMatrixAt(k, m4.compose(v, q, s3));
+    });
+    mesh.instanceMatrix.needsUpdate = true;
+    viewer.axlesPlaced = frame.axles.length;
+    if ((frame.axle_colours ?? []).length === radii.length) {
+      frame.axle_colours.forEach((c, k) => mesh.setColorAt(k, tint.setHex(c)));
       if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
     }
   }

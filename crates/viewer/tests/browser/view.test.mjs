@@ -271,6 +271,39 @@ try {
     rough.child.kill('SIGINT');
   }
 
+  // Joints: `animats view scenes/joints.toml` draws each of its three
+  // joints (two angle joints, one torque joint) as an axle centred on its
+  // joint particle, placed every frame.
+  const arm = await serve(['view', resolve(root, 'scenes/joints.toml'), '--port', '0']);
+  try {
+    const tab = await browser.newPage({ viewport: { width: 1100, height: 700 } });
+    const tabErrors = [];
+    tab.on('pageerror', (e) => tabErrors.push(e.message));
+    await tab.goto(arm.url);
+    await tab.waitForFunction(() => window.__viewer && window.__viewer.frame && window.__viewer.frame.t > 1, null, { timeout: 30000 });
+    const axles = await tab.evaluate(() => {
+      const { scene, frame } = window.__viewer;
+      const sent = scene.drawing.axles;
+      // Each axle's middle against its joint particle (single precision).
+      const off = sent.map((x, k) => {
+        const [a, b] = frame.axles[k];
+        const p = frame.p.slice(3 * x.joint, 3 * x.joint + 3);
+        return Math.hypot(...[0, 1, 2].map((i) => (a[i] + b[i]) / 2 - p[i]));
+      });
+      return { sent: sent.length, drawn: window.__viewer.axles, placed: window.__viewer.axlesPlaced, off: Math.max(...off) };
+    });
+    check(axles.sent === 3 && axles.drawn === 3 && axles.placed === 3 && axles.off < 1e-5,
+      'view joints.toml: each joint is drawn as an axle on its joint particle',
+      `${axles.sent} sent, ${axles.drawn} drawn, ${axles.placed} placed, farthest middle ${axles.off.toExponential(2)} m from its particle`);
+    const drawn = await canvasStats(tab);
+    check(drawn.variance > 50 && tabErrors.length === 0, 'view joints.toml: drawn, no script errors',
+      `luminance variance ${drawn.variance.toFixed(0)}; ${tabErrors.join('; ')}`);
+    await tab.screenshot({ path: join(dirname(screenshot), 'joints.png') });
+    await tab.close();
+  } finally {
+    arm.child.kill('SIGINT');
+  }
+
   // `evolve --view`: the thesis's roobot hops with the best brain so far,
   // and the overlay says which and how the run stands.
   const out = mkdtempSync(join(tmpdir(), 'animats-evolve-view-'));
