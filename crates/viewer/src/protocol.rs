@@ -43,9 +43,9 @@ pub struct Frame {
     /// `drawing.rods`): muscles by their activation; empty when the scene
     /// has no muscles (the rods keep their drawn colours).
     pub rods: Vec<u32>,
-    /// Each joint's axle now, its two ends (m), in the order of the
-    /// scene's `drawing.axles`.
-    pub axles: Vec<[[f64; 3]; 2]>,
+    /// Each joint's axle now, its two ends (m, single precision as `p`),
+    /// in the order of the scene's `drawing.axles`.
+    pub axles: Vec<[[f32; 3]; 2]>,
     /// Each axle's colour now (0xRRGGBB): motors by their actuator's
     /// level; empty when no actuator drives a joint.
     pub axle_colours: Vec<u32>,

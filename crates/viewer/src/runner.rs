@@ -297,7 +297,12 @@ impl Runner {
             } else {
                 Vec::new()
             },
-            axles: self.drawing.axle_ends(&at),
+            axles: self
+                .drawing
+                .axle_ends(&at)
+                .into_iter()
+                .map(|ends| ends.map(|e| e.map(|x| x as f32)))
+                .collect(),
             axle_colours: if self.drawing.axles.iter().any(|x| x.motor.is_some()) {
                 self.drawing.axle_colours(&levels)
             } else {
