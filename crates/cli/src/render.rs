@@ -407,21 +407,23 @@ impl Cameras {
     }
 
     /// Frames the watched creature snugly (`render`'s default camera on a
-    /// creature): its extent at the start fills 40 % of the frame's width,
-    /// or 60 % of its height if that is the tighter, seen from the usual
-    /// direction — so a 0.3 m walker is not a speck in a 2 m frame.
+    /// creature): its extent at the start (the watched particles and every
+    /// creature that holds one) fills 40 % of the frame's width, or 60 % of
+    /// its height if that is the tighter, seen from the usual direction —
+    /// so a 0.3 m walker is not a speck in a 2 m frame.
     fn snug(&mut self, args: &Args, stage: &SceneStage, at_start: &Snapshot) {
         if !matches!(args.camera, CameraSpec::Auto | CameraSpec::Follow) || self.watched.is_empty()
         {
             return;
         }
-        let radius = &stage.scene().world.particles().radius;
         let aspect = f64::from(args.width) / f64::from(args.height.max(1));
-        let spheres = self
-            .watched
-            .iter()
-            .map(|&i| (at_start.positions[i], radius[i]));
-        let Some((centre, distance)) = animats_view::snug(spheres, args.fov, aspect) else {
+        let Some((centre, distance)) = animats_view::snug_watched(
+            stage.scene(),
+            &self.watched,
+            &at_start.positions,
+            args.fov,
+            aspect,
+        ) else {
             return;
         };
         self.base = Camera::framing(DVec3::new(centre.x, centre.y.max(0.0), centre.z), distance);

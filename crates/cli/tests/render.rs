@@ -485,3 +485,42 @@ fn a_render_too_many_steps_away_is_refused() {
     );
     assert!(!out.exists());
 }
+
+/// A scene whose fitness watches one particle of a creature (the thesis's
+/// scene watches the roobot's hip) is framed around the whole creature:
+/// at the start every roobot pixel lies inside the picture, clear of its
+/// edges. (Framed around the hip alone, the hip and the head filled the
+/// picture and ran off its top.)
+#[test]
+fn a_watched_particle_s_whole_creature_is_framed() {
+    let dir = scratch("render-watched");
+    let out = dir.join("hop.png");
+    run_ok(&[
+        "render",
+        "scenes/hop_evolver.toml",
+        "--seconds",
+        "0.05",
+        "--width",
+        "320",
+        "--height",
+        "200",
+        "--no-caption",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let img = decode_png(&out);
+    let (w, h) = (img.width as usize, img.height as usize);
+    let orange = |x: usize, y: usize| {
+        let p = &img.rgb[3 * (y * w + x)..3 * (y * w + x) + 3];
+        let (r, g, b) = (p[0] as i32, p[1] as i32, p[2] as i32);
+        r > g + 40 && r > b + 70
+    };
+    let seen = orange_pixels(&img);
+    let edge = (0..w)
+        .flat_map(|x| [(x, 0), (x, 1), (x, h - 2), (x, h - 1)])
+        .chain((0..h).flat_map(|y| [(0, y), (1, y), (w - 2, y), (w - 1, y)]))
+        .filter(|&(x, y)| orange(x, y))
+        .count();
+    assert!(seen > 500, "the roobot covers {seen} pixels");
+    assert_eq!(edge, 0, "{edge} roobot pixels on the picture's edges");
+}

@@ -27,4 +27,4 @@ pub mod stage;
 pub use drawing::{Axle, Ball, BellPlan, BellShape, Drawing, Look, Rod};
 pub use ground::GroundMesh;
 pub use model::{CreatureState, Describe, Dome, Part};
-pub use stage::{framing, snug, SceneStage, Stage};
+pub use stage::{framing, snug, snug_watched, SceneStage, Stage};

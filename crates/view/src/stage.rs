@@ -215,6 +215,34 @@ pub fn snug(
     Some((0.5 * (lo + hi), distance))
 }
 
+/// [`snug`] over the `watched` particles of `scene` and every particle of
+/// a creature that holds one, at `positions`: a scene whose fitness
+/// watches a roobot's hip frames the whole roobot, not its hip alone.
+pub fn snug_watched(
+    scene: &Scene,
+    watched: &[usize],
+    positions: &[DVec3],
+    fov: f64,
+    aspect: f64,
+) -> Option<(DVec3, f64)> {
+    let mut framed = watched.to_vec();
+    for c in &scene.creatures {
+        if c.particles.iter().any(|p| watched.contains(p)) {
+            framed.extend(&c.particles);
+        }
+    }
+    framed.sort_unstable();
+    framed.dedup();
+    let radius = &scene.world.particles().radius;
+    snug(
+        framed
+            .iter()
+            .filter_map(|&i| Some((*positions.get(i)?, *radius.get(i)?))),
+        fov,
+        aspect,
+    )
+}
+
 impl Stage for SceneStage {
     fn describe(&self) -> Describe {
         let w = &self.scene.world;
