@@ -171,7 +171,7 @@ fn corrupt_checkpoints_are_refused() {
 /// `state` as a checkpoint after `edit` of its JSON, written with its
 /// checksum made again (as a hand edit or another program could): what
 /// loading it says.
-pub fn load_edited(
+fn load_edited(
     state: &State,
     path: &std::path::Path,
     edit: &dyn Fn(&mut serde_json::Value),

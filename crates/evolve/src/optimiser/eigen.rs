@@ -99,7 +99,11 @@ pub fn jacobi_eigen(m: &[f64], n: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 /// `√(a² + b²)` without overflow or underflow on the way, in a fixed
-/// order (std's `hypot` is the platform's).
+/// order (std's `hypot` is the platform's). Not the engine's
+/// `math::hypot`: `libm`'s correctly rounded one made the decomposition
+/// 3.7× slower at 20 rows and 2.0× at 100 (`cma_es_genes`, 0.075 against
+/// 0.020 ms and 2.45 against 1.22 ms), and the rotations need no more
+/// than this.
 fn hypot(a: f64, b: f64) -> f64 {
     let (a, b) = (a.abs(), b.abs());
     let (big, small) = if a >= b { (a, b) } else { (b, a) };
