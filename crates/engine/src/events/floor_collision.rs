@@ -97,8 +97,8 @@ impl Pending {
     }
 
     /// The bounces, to a holder of the only reference: no lock taken (a
-    /// lock and an unlock are two atomic exchanges, which cost a land
-    /// run of random bodies 4 % of its time every step).
+    /// lock and an unlock are two atomic exchanges: taken at the end of
+    /// every step, about 4 % of a land run of random bodies).
     fn get_mut(&mut self) -> &mut Vec<Collision> {
         self.0
             .get_mut()

@@ -524,8 +524,6 @@ fn first_non_finite(s: &State, fixed: &[bool]) -> Option<usize> {
         .or_else(|| (0..n).find(bad))
 }
 
-/// True if every coordinate of `pos` and `vel` (as long as each other) is
-/// finite.
 /// `std::mem::swap(a, b)`, out of line: inline, where the two states lie
 /// side by side in the world, LLVM swapped them through overlapping
 /// vector moves, storing part of one and at once loading it back wider, a
@@ -536,6 +534,8 @@ fn swap_states(a: &mut State, b: &mut State) {
     std::mem::swap(a, b);
 }
 
+/// True if every coordinate of `pos` and `vel` (as long as each other) is
+/// finite.
 fn all_finite(pos: &[DVec3], vel: &[DVec3]) -> bool {
     let n = pos.len().min(vel.len());
     let (pos, vel) = (&pos[..n], &vel[..n]);
@@ -583,8 +583,8 @@ fn lane_sums<const L: usize>(p: &[f64], v: &[f64]) -> [f64; L] {
     // The rest summed apart, one by one, then into lane 0 (any order
     // tells finite from not): added into the lanes themselves, LLVM
     // vectorised the rest with masked stores to the lanes' stack copy
-    // and the loads after them waited for the stores, a third of the
-    // small scan's time.
+    // and the loads after them waited for the stores (`perf`: the scan
+    // 9.9 % of a land-task run's samples, 1.3 % this way).
     let mut rest = 0.0;
     for (p, v) in pr.iter().zip(vr) {
         rest += p + v;
