@@ -115,7 +115,7 @@ pub fn sin_lanes(x: [f64; LANES]) -> [f64; LANES] {
 /// evaluates musl's polynomial and scales by `2ᵏ` (musl's `scalbn` is
 /// one multiplication for these `k`), in musl's operations and order.
 /// (`k = 0` goes through the same reduction: `x − 0·ln2hi` is `x`.) Any
-/// other argument sends every lane to [`exp`]. (`tests/math.rs` holds
+/// other argument takes [`exp`] in its lane. (`tests/math.rs` holds
 /// every lane to `libm::exp` on 10⁷ arguments and the edges.)
 #[inline]
 pub fn exp_lanes(x: [f64; LANES]) -> [f64; LANES] {
@@ -128,14 +128,14 @@ pub fn exp_lanes(x: [f64; LANES]) -> [f64; LANES] {
     const P4: f64 = f64::from_bits(0xBEBBBD41_C5D26BF1);
     const P5: f64 = f64::from_bits(0x3E663769_72BEA4D0);
     const BIAS: f64 = 6_755_399_441_056_767.0; // 1.5·2⁵² + 1023
-    let mut general = true;
+    let mut general = [true; LANES];
     let mut out = [0.0; LANES];
     for i in 0..LANES {
         let x = x[i];
         let high = (x.to_bits() >> 32) as u32;
         let hx = high & 0x7fff_ffff;
         let negative = high >> 31 == 1;
-        general &= (hx > 0x3e30_0000) & (hx < 0x4086_232b);
+        general[i] = (hx > 0x3e30_0000) & (hx < 0x4086_232b);
         let near = if negative { -1.0 } else { 1.0 };
         let far = (INVLN2 * x + if negative { -0.5 } else { 0.5 }).trunc();
         let k = if hx >= 0x3ff0_a2b2 {
@@ -155,8 +155,15 @@ pub fn exp_lanes(x: [f64; LANES]) -> [f64; LANES] {
         let scale = f64::from_bits(((k + BIAS).to_bits() & 0x7ff) << 52);
         out[i] = y * scale;
     }
-    if !general {
-        return std::array::from_fn(|i| exp(x[i]));
+    // A lane outside the range takes `exp` itself, the others keep
+    // theirs (a network's zeros, near the start of a run, had sent whole
+    // groups to `exp` one by one).
+    if general != [true; LANES] {
+        for i in 0..LANES {
+            if !general[i] {
+                out[i] = exp(x[i]);
+            }
+        }
     }
     out
 }

@@ -25,6 +25,7 @@
 //! every weight in [−16, 16] (Beer's), g in [0, 5], each widened to contain
 //! the value the scene gives; a τ below 1e-4 s counts as 1e-4 s.
 
+use super::neural::logistic;
 use crate::brain::{around, check_genome, finite, network_inputs, positive, Brain, GenomeKey};
 use animats_engine::ModelError;
 use serde::Deserialize;
@@ -216,10 +217,12 @@ impl Brain for Ctrnn {
         let n = self.neurons();
         let (x, rates) = &mut self.scratch;
         network_inputs(x, inputs, self.clock, t);
+        // The rates are `sigma` of each neuron (`Ctrnn::rate`), its
+        // exponentials a group of neurons at a time: the same bits (perf:
+        // one at a time, `exp` was a fifth of a CTRNN walker's run).
         rates.clear();
-        for i in 0..n {
-            rates.push(sigma(self.gain[i] * (self.state[i] + self.bias[i])));
-        }
+        rates.extend((0..n).map(|i| self.gain[i] * (self.state[i] + self.bias[i])));
+        logistic(rates);
         let m = x.len();
         for i in 0..n {
             let mut drive = 0.0;
@@ -232,9 +235,11 @@ impl Brain for Ctrnn {
             let h = dt / self.tau[i].max(MIN_TAU);
             self.state[i] = (self.state[i] + h * drive) / (1.0 + h);
         }
-        for (i, out) in outputs.iter_mut().enumerate().take(self.outputs) {
-            *out = self.rate(i);
+        let k = self.outputs.min(outputs.len());
+        for (i, out) in outputs[..k].iter_mut().enumerate() {
+            *out = self.gain[i] * (self.state[i] + self.bias[i]);
         }
+        logistic(&mut outputs[..k]);
     }
 
     fn genome(&self) -> Vec<f64> {

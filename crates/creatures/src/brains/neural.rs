@@ -38,8 +38,8 @@ pub struct NeuralEntry {
 
 /// Each `a` in `y` becomes `1 / (1 + e^−a)`, libm's `exp` a group of
 /// outputs at a time (the same bits as one at a time; lanes past the last
-/// repeat the group's first).
-fn logistic(y: &mut [f64]) {
+/// repeat the group's first). A CTRNN's rates are this too.
+pub(crate) fn logistic(y: &mut [f64]) {
     use animats_engine::math::{exp_lanes, LANES};
     for group in y.chunks_mut(LANES) {
         let e = exp_lanes(std::array::from_fn(|k| {
