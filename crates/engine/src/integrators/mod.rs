@@ -195,21 +195,43 @@ pub(crate) const SMALL: usize = 16;
 pub(crate) trait Coord:
     Copy + std::ops::Add<Output = Self> + std::ops::AddAssign + std::ops::Mul<f64, Output = Self>
 {
-    /// No coordinate infinite or NaN.
-    fn finite(self) -> bool;
+    /// A word whose top bit is set if a coordinate is infinite or NaN:
+    /// the loops OR these together and test the top bit once at the end
+    /// ([`all_finite`]). An OR of integers is associative, so it adds
+    /// three cheap vector operations to a vectorised loop, where
+    /// `finite &= x.is_finite()` compared, then packed and extracted the
+    /// comparison's lanes every iteration (`perf`: `World::step` 18.9 →
+    /// 17.0 % of `animats bench nbody5 --quick`'s samples).
+    fn not_finite(self) -> u64;
+}
+
+/// The top bit of `x`'s exponent field plus one: set exactly when every
+/// bit of the exponent is (an infinity or a NaN).
+#[inline(always)]
+fn exponent_carry(x: f64) -> u64 {
+    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
+    const ONE: u64 = 0x0010_0000_0000_0000;
+    (x.to_bits() & EXPONENT).wrapping_add(ONE)
+}
+
+/// Whether an OR of [`Coord::not_finite`] words says every coordinate was
+/// finite.
+#[inline(always)]
+pub(crate) fn all_finite(not_finite: u64) -> bool {
+    not_finite >> 63 == 0
 }
 
 impl Coord for f64 {
     #[inline(always)]
-    fn finite(self) -> bool {
-        self.is_finite()
+    fn not_finite(self) -> u64 {
+        exponent_carry(self)
     }
 }
 
 impl Coord for DVec3 {
     #[inline(always)]
-    fn finite(self) -> bool {
-        self.is_finite()
+    fn not_finite(self) -> u64 {
+        exponent_carry(self.x) | exponent_carry(self.y) | exponent_carry(self.z)
     }
 }
 
@@ -363,6 +385,68 @@ pub(crate) fn test_numbers(n: usize, seed: u64) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::{ParticleDef, SpringDef, World};
+
+    /// The top bit of `not_finite` is set exactly for infinities and NaNs:
+    /// every special value, the largest and smallest of each exponent, and
+    /// a million random bit patterns, alone and ORed in a vector's place.
+    #[test]
+    fn the_not_finite_word_is_is_finite() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            f64::MAX,
+            f64::MIN,
+            f64::MIN_POSITIVE,
+            f64::from_bits(1),
+            f64::from_bits(0x000f_ffff_ffff_ffff),
+            f64::from_bits(0x7fef_ffff_ffff_ffff),
+            f64::from_bits(0x7ff0_0000_0000_0001),
+            f64::from_bits(0xfff8_0000_0000_0000),
+            f64::from_bits(u64::MAX),
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+        ];
+        for e in 0..2048u64 {
+            values.push(f64::from_bits(e << 52));
+            values.push(f64::from_bits(
+                (e << 52) | 0x000f_ffff_ffff_ffff | (1 << 63),
+            ));
+        }
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..1_000_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            values.push(f64::from_bits(s));
+        }
+        let mut non_finite = 0;
+        for (k, &x) in values.iter().enumerate() {
+            assert_eq!(
+                all_finite(x.not_finite()),
+                x.is_finite(),
+                "{:#x}",
+                x.to_bits()
+            );
+            non_finite += usize::from(!x.is_finite());
+            let y = values[(k * 7 + 3) % values.len()];
+            for v in [
+                DVec3::new(x, 1.0, y),
+                DVec3::new(y, x, 2.0),
+                DVec3::new(-3.0, y, x),
+            ] {
+                assert_eq!(all_finite(v.not_finite()), v.is_finite(), "{v:?}");
+                // ORed with a finite coordinate's word, as the loops do.
+                assert_eq!(all_finite(v.not_finite() | 5.0.not_finite()), v.is_finite());
+            }
+        }
+        // About one random pattern in 2,048 is not finite.
+        assert!(
+            non_finite > 400,
+            "the patterns hold {non_finite} infinities and NaNs"
+        );
+    }
 
     /// Properties written field by field (not by a World) lack the
     /// per-coordinate inverse masses; `integrate` makes them, and the step is

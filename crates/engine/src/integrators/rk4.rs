@@ -3,7 +3,7 @@
 //! `x₁ = x₀ + h/6 (v₁ + 2v₂ + 2v₃ + v₄)`, `v₁ = v₀ + h/6 (a₁ + 2a₂ + 2a₃ + a₄)`.
 //! The thesis's default integrator.
 
-use super::{flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
+use super::{all_finite, flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
 use crate::parallel::{by_pieces, fold_by_pieces};
 use crate::particle::State;
 use crate::simd::{chosen, Use};
@@ -101,16 +101,16 @@ fn stage<T: Coord, const STAGE: u8>(
         }
         _ => {
             let sixth = s;
-            let mut finite = true;
+            let mut not_finite = 0;
             for i in 0..n {
                 let a = f[i] * w[i];
                 let x1 = x0[i] + (dx[i] + v[i]) * sixth;
                 let v1 = v0[i] + (dv[i] + a) * sixth;
                 x[i] = x1;
                 v[i] = v1;
-                finite &= x1.finite() & v1.finite();
+                not_finite |= x1.not_finite() | v1.not_finite();
             }
-            finite
+            all_finite(not_finite)
         }
     }
 }

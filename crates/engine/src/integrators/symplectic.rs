@@ -2,7 +2,7 @@
 //! `x₁ = x₀ + h v₁`. First order, but symplectic: on a conservative system its
 //! energy error oscillates and stays bounded instead of drifting.
 
-use super::{flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
+use super::{all_finite, flat, flat_mut, Coord, Dynamics, Finish, Settled, Written, SMALL};
 use crate::parallel::{by_pieces, fold_by_pieces};
 use crate::particle::State;
 use crate::simd::{chosen, Use};
@@ -150,15 +150,15 @@ fn update<T: Coord>(
 ) -> bool {
     let n = x1.len();
     let (x0, v0, f, w, v1) = (&x0[..n], &v0[..n], &f[..n], &w[..n], &mut v1[..n]);
-    let mut finite = true;
+    let mut not_finite = 0;
     for i in 0..n {
         let v = v0[i] + f[i] * (h * w[i]);
         let x = x0[i] + v * h;
         v1[i] = v;
         x1[i] = x;
-        finite &= v.finite() & x.finite();
+        not_finite |= v.not_finite() | x.not_finite();
     }
-    finite
+    all_finite(not_finite)
 }
 
 #[cfg(test)]
