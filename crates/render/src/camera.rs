@@ -68,9 +68,20 @@ impl View {
     /// The unit ray through the point (px, py) of the image (pixel centres
     /// are at half-integers).
     pub fn ray(&self, px: f64, py: f64) -> DVec3 {
+        (self.column(px) + self.row(py)).normalize()
+    }
+
+    /// The part of [`Self::ray`] (before its normalisation) that depends
+    /// only on `px`: the renderer computes it once for each column.
+    pub fn column(&self, px: f64) -> DVec3 {
         let x = (2.0 * px / self.width - 1.0) * self.tan_half * self.aspect;
+        self.forward + self.right * x
+    }
+
+    /// The part of [`Self::ray`] that depends only on `py`, added last.
+    pub fn row(&self, py: f64) -> DVec3 {
         let y = (1.0 - 2.0 * py / self.height) * self.tan_half;
-        (self.forward + self.right * x + self.up * y).normalize()
+        self.up * y
     }
 
     /// Where `p` appears on the image (x, y in pixels) and its depth along

@@ -24,6 +24,7 @@ const SUN: DVec3 = DVec3::new(0.3, 1.0, 0.5);
 const WATER_FOG: f64 = 0.18;
 
 /// Colour and depth buffers at the supersampled size.
+#[derive(Default)]
 struct Canvas {
     width: u32,
     height: u32,
@@ -32,42 +33,81 @@ struct Canvas {
     depth: Vec<f64>,
     /// Where each pixel's ray meets the floor, if it shows the floor.
     floor: Vec<Option<DVec3>>,
+    /// Each pixel column's and row's part of its ray ([`View::column`],
+    /// [`View::row`]).
+    columns: Vec<DVec3>,
+    rows: Vec<DVec3>,
+}
+
+impl Canvas {
+    /// The canvas sized for a `w` × `h` picture seen by `view`, reusing
+    /// the buffers of the last picture: a GIF's frames, drawn one after
+    /// another on a thread, then allocate nothing (a fresh 64 MB a frame
+    /// for a zoo's 640 × 400 tiles had the kernel zeroing new pages for a
+    /// tenth of the render's time).
+    fn clear(&mut self, view: &View, w: u32, h: u32) {
+        let n = (w * h) as usize;
+        (self.width, self.height) = (w, h);
+        // Sized only: `backdrop` writes every pixel first.
+        self.colour.resize(n, Colour::ZERO);
+        self.depth.resize(n, f64::INFINITY);
+        self.floor.resize(n, None);
+        self.columns.clear();
+        self.columns
+            .extend((0..w).map(|x| view.column(f64::from(x) + 0.5)));
+        self.rows.clear();
+        self.rows
+            .extend((0..h).map(|y| view.row(f64::from(y) + 0.5)));
+    }
+
+    /// The unit ray through the centre of pixel (x, y): [`View::ray`]'s
+    /// bits, from the parts computed once a frame.
+    #[inline]
+    fn ray(&self, x: u32, y: u32) -> DVec3 {
+        (self.columns[x as usize] + self.rows[y as usize]).normalize()
+    }
+}
+
+thread_local! {
+    /// Each thread's canvas, kept from one picture to the next.
+    static CANVAS: std::cell::RefCell<Canvas> = std::cell::RefCell::default();
 }
 
 /// Renders `picture` seen by `camera` as a `width` × `height` image.
 pub fn render(picture: &Picture, camera: &Camera, width: u32, height: u32) -> Image {
+    CANVAS.with(|c| match c.try_borrow_mut() {
+        Ok(mut c) => render_on(&mut c, picture, camera, width, height),
+        // (Only if a render were to call itself.)
+        Err(_) => render_on(&mut Canvas::default(), picture, camera, width, height),
+    })
+}
+
+fn render_on(c: &mut Canvas, picture: &Picture, camera: &Camera, width: u32, height: u32) -> Image {
     let (w, h) = (width.max(1) * SUPERSAMPLE, height.max(1) * SUPERSAMPLE);
     let view = View::new(camera, w, h);
-    let n = (w * h) as usize;
-    let mut c = Canvas {
-        width: w,
-        height: h,
-        colour: vec![Colour::ZERO; n],
-        depth: vec![f64::INFINITY; n],
-        floor: vec![None; n],
-    };
+    c.clear(&view, w, h);
     let sun = SUN.normalize();
-    backdrop(&mut c, &view, picture);
+    backdrop(c, &view, picture);
     if let (Some(cell), Some((mesh, _))) = (picture.floor, &picture.ground) {
-        ground(&mut c, &view, mesh, cell, picture.water);
+        ground(c, &view, mesh, cell, picture.water);
     }
     if picture.floor.is_some() {
         let terrain = picture.ground.as_ref().map(|(_, t)| t);
         for s in picture.spheres.iter().filter(|s| s.shadow) {
-            shadow(&mut c, &view, s, terrain);
+            shadow(c, &view, s, terrain);
         }
     }
     for s in &picture.spheres {
-        sphere(&mut c, &view, s, sun);
+        sphere(c, &view, s, sun);
     }
     for r in &picture.rods {
-        rod(&mut c, &view, r, sun);
+        rod(c, &view, r, sun);
     }
     for b in &picture.bells {
-        bell(&mut c, &view, b, sun);
+        bell(c, &view, b, sun);
     }
-    fog(&mut c, &view, picture.water);
-    let mut image = downsample(&c, width.max(1), height.max(1));
+    fog(c, picture.water);
+    let mut image = downsample(c, width.max(1), height.max(1));
     if let Some(caption) = &picture.caption {
         image.caption(caption);
     }
@@ -83,34 +123,39 @@ fn sky_colour(ray: DVec3) -> Colour {
     hex(0xdfe9f2).lerp(hex(0x9fbdd8), ray.y.clamp(0.0, 1.0).sqrt())
 }
 
-/// Sky (or water) and the floor, one ray per pixel.
+/// Sky (or water) and the floor, one ray per pixel: every pixel's colour,
+/// depth and floor point written (the canvas is not cleared before).
 fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
     let (light, dark) = floor_colours(picture.water);
     // Lambert under the sun, as the live view's floor.
     let lit = 0.55 + 0.45 * SUN.normalize().y;
     let (light, dark) = (light * lit, dark * lit);
-    for y in 0..c.height {
-        for x in 0..c.width {
-            let i = (y * c.width + x) as usize;
-            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            c.colour[i] = if picture.water {
+    let cell = picture.floor.filter(|_| picture.ground.is_none());
+    let eye = view.eye;
+    let w = c.width as usize;
+    for (y, row) in c.rows.iter().enumerate() {
+        let at = y * w;
+        let colour = &mut c.colour[at..at + w];
+        let depth = &mut c.depth[at..at + w];
+        let floor = &mut c.floor[at..at + w];
+        for (x, column) in c.columns.iter().enumerate() {
+            let ray = (*column + *row).normalize();
+            let back = if picture.water {
                 water_colour(ray)
             } else {
                 sky_colour(ray)
             };
-            let Some(cell) = picture.floor.filter(|_| picture.ground.is_none()) else {
-                continue;
+            (colour[x], depth[x], floor[x]) = match cell {
+                Some(cell) if !(ray.y >= -1e-9 || eye.y <= 0.0) => {
+                    let t = -eye.y / ray.y;
+                    let p = eye + ray * t;
+                    let odd = ((p.x / cell).floor() as i64 + (p.z / cell).floor() as i64)
+                        .rem_euclid(2)
+                        == 1;
+                    (if odd { dark } else { light }, t, Some(p))
+                }
+                _ => (back, f64::INFINITY, None),
             };
-            if ray.y >= -1e-9 || view.eye.y <= 0.0 {
-                continue;
-            }
-            let t = -view.eye.y / ray.y;
-            let p = view.eye + ray * t;
-            let odd =
-                ((p.x / cell).floor() as i64 + (p.z / cell).floor() as i64).rem_euclid(2) == 1;
-            c.colour[i] = if odd { dark } else { light };
-            c.depth[i] = t;
-            c.floor[i] = Some(p);
         }
     }
 }
@@ -145,7 +190,7 @@ fn ground(c: &mut Canvas, view: &View, mesh: &GroundMesh, cell: f64, water: bool
         let lit = (0.55 + 0.45 * sun.y + 1.5 * (normal.dot(sun) - sun.y)).clamp(0.3, 1.1);
         for y in y0..y1 {
             for x in x0..x1 {
-                let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let ray = c.ray(x, y);
                 // Möller–Trumbore.
                 let p = ray.cross(e2);
                 let det = e1.dot(p);
@@ -289,7 +334,7 @@ fn sphere(c: &mut Canvas, view: &View, s: &Sphere, sun: DVec3) {
     let cc = oc.length_squared() - s.radius * s.radius;
     for y in y0..y1 {
         for x in x0..x1 {
-            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let ray = c.ray(x, y);
             let b = oc.dot(ray);
             let disc = b * b - cc;
             if disc < 0.0 {
@@ -323,7 +368,7 @@ fn rod(c: &mut Canvas, view: &View, r: &Rod, sun: DVec3) {
     let baoc = ba.dot(oc);
     for y in y0..y1 {
         for x in x0..x1 {
-            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let ray = c.ray(x, y);
             // Ray against the finite cylinder (the ends are under the spheres).
             let bard = ba.dot(ray);
             let k2 = baba - bard * bard;
@@ -370,7 +415,7 @@ fn bell(c: &mut Canvas, view: &View, b: &Bell, sun: DVec3) {
     let o = local(view.eye - b.centre);
     for y in y0..y1 {
         for x in x0..x1 {
-            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let ray = c.ray(x, y);
             let d = local(ray);
             let (a2, b2, c2) = (d.length_squared(), o.dot(d), o.length_squared() - 1.0);
             let disc = b2 * b2 - a2 * c2;
@@ -401,24 +446,43 @@ fn bell(c: &mut Canvas, view: &View, b: &Bell, sun: DVec3) {
 
 /// Water fades everything into its colour with distance; air only the far
 /// floor into the haze of the horizon.
-fn fog(c: &mut Canvas, view: &View, water: bool) {
-    for y in 0..c.height {
-        for x in 0..c.width {
-            let i = (y * c.width + x) as usize;
-            let t = c.depth[i];
-            if !t.is_finite() {
-                continue;
-            }
-            let ray = view.ray(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let (haze, density) = if water {
-                (water_colour(ray), WATER_FOG)
+fn fog(c: &mut Canvas, water: bool) {
+    use animats_engine::math::{exp_lanes, LANES};
+    let density = if water { WATER_FOG } else { 1.0 / 60.0 };
+    // In air the haze is the sky's colour at the horizon (`sky_colour` of a
+    // level ray: it reads only the ray's height), whatever the pixel.
+    let horizon = sky_colour(DVec3::ZERO);
+    // The pixels that show something, LANES at a time: `exp_lanes` gives
+    // each lane `exp`'s bits, side by side.
+    let fade = |c: &mut Canvas, at: &[usize]| {
+        let mut arg = [0.0; LANES];
+        for (a, &i) in arg.iter_mut().zip(at) {
+            *a = -density * c.depth[i];
+        }
+        let keep = exp_lanes(arg);
+        for (&keep, &i) in keep.iter().zip(at) {
+            let haze = if water {
+                let w = c.width as usize;
+                water_colour(c.ray((i % w) as u32, (i / w) as u32))
             } else {
-                (sky_colour(DVec3::new(ray.x, 0.0, ray.z)), 1.0 / 60.0)
+                horizon
             };
-            let keep = libm::exp(-density * t);
             c.colour[i] = haze.lerp(c.colour[i], keep);
         }
+    };
+    let mut at = [0usize; LANES];
+    let mut k = 0;
+    for i in 0..c.depth.len() {
+        if c.depth[i].is_finite() {
+            at[k] = i;
+            k += 1;
+            if k == LANES {
+                fade(c, &at);
+                k = 0;
+            }
+        }
     }
+    fade(c, &at[..k]);
 }
 
 /// Averages each SUPERSAMPLE × SUPERSAMPLE block into one 8-bit pixel.

@@ -199,6 +199,20 @@ fn the_same_picture_renders_the_same_bytes() {
     let b = render(&pic, &camera(), W, H);
     assert_eq!(a, b);
     assert_eq!(a.png().expect("png"), b.png().expect("png"));
+    // Each thread keeps its canvas from one picture to the next, unclear
+    // (the backdrop writes every pixel first): pictures of other sizes,
+    // under water, with no floor, leave nothing behind; a fresh thread
+    // draws the same.
+    let water = Picture {
+        water: true,
+        ..pic.clone()
+    };
+    render(&water, &camera(), W + 37, H / 2);
+    render(&Picture::default(), &camera(), 16, 9);
+    render(&water, &camera(), W, H);
+    assert_eq!(render(&pic, &camera(), W, H), a, "after other pictures");
+    let fresh = std::thread::spawn(move || render(&pic, &camera(), W, H));
+    assert_eq!(fresh.join().expect("thread"), a, "on a fresh thread");
 }
 
 #[test]
