@@ -129,34 +129,112 @@ fn backdrop(c: &mut Canvas, view: &View, picture: &Picture) {
     let (light, dark) = floor_colours(picture.water);
     // Lambert under the sun, as the live view's floor.
     let lit = 0.55 + 0.45 * SUN.normalize().y;
-    let (light, dark) = (light * lit, dark * lit);
-    let cell = picture.floor.filter(|_| picture.ground.is_none());
-    let eye = view.eye;
+    let back = Backdrop {
+        light: light * lit,
+        dark: dark * lit,
+        cell: picture.floor.filter(|_| picture.ground.is_none()),
+        eye: view.eye,
+        water: picture.water,
+    };
     let w = c.width as usize;
     for (y, row) in c.rows.iter().enumerate() {
         let at = y * w;
-        let colour = &mut c.colour[at..at + w];
-        let depth = &mut c.depth[at..at + w];
-        let floor = &mut c.floor[at..at + w];
-        for (x, column) in c.columns.iter().enumerate() {
-            let ray = (*column + *row).normalize();
-            let back = if picture.water {
-                water_colour(ray)
-            } else {
-                sky_colour(ray)
-            };
-            (colour[x], depth[x], floor[x]) = match cell {
-                Some(cell) if !(ray.y >= -1e-9 || eye.y <= 0.0) => {
-                    let t = -eye.y / ray.y;
-                    let p = eye + ray * t;
-                    let odd = ((p.x / cell).floor() as i64 + (p.z / cell).floor() as i64)
-                        .rem_euclid(2)
-                        == 1;
-                    (if odd { dark } else { light }, t, Some(p))
-                }
-                _ => (back, f64::INFINITY, None),
-            };
+        let mut colour = &mut c.colour[at..at + w];
+        let mut depth = &mut c.depth[at..at + w];
+        let mut floor = &mut c.floor[at..at + w];
+        let mut columns = &c.columns[..];
+        // Four pixels at a time, whose square roots and divisions the
+        // compiler computes side by side; the rest one by one.
+        while columns.len() >= 4 {
+            back.pixels::<4>(columns, *row, colour, depth, floor);
+            (columns, colour, depth, floor) = (
+                &columns[4..],
+                &mut colour[4..],
+                &mut depth[4..],
+                &mut floor[4..],
+            );
         }
+        for k in 0..columns.len() {
+            back.pixels::<1>(
+                &columns[k..],
+                *row,
+                &mut colour[k..],
+                &mut depth[k..],
+                &mut floor[k..],
+            );
+        }
+    }
+}
+
+/// What the backdrop draws.
+struct Backdrop {
+    light: Colour,
+    dark: Colour,
+    /// The flat floor's checker size, if it draws the floor.
+    cell: Option<f64>,
+    eye: DVec3,
+    water: bool,
+}
+
+impl Backdrop {
+    /// `N` pixels of a row: their rays (`Canvas::ray`'s operations, in
+    /// separate arrays), where each meets the floor, and what each shows.
+    #[inline(always)]
+    fn pixels<const N: usize>(
+        &self,
+        columns: &[DVec3],
+        row: DVec3,
+        colour: &mut [Colour],
+        depth: &mut [f64],
+        floor: &mut [Option<DVec3>],
+    ) {
+        let eye = self.eye;
+        let (mut x, mut y, mut z) = ([0.0; N], [0.0; N], [0.0; N]);
+        for l in 0..N {
+            let v = columns[l] + row;
+            // glam's `normalize`: times 1 / √(x x + y y + z z).
+            let r = 1.0 / ((v.x * v.x + v.y * v.y) + v.z * v.z).sqrt();
+            (x[l], y[l], z[l]) = (v.x * r, v.y * r, v.z * r);
+        }
+        let (mut t, mut px, mut pz, mut fx, mut fz) =
+            ([0.0; N], [0.0; N], [0.0; N], [0.0; N], [0.0; N]);
+        let cell = self.cell.unwrap_or(1.0);
+        for l in 0..N {
+            t[l] = -eye.y / y[l];
+            px[l] = eye.x + x[l] * t[l];
+            pz[l] = eye.z + z[l] * t[l];
+            fx[l] = (px[l] / cell).floor();
+            fz[l] = (pz[l] / cell).floor();
+        }
+        for l in 0..N {
+            let ray = DVec3::new(x[l], y[l], z[l]);
+            (colour[l], depth[l], floor[l]) =
+                if self.cell.is_some() && !(ray.y >= -1e-9 || eye.y <= 0.0) {
+                    let odd = odd_square(fx[l], fz[l]);
+                    let p = DVec3::new(px[l], eye.y + y[l] * t[l], pz[l]);
+                    (if odd { self.dark } else { self.light }, t[l], Some(p))
+                } else if self.water {
+                    (water_colour(ray), f64::INFINITY, None)
+                } else {
+                    (sky_colour(ray), f64::INFINITY, None)
+                };
+        }
+    }
+}
+
+/// Whether the checker square (`fx`, `fz`) (the floors of a floor point's
+/// coordinates over the square's size) is a dark one: as `(fx as i64 + fz
+/// as i64).rem_euclid(2) == 1`, from each one's parity in floating point
+/// (vectorised, where the conversions are one at a time), exact below
+/// 2⁵³; the conversions decide the rest (never on a picture's floor).
+#[inline(always)]
+fn odd_square(fx: f64, fz: f64) -> bool {
+    const EXACT: f64 = 9_007_199_254_740_992.0; // 2⁵³
+    if fx.abs() < EXACT && fz.abs() < EXACT {
+        let parity = |f: f64| f - 2.0 * (f * 0.5).floor();
+        parity(fx) != parity(fz)
+    } else {
+        (fx as i64).wrapping_add(fz as i64).rem_euclid(2) == 1
     }
 }
 
@@ -503,4 +581,52 @@ fn downsample(c: &Canvas, width: u32, height: u32) -> Image {
         }
     }
     Image { width, height, rgb }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::odd_square;
+
+    /// `odd_square` is the integer conversions' answer for floors near
+    /// zero, either side of 2⁵³ and 2⁶³, at the extremes, for ±0, ±∞ and
+    /// NaN, and for a million random pairs of every magnitude.
+    #[test]
+    fn odd_squares_are_the_integer_parity() {
+        let reference = |fx: f64, fz: f64| (fx as i64).wrapping_add(fz as i64).rem_euclid(2) == 1;
+        let mut values = vec![
+            0.0,
+            -0.0,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            f64::MAX,
+            f64::MIN,
+        ];
+        for base in [
+            0.0f64,
+            2f64.powi(52),
+            2f64.powi(53),
+            2f64.powi(63),
+            2f64.powi(64),
+        ] {
+            for d in -3..=3 {
+                let v = (base + f64::from(d) * base.max(1.0) * f64::EPSILON).floor();
+                values.extend([v, -v, v + 1.0, -v - 1.0]);
+            }
+        }
+        for &a in &values {
+            for &b in &values {
+                assert_eq!(odd_square(a, b), reference(a, b), "{a:e}, {b:e}");
+            }
+        }
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..1_000_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let m = (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5;
+            let (a, b) = ((m * 2f64.powi((s % 70) as i32)).floor(), (-m * 3e4).floor());
+            assert_eq!(odd_square(a, b), reference(a, b), "{a:e}, {b:e}");
+        }
+    }
 }
